@@ -1,0 +1,61 @@
+"""Input checks shared by every module: one clear message per bad value."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint.errors import ParameterError, ParameterTypeError
+
+
+def real_scalar(name: str, value: Any, *, unit: str = "") -> float:
+    """Return ``value`` as a finite float, or raise an error naming ``name``."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        raise ParameterTypeError(
+            f"{name} must be a real number{_in(unit)}, got {value!r} of type {type(value).__name__}"
+        )
+    result = float(value)
+    if not math.isfinite(result):
+        raise ParameterError(f"{name} must be finite{_in(unit)}, got {result!r}")
+    return result
+
+
+def positive(name: str, value: Any, *, unit: str = "") -> float:
+    """Return ``value`` as a float > 0, or raise an error naming ``name``."""
+    result = real_scalar(name, value, unit=unit)
+    if result <= 0.0:
+        raise ParameterError(f"{name} must be > 0{_in(unit)}, got {result!r}")
+    return result
+
+
+def non_negative(name: str, value: Any, *, unit: str = "") -> float:
+    """Return ``value`` as a float >= 0, or raise an error naming ``name``."""
+    result = real_scalar(name, value, unit=unit)
+    if result < 0.0:
+        raise ParameterError(f"{name} must be >= 0{_in(unit)}, got {result!r}")
+    return result
+
+
+def non_negative_array(name: str, value: Any, *, unit: str = "") -> NDArray[np.float64]:
+    """Return ``value`` as a float array with every entry finite and >= 0."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ParameterTypeError(
+            f"{name} must be a number or an array of numbers{_in(unit)}, got {value!r}"
+        ) from exc
+    if array.size and not np.all(np.isfinite(array)):
+        raise ParameterError(f"{name} must be finite{_in(unit)}; it contains NaN or inf")
+    if array.size and np.any(array < 0.0):
+        raise ParameterError(
+            f"{name} must be >= 0{_in(unit)}; smallest value is {float(array.min())!r}"
+        )
+    return array
+
+
+def _in(unit: str) -> str:
+    return f" (in {unit})" if unit else ""

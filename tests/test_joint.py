@@ -1,0 +1,99 @@
+"""Joint: validation at construction and the restoring force of MODEL.md sec. 0."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint import Joint, ParameterError, ParameterTypeError
+
+
+def make(**changes: object) -> Joint:
+    values: dict[str, object] = {"mass": 2.0, "clearance": 1e-4, "compression_stiffness": 8e7}
+    values.update(changes)
+    return Joint(**values)  # type: ignore[arg-type]
+
+
+def test_defaults_are_symmetric_centred_and_without_gap_spring() -> None:
+    joint = make()
+    assert joint.tension_stiffness == joint.compression_stiffness
+    assert joint.gap_stiffness == 0.0
+    assert joint.compression_gap == joint.tension_gap == pytest.approx(5e-5)
+
+
+def test_is_frozen() -> None:
+    joint = make()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        joint.mass = 3.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "words"),
+    [
+        ("mass", 0.0, "mass must be > 0"),
+        ("mass", -1.0, "mass must be > 0"),
+        ("mass", math.nan, "mass must be finite"),
+        ("clearance", -1e-6, "clearance must be >= 0"),
+        ("clearance", math.inf, "clearance must be finite"),
+        ("compression_stiffness", 0.0, "compression_stiffness must be > 0"),
+        ("tension_stiffness", -5.0, "tension_stiffness must be > 0"),
+        ("gap_stiffness", -1.0, "gap_stiffness must be >= 0"),
+        ("gap_stiffness", math.nan, "gap_stiffness must be finite"),
+        ("gap_offset", 6e-5, "gap_offset must lie within the clearance"),
+        ("gap_offset", -6e-5, "gap_offset must lie within the clearance"),
+    ],
+)
+def test_invalid_values_name_the_field(field: str, value: float, words: str) -> None:
+    with pytest.raises(ParameterError, match=words):
+        make(**{field: value})
+
+
+@pytest.mark.parametrize("value", ["1", None, True, [1.0]])
+def test_wrong_types_are_type_errors(value: object) -> None:
+    with pytest.raises(ParameterTypeError, match="mass must be a real number"):
+        make(mass=value)
+
+
+def test_errors_are_value_errors_for_generic_handlers() -> None:
+    with pytest.raises(ValueError, match="clearance"):
+        make(clearance=-1.0)
+
+
+def test_offset_at_the_edge_of_the_clearance_is_allowed() -> None:
+    joint = make(gap_offset=5e-5)
+    assert joint.tension_gap == 0.0
+    assert joint.compression_gap == pytest.approx(1e-4)
+
+
+def test_restoring_force_by_stage() -> None:
+    joint = make(tension_stiffness=3e7, gap_stiffness=1e5, gap_offset=1e-5)
+    g_c, g_t = 6e-5, 4e-5
+    x = np.array([-1e-4, -g_t, 0.0, 2e-5, g_c, 2e-4])
+    expected = [
+        1e5 * -1e-4 + 3e7 * (-1e-4 + g_t),
+        1e5 * -g_t,
+        0.0,
+        1e5 * 2e-5,
+        1e5 * g_c,
+        1e5 * 2e-4 + 8e7 * (2e-4 - g_c),
+    ]
+    np.testing.assert_allclose(joint.restoring_force(x), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_potential_is_the_integral_of_the_force() -> None:
+    from scipy.integrate import quad
+
+    joint = make(tension_stiffness=3e7, gap_stiffness=1e5, gap_offset=-2e-5)
+    for x in (-3e-4, -1e-5, 4e-5, 2.5e-4):
+        numeric, _ = quad(lambda s: float(joint.restoring_force(s)), 0.0, x, points=[-7e-5, 3e-5])
+        assert float(joint.potential_energy(x)) == pytest.approx(numeric, rel=1e-10)
+
+
+def test_large_amplitude_stiffness_is_the_bilinear_oscillators() -> None:
+    joint = make(tension_stiffness=2e7, gap_stiffness=1e6)
+    big_c, big_t = 8.1e7, 2.1e7
+    period = math.pi * math.sqrt(2.0 / big_c) + math.pi * math.sqrt(2.0 / big_t)
+    assert joint.large_amplitude_stiffness == pytest.approx(2.0 * (2 * math.pi / period) ** 2)
