@@ -1,0 +1,157 @@
+"""The ``clearjoint`` command line: parses, calls the library, prints. No physics here.
+
+Quantities take units (``0.106mm``, ``5um``, ``8e7N/m``; SI when none) and
+frequencies are in Hz. Bad input ends with exit code 2 and one line on stderr
+that says what is wrong.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+import numpy as np
+
+from clearjoint import __version__
+from clearjoint.errors import ClearjointError
+
+EXIT_BAD_INPUT = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line and exit code 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def _stiffness_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "stiffness",
+        help="dynamic stiffness of a clearance joint at given amplitudes (MODEL.md sec. 1)",
+        description=(
+            "Exact period, natural frequency, dynamic stiffness k_d = m w_n^2 and stiffness "
+            "coefficient c_d = k_d / k_inf of a joint with clearance, at one or several "
+            "amplitudes A beyond the compression gap edge. Units may be given "
+            "(0.106mm, 5um, 8e7N/m); a bare number is SI."
+        ),
+    )
+    p.add_argument("--mass", required=True, help="moving mass, e.g. 2kg")
+    p.add_argument("--stiffness", required=True, help="compression contact stiffness, e.g. 8e7N/m")
+    p.add_argument("--tension-stiffness", help="tension contact stiffness (default: --stiffness)")
+    p.add_argument("--gap-stiffness", default="0", help="stiffness inside the gap k0 (default 0)")
+    p.add_argument("--clearance", required=True, help="total axial clearance, e.g. 0.106mm")
+    p.add_argument("--gap-offset", default="0", help="offset of the gap centre (default 0)")
+    p.add_argument(
+        "--amplitude", required=True, help="penetration(s) beyond the gap edge, e.g. 1um,5um,20um"
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+
+
+def _reproduce_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "reproduce",
+        help="run the paper's study and write a report",
+        description="Run the reproduction of the paper's study and write DIR/report.html "
+        "and DIR/results.json.",
+    )
+    p.add_argument("--out", default="clearjoint-reproduction", help="output folder")
+    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the argument parser of the ``clearjoint`` command."""
+    parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
+    parser.add_argument("--version", action="version", version=f"clearjoint {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    _stiffness_parser(sub)
+    _reproduce_parser(sub)
+    return parser
+
+
+def _joint_from(args: argparse.Namespace) -> Any:
+    from clearjoint.joint import Joint
+    from clearjoint.units import parse_quantity
+
+    stiffness = parse_quantity(args.stiffness, "stiffness", name="--stiffness")
+    return Joint(
+        mass=parse_quantity(args.mass, "mass", name="--mass"),
+        clearance=parse_quantity(args.clearance, "length", name="--clearance"),
+        compression_stiffness=stiffness,
+        tension_stiffness=(
+            stiffness
+            if args.tension_stiffness is None
+            else parse_quantity(args.tension_stiffness, "stiffness", name="--tension-stiffness")
+        ),
+        gap_stiffness=parse_quantity(args.gap_stiffness, "stiffness", name="--gap-stiffness"),
+        gap_offset=parse_quantity(args.gap_offset, "length", name="--gap-offset"),
+    )
+
+
+def _json_value(values: np.ndarray, several: bool) -> Any:
+    """A JSON number for one amplitude, a list for several; inf becomes null."""
+    cleaned = [float(v) if np.isfinite(v) else None for v in np.atleast_1d(values)]
+    return cleaned if several else cleaned[0]
+
+
+def _run_stiffness(args: argparse.Namespace) -> int:
+    from clearjoint import stiffness
+    from clearjoint.units import parse_quantity_list
+
+    joint = _joint_from(args)
+    amplitudes = np.array(parse_quantity_list(args.amplitude, "length", name="--amplitude"))
+    period = stiffness.period(joint, amplitudes)
+    with np.errstate(divide="ignore"):
+        frequency_hz = 1.0 / period
+    k_d = stiffness.dynamic_stiffness(joint, amplitudes)
+    c_d = stiffness.stiffness_coefficient(joint, amplitudes)
+    several = amplitudes.size > 1
+    if args.json:
+        out = {
+            "amplitude_m": _json_value(amplitudes, several),
+            "period_s": _json_value(period, several),
+            "natural_frequency_hz": _json_value(frequency_hz, several),
+            "dynamic_stiffness_n_per_m": _json_value(k_d, several),
+            "stiffness_coefficient": _json_value(c_d, several),
+        }
+        print(json.dumps(out))
+        return 0
+    print(
+        f"joint: m = {joint.mass:g} kg, c = {joint.clearance * 1e3:g} mm, "
+        f"k_c = {joint.compression_stiffness:.4g} N/m, k_t = {joint.tension_stiffness:.4g} N/m, "
+        f"k0 = {joint.gap_stiffness:.4g} N/m, k_inf = {joint.large_amplitude_stiffness:.4g} N/m"
+    )
+    header = f"{'A (um)':>12} {'T (ms)':>12} {'f_n (Hz)':>12} {'k_d (N/m)':>12} {'c_d':>8}"
+    print(header)
+    print("-" * len(header))
+    for a, t, f, k, c in zip(amplitudes, period, frequency_hz, k_d, c_d, strict=True):
+        print(f"{a * 1e6:12.4g} {t * 1e3:12.5g} {f:12.5g} {k:12.5g} {c:8.4f}")
+    return 0
+
+
+def _run_reproduce(args: argparse.Namespace) -> int:
+    from clearjoint.report import NOT_BUILT, reproduce
+
+    written = reproduce(
+        Path(args.out), force=args.force, progress=lambda m: print(f"- {m}", file=sys.stderr)
+    )
+    for path in written:
+        print(f"wrote {path}")
+    print("not built yet: " + "; ".join(NOT_BUILT))
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    runners = {"stiffness": _run_stiffness, "reproduce": _run_reproduce}
+    try:
+        return runners[args.command](args)
+    except ClearjointError as exc:
+        print(f"clearjoint {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
