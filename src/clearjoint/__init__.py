@@ -9,13 +9,15 @@ circular frequencies in rad/s.
 
 from clearjoint import stiffness
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
-from clearjoint.joint import Joint
+from clearjoint.joint import Friction, Joint, Pin
 
 __all__ = [
     "ClearjointError",
+    "Friction",
     "Joint",
     "ParameterError",
     "ParameterTypeError",
+    "Pin",
     "stiffness",
 ]
 

@@ -117,3 +117,106 @@ class Joint:
         )
         energy = energy + 0.5 * self.tension_stiffness * np.minimum(x + self.tension_gap, 0.0) ** 2
         return energy
+
+
+FRICTION_REGIONS = ("everywhere", "free-play")
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Coulomb sliding friction mu_s P sign(x') from a lateral load (MODEL.md eq 10).
+
+    Parameters
+    ----------
+    coefficient : float
+        Sliding-friction coefficient mu_s >= 0 (static and kinetic taken equal).
+    lateral_load : float
+        Lateral (transverse) load P >= 0 in the joint or bearing, N.
+    region : {"everywhere", "free-play"}
+        Where the friction acts: over the whole path (default: P in the bearing, or
+        the joint's faces sliding with the structure), or over the free-play stroke
+        only (P at the joint faces, which stop slipping once the pin bears).
+    """
+
+    coefficient: float
+    lateral_load: float
+    region: str = "everywhere"
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "coefficient", _checks.non_negative("friction coefficient", self.coefficient))
+        set_(
+            self, "lateral_load", _checks.non_negative("lateral_load", self.lateral_load, unit="N")
+        )
+        if self.region not in FRICTION_REGIONS:
+            raise ParameterError(
+                f"friction region must be one of {FRICTION_REGIONS}, got {self.region!r}"
+            )
+
+    @property
+    def force(self) -> float:
+        """The friction force mu_s P, N."""
+        return self.coefficient * self.lateral_load
+
+
+@dataclass(frozen=True)
+class Pin:
+    """The pin and its hole: geometry and elastic constants for Hertz contact (MODEL.md eq 13).
+
+    Parameters
+    ----------
+    radius : float
+        Pin radius R_p, m, > 0.
+    hole_radius : float
+        Hole radius R_h > R_p, m (R_h = R_p + radial clearance).
+    length : float
+        Contact length L_p, m, > 0.
+    youngs_modulus : float
+        Young's modulus of the pin E_p, Pa, > 0.
+    poisson_ratio : float
+        Poisson's ratio of the pin, 0 <= nu < 0.5.
+    hole_youngs_modulus, hole_poisson_ratio : float, optional
+        Those of the hole's material; default: the pin's.
+    """
+
+    radius: float
+    hole_radius: float
+    length: float
+    youngs_modulus: float = 2.06e11
+    poisson_ratio: float = 0.3
+    hole_youngs_modulus: float = field(default=None)  # type: ignore[assignment]
+    hole_poisson_ratio: float = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "radius", _checks.positive("pin radius", self.radius, unit="m"))
+        hole = _checks.positive("hole_radius", self.hole_radius, unit="m")
+        if hole <= self.radius:
+            raise ParameterError(
+                f"hole_radius must be larger than the pin radius {self.radius!r} m, got {hole!r}"
+            )
+        set_(self, "hole_radius", hole)
+        set_(self, "length", _checks.positive("pin length", self.length, unit="m"))
+        e_p = _checks.positive("youngs_modulus", self.youngs_modulus, unit="Pa")
+        set_(self, "youngs_modulus", e_p)
+        nu_p = _poisson("poisson_ratio", self.poisson_ratio)
+        set_(self, "poisson_ratio", nu_p)
+        e_h = e_p if self.hole_youngs_modulus is None else self.hole_youngs_modulus
+        set_(self, "hole_youngs_modulus", _checks.positive("hole_youngs_modulus", e_h, unit="Pa"))
+        nu_h = nu_p if self.hole_poisson_ratio is None else self.hole_poisson_ratio
+        set_(self, "hole_poisson_ratio", _poisson("hole_poisson_ratio", nu_h))
+
+    @classmethod
+    def for_clearance(
+        cls, radius: float, clearance: float, length: float, **materials: float
+    ) -> Pin:
+        """A pin whose hole carries the joint's whole axial clearance: R_h = R_p + c/2."""
+        c = _checks.positive("clearance", clearance, unit="m")
+        return cls(radius=radius, hole_radius=radius + 0.5 * c, length=length, **materials)
+
+
+def _poisson(name: str, value: float) -> float:
+    nu = _checks.real_scalar(name, value)
+    if not 0.0 <= nu < 0.5:
+        raise ParameterError(f"{name} must satisfy 0 <= nu < 0.5, got {nu!r}")
+    return nu

@@ -1,0 +1,31 @@
+"""Exact, event-driven time-domain simulation of the forced clearance joint.
+
+``steady_state``, ``time_response`` and ``frequency_sweep`` advance the motion
+state by state in closed form (see ``_kernel``); ``reference_time_response``
+solves the same equations with scipy's solve_ivp and event location, as a
+cross-check. MODEL.md sec. 1-2.
+"""
+
+from clearjoint.simulate.core import (
+    EnergyLedger,
+    FrequencySweep,
+    Motion,
+    SimulationError,
+    Stage,
+    SteadyState,
+    frequency_sweep,
+    steady_state,
+    time_response,
+)
+
+__all__ = [
+    "EnergyLedger",
+    "FrequencySweep",
+    "Motion",
+    "SimulationError",
+    "Stage",
+    "SteadyState",
+    "frequency_sweep",
+    "steady_state",
+    "time_response",
+]

@@ -1,0 +1,609 @@
+"""Exact time-domain response of the forced clearance joint, with its energy ledger.
+
+MODEL.md sec. 2: m x'' + c_v x' + f(x) + mu_s P sgn(x') = F0 sin(w t), with
+x' -> e x' on entering contact. The motion is advanced state by state in closed
+form by the compiled kernel (``_kernel.py``); this module sets it up, detects the
+steady state (period-1 or period-n, from the stroboscopic map at every forcing
+period), samples the cycle and closes the energy balance.
+
+The contact-friction term of MODEL.md (mu_c on the pin's contact arc) is
+*evaluated along the cycle without feedback on the motion*, as the paper does:
+it is reported in the ledger but is not among the losses that balance the input.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from clearjoint import _checks
+from clearjoint.contact import hertz_coefficient
+from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.simulate import _kernel as kn
+from clearjoint.stiffness import viscous_coefficient
+
+FloatArray = NDArray[np.float64]
+
+STAGE_NAMES = {kn.FREE: "free-play", kn.COMPRESSION: "compression", kn.TENSION: "tension"}
+
+
+class SimulationError(ClearjointError, RuntimeError):
+    """The simulation could not do what was asked (no steady state, too many events...)."""
+
+
+@dataclass(frozen=True)
+class EnergyLedger:
+    """Energies over one steady cycle (or over a whole time response), J.
+
+    ``input`` is the work of F0 sin(w t); ``viscous``, ``sliding_friction`` and
+    ``impact`` are the losses the equation of motion carries, so that
+    input = losses + mechanical_energy_change exactly. ``contact_friction`` is
+    MODEL.md eq 15 evaluated along the motion without feedback on it (0 without
+    a pin or with mu_c = 0).
+    """
+
+    input: float
+    viscous: float
+    sliding_friction: float
+    impact: float
+    contact_friction: float = 0.0
+    mechanical_energy_change: float = 0.0
+
+    @property
+    def losses(self) -> float:
+        """viscous + sliding_friction + impact: the losses carried by the motion, J."""
+        return self.viscous + self.sliding_friction + self.impact
+
+    @property
+    def balance_error(self) -> float:
+        """|input - losses - mechanical_energy_change| / max(|input|, losses)."""
+        scale = max(abs(self.input), self.losses, 1e-300)
+        return abs(self.input - self.losses - self.mechanical_energy_change) / scale
+
+    def as_dict(self) -> dict[str, float]:
+        """The ledger as a plain mapping (J)."""
+        return {
+            "input": self.input,
+            "viscous": self.viscous,
+            "sliding_friction": self.sliding_friction,
+            "impact": self.impact,
+            "contact_friction": self.contact_friction,
+            "mechanical_energy_change": self.mechanical_energy_change,
+            "losses": self.losses,
+        }
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One stage of the motion: ``name`` in {"free-play", "compression", "tension"}, times in s."""
+
+    name: str
+    start: float
+    end: float
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A sampled stretch of the exact motion, with its stages, impacts and energy ledger.
+
+    Attributes
+    ----------
+    time : (N,) ndarray
+        Time from the start of the stretch, s.
+    displacement, velocity, acceleration : (N,) ndarray
+        x (m), x' (m/s), x'' (m/s^2).
+    excitation : (N,) ndarray
+        F0 sin(w t), N.
+    restoring_force : (N,) ndarray
+        f(x), N.
+    stages : tuple of Stage
+    impact_times : (I,) ndarray
+        When each contact was entered, s.
+    impact_velocities : (I,) ndarray
+        Approach speed before restitution, m/s, signed: + into compression, - into tension.
+    energy : EnergyLedger
+    events : int
+        Number of events (edges, velocity zeros, stick releases) in the stretch.
+    x_max, x_min : float
+        Exact extremes of x (at turning points), m.
+    stick_time : float
+        Time spent stuck by sliding friction, s.
+    final_state : tuple of float
+        (x, v) at the end of the stretch, m and m/s.
+    """
+
+    time: FloatArray
+    displacement: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+    excitation: FloatArray
+    restoring_force: FloatArray
+    stages: tuple[Stage, ...]
+    impact_times: FloatArray
+    impact_velocities: FloatArray
+    energy: EnergyLedger
+    events: int
+    x_max: float
+    x_min: float
+    stick_time: float
+    final_state: tuple[float, float]
+
+    @property
+    def amplitude(self) -> float:
+        """Displacement amplitude X = (x_max - x_min) / 2, m."""
+        return 0.5 * (self.x_max - self.x_min)
+
+
+@dataclass(frozen=True)
+class SteadyState(Motion):
+    """The steady periodic response: one orbit of ``period_multiple`` forcing periods.
+
+    Adds to :class:`Motion`: ``period_multiple`` (1 for period-1, n for a
+    period-n orbit), ``period`` (s, the orbit's), ``periods_to_converge`` and
+    ``initial_state`` (x, v, region, slip at the orbit's start, forcing phase 0),
+    from which a continuation can start.
+    """
+
+    period_multiple: int = 1
+    period: float = 0.0
+    periods_to_converge: int = 0
+    initial_state: tuple[float, float, int, int] = (0.0, 0.0, 0, 0)
+    compression_penetration: float = 0.0
+    tension_penetration: float = 0.0
+
+
+@dataclass(frozen=True)
+class FrequencySweep:
+    """Stepped-sine sweep: steady amplitude against frequency, up and down.
+
+    ``omega`` in rad/s; ``amplitude_up`` / ``amplitude_down`` in m (NaN where a
+    direction was not swept or no steady state was found); ``multiple_up`` /
+    ``multiple_down`` the period multiple of each orbit (0 where none).
+    """
+
+    omega: FloatArray
+    amplitude_up: FloatArray
+    amplitude_down: FloatArray
+    multiple_up: NDArray[np.int64]
+    multiple_down: NDArray[np.int64]
+    steady_up: tuple[SteadyState | None, ...] = field(repr=False, default=())
+    steady_down: tuple[SteadyState | None, ...] = field(repr=False, default=())
+
+
+# ---- set-up -------------------------------------------------------------------------------
+
+
+def _parameters(
+    joint: Joint,
+    force_amplitude: float,
+    omega: float,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+) -> FloatArray:
+    f0 = _checks.positive("force_amplitude", force_amplitude, unit="N")
+    w = _checks.positive("omega", omega, unit="rad/s")
+    e = _checks.real_scalar("restitution", restitution)
+    if not 0.0 <= e <= 1.0:
+        raise ParameterError(f"restitution must satisfy 0 <= e <= 1, got {e!r}")
+    if friction is not None and not isinstance(friction, Friction):
+        raise ParameterError(
+            f"friction must be a clearjoint.Friction(coefficient, lateral_load), got {friction!r}"
+        )
+    if not isinstance(joint, Joint):
+        raise ParameterError(f"joint must be a clearjoint.Joint, got {joint!r}")
+    p = np.zeros(kn.N_PARAMS)
+    p[kn.P_MASS] = joint.mass
+    p[kn.P_DAMP] = viscous_coefficient(joint, damping_ratio)
+    p[kn.P_K0] = joint.gap_stiffness
+    p[kn.P_KC] = joint.compression_stiffness
+    p[kn.P_KT] = joint.tension_stiffness
+    p[kn.P_GC] = joint.compression_gap
+    p[kn.P_GT] = joint.tension_gap
+    p[kn.P_F0] = f0
+    p[kn.P_W] = w
+    p[kn.P_E] = e
+    p[kn.P_TF] = 2.0 * math.pi / w
+    if friction is not None and friction.force > 0.0:
+        p[kn.P_FF] = friction.force
+        p[kn.P_FMODE] = (
+            kn.FRICTION_EVERYWHERE if friction.region == "everywhere" else kn.FRICTION_FREE_PLAY
+        )
+    return p
+
+
+def _initial_state(p: FloatArray, initial: ArrayLike | None) -> FloatArray:
+    if initial is None:
+        x0, v0 = 0.0, 0.0
+        values: Sequence[float] = (0.0, 0.0)
+    else:
+        values = [float(v) for v in np.ravel(np.asarray(initial, dtype=np.float64))]
+        if len(values) not in (2, 4) or not all(math.isfinite(v) for v in values):
+            raise ParameterError(f"initial must be (x0, v0) in m and m/s, finite, got {initial!r}")
+        x0, v0 = values[0], values[1]
+    state = np.zeros(4)
+    state[kn.S_X] = x0
+    state[kn.S_V] = v0
+    if len(values) == 4:  # a state handed back by a SteadyState: keep its region and slip
+        state[kn.S_REGION] = values[2]
+        state[kn.S_SLIP] = values[3]
+        return state
+    region = kn.region_of(p, x0, v0)
+    state[kn.S_REGION] = region
+    state[kn.S_SLIP] = (1 if v0 > 0 else -1) if v0 != 0.0 else kn.decide_slip(p, region, x0, 0.0)
+    return state
+
+
+# ---- running the kernel and turning its records into a Motion ----------------------------
+
+
+@dataclass
+class _Run:
+    segments: FloatArray
+    impacts: FloatArray
+    strobe: FloatArray
+    ledger: FloatArray
+    events: int
+
+
+def _run(p: FloatArray, state: FloatArray, n_periods: int, t_last: float, record: bool) -> _Run:
+    if n_periods < 1:
+        raise ParameterError("the duration must cover a positive time")
+    strobe = np.zeros((n_periods, 4))
+    ledger = np.zeros((n_periods, kn.LEDGER_WIDTH))
+    capacity = 64 * n_periods if record else 1
+    while True:
+        segments = np.zeros((capacity, kn.SEG_WIDTH))
+        impacts = np.zeros((capacity, kn.IMP_WIDTH))
+        start = state.copy()
+        n_seg, n_imp, events, status = kn.advance(
+            p, start, n_periods, t_last, record, segments, impacts, strobe, ledger
+        )
+        if status == kn.STATUS_SEGMENTS_FULL:
+            capacity *= 4
+            continue
+        if status == kn.STATUS_TOO_MANY_EVENTS:
+            raise SimulationError(
+                f"more than {kn.MAX_EVENTS_PER_PERIOD} events in one forcing period "
+                "(chattering); add damping or a restitution below 1"
+            )
+        state[:] = start
+        return _Run(segments[:n_seg], impacts[:n_imp], strobe, ledger, events)
+
+
+def _mechanical_energy(joint: Joint, x: float, v: float) -> float:
+    return 0.5 * joint.mass * v * v + float(joint.potential_energy(x))
+
+
+def _contact_friction(
+    p: FloatArray,
+    joint: Joint,
+    run: _Run,
+    pin: Pin | None,
+    friction_coefficient: float,
+) -> float:
+    """MODEL.md eq 14-15 along the recorded motion: (4 mu_c beta_H / (3 pi R_p)) F_n^1.5 |v|."""
+    if pin is None or friction_coefficient == 0.0:
+        return 0.0
+    factor = 4.0 * friction_coefficient * hertz_coefficient(pin) / (3.0 * math.pi * pin.radius)
+    nodes, weights = np.polynomial.legendre.leggauss(64)
+    tf = p[kn.P_TF]
+    total = 0.0
+    for row in run.segments:
+        region = int(row[kn.SEG_REGION])
+        if region == kn.FREE or row[kn.SEG_DT] <= 0.0 or row[kn.SEG_SLIP] == 0:
+            continue
+        start = row[kn.SEG_PERIOD] * tf + row[kn.SEG_T0]
+        times = start + 0.5 * row[kn.SEG_DT] * (nodes + 1.0)
+        out = np.zeros((times.size, 3))
+        kn.sample(p, row[None, :], 1, times, out)
+        if region == kn.COMPRESSION:
+            force = joint.compression_stiffness * np.maximum(out[:, 0] - joint.compression_gap, 0)
+        else:
+            force = joint.tension_stiffness * np.maximum(-joint.tension_gap - out[:, 0], 0)
+        total += 0.5 * row[kn.SEG_DT] * float(np.sum(weights * force**1.5 * np.abs(out[:, 1])))
+    return factor * total
+
+
+def _motion_fields(
+    p: FloatArray,
+    joint: Joint,
+    run: _Run,
+    start_state: FloatArray,
+    duration: float,
+    samples_per_period: int,
+    pin: Pin | None,
+    contact_friction_coefficient: float,
+) -> dict[str, object]:
+    tf = p[kn.P_TF]
+    n = max(round(samples_per_period * duration / tf), 2)
+    time = (
+        np.linspace(0.0, duration, n + 1)[:-1] if duration >= tf else np.linspace(0.0, duration, n)
+    )
+    out = np.zeros((time.size, 3))
+    kn.sample(p, run.segments, run.segments.shape[0], time, out)
+    x, v, a = out[:, 0], out[:, 1], out[:, 2]
+    seg = run.segments
+    starts = seg[:, kn.SEG_PERIOD] * tf + seg[:, kn.SEG_T0]
+    ends = starts + seg[:, kn.SEG_DT]
+    stages: list[Stage] = []
+    for region, s, e in zip(seg[:, kn.SEG_REGION].astype(int), starts, ends, strict=True):
+        name = STAGE_NAMES[int(region)]
+        if stages and stages[-1].name == name:
+            stages[-1] = Stage(name, stages[-1].start, float(e))
+        elif e > s or not stages:
+            stages.append(Stage(name, float(s), float(e)))
+    # extremes: v never changes sign inside a state, so they sit at state boundaries
+    end_state = run.strobe[-1]
+    boundary_x = np.concatenate((seg[:, kn.SEG_X0], [end_state[kn.S_X]]))
+    ledger = run.ledger.sum(axis=0)
+    energy = EnergyLedger(
+        input=float(ledger[kn.L_INPUT]),
+        viscous=float(ledger[kn.L_VISCOUS]),
+        sliding_friction=float(ledger[kn.L_SLIDING]),
+        impact=float(ledger[kn.L_IMPACT]),
+        contact_friction=_contact_friction(p, joint, run, pin, contact_friction_coefficient),
+        mechanical_energy_change=_mechanical_energy(joint, end_state[kn.S_X], end_state[kn.S_V])
+        - _mechanical_energy(joint, start_state[kn.S_X], start_state[kn.S_V]),
+    )
+    imp = run.impacts
+    return {
+        "time": time,
+        "displacement": x,
+        "velocity": v,
+        "acceleration": a,
+        "excitation": p[kn.P_F0] * np.sin(p[kn.P_W] * time),
+        "restoring_force": joint.restoring_force(x),
+        "stages": tuple(stages),
+        "impact_times": imp[:, 0] * tf + imp[:, 1],
+        "impact_velocities": imp[:, 2] * imp[:, 3],
+        "energy": energy,
+        "events": run.events,
+        "x_max": float(boundary_x.max()),
+        "x_min": float(boundary_x.min()),
+        "stick_time": float(np.sum(seg[:, kn.SEG_DT][seg[:, kn.SEG_SLIP] == 0])),
+        "final_state": (float(end_state[kn.S_X]), float(end_state[kn.S_V])),
+    }
+
+
+# ---- public API ---------------------------------------------------------------------------
+
+
+def time_response(
+    joint: Joint,
+    force_amplitude: float,
+    omega: float,
+    duration: float,
+    *,
+    initial: ArrayLike | None = None,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+    pin: Pin | None = None,
+    contact_friction_coefficient: float = 0.0,
+    samples_per_period: int = 256,
+) -> Motion:
+    """Return the exact transient response from ``initial`` = (x0, v0) over ``duration`` s.
+
+    The forcing is F0 sin(omega t) from t = 0 (omega in rad/s). The ledger covers
+    the whole run, so input = losses + mechanical_energy_change.
+    """
+    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    duration = _checks.positive("duration", duration, unit="s")
+    _check_samples(samples_per_period)
+    mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
+    state = _initial_state(p, initial)
+    start = state.copy()
+    tf = p[kn.P_TF]
+    n_full = int(duration // tf)
+    remainder = duration - n_full * tf
+    if remainder <= 1e-12 * tf and n_full > 0:
+        n_periods, t_last = n_full, tf
+    else:
+        n_periods, t_last = n_full + 1, remainder
+    run = _run(p, state, n_periods, t_last, record=True)
+    fields = _motion_fields(p, joint, run, start, duration, samples_per_period, pin, mu_c)
+    return Motion(**fields)  # type: ignore[arg-type]
+
+
+def _check_samples(samples_per_period: int) -> None:
+    if (
+        isinstance(samples_per_period, bool)
+        or not isinstance(samples_per_period, int)
+        or (samples_per_period < 8)
+    ):
+        raise ParameterError(
+            f"samples_per_period must be an integer >= 8, got {samples_per_period!r}"
+        )
+
+
+def _periodic_multiple(
+    strobe: FloatArray, max_multiple: int, tolerance: float, x_scale: float, v_scale: float
+) -> int:
+    """Smallest p such that the last 2p stroboscopic states repeat with period p (0 if none)."""
+    n = strobe.shape[0]
+    for mult in range(1, max_multiple + 1):
+        if n < 3 * mult:
+            break
+        recent = strobe[-2 * mult :]
+        before = strobe[-3 * mult : -mult]
+        dx = np.max(np.abs(recent[:, kn.S_X] - before[:, kn.S_X])) / x_scale
+        dv = np.max(np.abs(recent[:, kn.S_V] - before[:, kn.S_V])) / v_scale
+        same_discrete = np.array_equal(recent[:, 2:], before[:, 2:])
+        if dx <= tolerance and dv <= tolerance and same_discrete:
+            return mult
+    return 0
+
+
+def steady_state(
+    joint: Joint,
+    force_amplitude: float,
+    omega: float,
+    *,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+    pin: Pin | None = None,
+    contact_friction_coefficient: float = 0.0,
+    initial: ArrayLike | None = None,
+    max_periods: int = 20_000,
+    max_multiple: int = 8,
+    tolerance: float = 1e-11,
+    samples_per_period: int = 256,
+) -> SteadyState:
+    """Return the steady periodic response of the forced joint (MODEL.md sec. 2).
+
+    Integrates exactly, from ``initial`` (x0, v0; default at rest at x = 0),
+    until the state at the start of each forcing period repeats with some period
+    p <= ``max_multiple`` forcing periods, to ``tolerance`` relative to the
+    motion's size; then returns that orbit (p = 1: period-1; p > 1: period-p,
+    detected, not assumed). Its energy ledger is summed over the orbit's p
+    periods.
+
+    Parameters
+    ----------
+    joint : Joint
+    force_amplitude : float
+        F0 > 0, N.
+    omega : float
+        Forcing circular frequency w > 0, rad/s.
+    damping_ratio : float
+        zeta >= 0 of the linear part: c_v = 2 zeta sqrt(m k_c), held fixed.
+    friction : Friction, optional
+        Coulomb sliding friction mu_s P sign(x').
+    restitution : float
+        Coefficient of restitution e in [0, 1] on entering contact; each impact
+        removes beta m v^2 with beta = (1 - e^2)/2 (MODEL.md eq 16).
+    pin : Pin, optional
+        With ``contact_friction_coefficient`` > 0, eq 15 is evaluated along the cycle.
+    contact_friction_coefficient : float
+        mu_c on the pin's contact arc.
+
+    Raises
+    ------
+    SimulationError
+        No periodic orbit was found within ``max_periods`` (e.g. a lossless
+        system, which never settles, or a chaotic response).
+    """
+    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    _check_samples(samples_per_period)
+    mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
+    if max_periods < 1 or max_multiple < 1:
+        raise ParameterError("max_periods and max_multiple must be >= 1")
+    tol = _checks.positive("tolerance", tolerance)
+    lossless = p[kn.P_DAMP] == 0.0 and p[kn.P_FF] == 0.0 and p[kn.P_E] == 1.0
+    state = _initial_state(p, initial)
+    history: list[FloatArray] = []
+    done = 0
+    chunk = 16
+    multiple = 0
+    while done < max_periods:
+        n = min(chunk, max_periods - done)
+        run = _run(p, state, n, p[kn.P_TF], record=False)
+        history.append(run.strobe.copy())
+        done += n
+        strobe = np.concatenate(history[-4:]) if len(history) > 1 else history[-1]
+        x_scale = max(float(np.ptp(strobe[:, 0])), joint.clearance, 1e-300)
+        x_scale = max(x_scale, float(np.max(np.abs(strobe[:, 0]))))
+        v_scale = max(float(np.max(np.abs(strobe[:, 1]))), x_scale * p[kn.P_W])
+        multiple = _periodic_multiple(strobe, max_multiple, tol, x_scale, v_scale)
+        if multiple:
+            break
+        chunk = min(2 * chunk, 1024)
+    if not multiple:
+        hint = (
+            "the system has no damping, friction or impact loss, so it never settles; "
+            "give damping_ratio > 0, friction or restitution < 1"
+            if lossless
+            else "raise max_periods, or the response may be chaotic"
+        )
+        raise SimulationError(f"no periodic orbit within {max_periods} forcing periods: {hint}")
+    start = state.copy()
+    run = _run(p, state, multiple, p[kn.P_TF], record=True)
+    duration = multiple * p[kn.P_TF]
+    fields = _motion_fields(p, joint, run, start, duration, samples_per_period, pin, mu_c)
+    x_max = float(fields["x_max"])  # type: ignore[arg-type]
+    x_min = float(fields["x_min"])  # type: ignore[arg-type]
+    return SteadyState(
+        **fields,  # type: ignore[arg-type]
+        period_multiple=multiple,
+        period=duration,
+        periods_to_converge=done,
+        initial_state=(
+            float(start[0]),
+            float(start[1]),
+            int(start[2]),
+            int(start[3]),
+        ),
+        compression_penetration=max(x_max - joint.compression_gap, 0.0),
+        tension_penetration=max(-joint.tension_gap - x_min, 0.0),
+    )
+
+
+def frequency_sweep(
+    joint: Joint,
+    force_amplitude: float,
+    omegas: ArrayLike,
+    *,
+    direction: Literal["up", "down", "both"] = "both",
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+    max_periods: int = 20_000,
+    keep_cycles: bool = False,
+) -> FrequencySweep:
+    """Return the stepped-sine amplitude-frequency curve, swept up and/or down.
+
+    Each step starts from the previous step's steady state, so the jump and the
+    hysteresis of the amplitude-frequency curve show up as they do on a shaker.
+    ``omegas`` (rad/s) are sorted ascending; the down sweep visits them in reverse.
+    A step with no steady state gives NaN rather than stopping the sweep.
+    """
+    w = np.sort(np.atleast_1d(np.asarray(omegas, dtype=np.float64)))
+    if w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0.0):
+        raise ParameterError("omegas must be a non-empty array of finite values > 0 (rad/s)")
+    if direction not in ("up", "down", "both"):
+        raise ParameterError(f"direction must be 'up', 'down' or 'both', got {direction!r}")
+
+    def sweep(order: FloatArray) -> tuple[FloatArray, NDArray[np.int64], list[SteadyState | None]]:
+        amps = np.full(order.size, np.nan)
+        mults = np.zeros(order.size, dtype=np.int64)
+        cycles: list[SteadyState | None] = []
+        initial: tuple[float, float, int, int] | None = None
+        for i, omega in enumerate(order):
+            try:
+                ss = steady_state(
+                    joint,
+                    force_amplitude,
+                    float(omega),
+                    damping_ratio=damping_ratio,
+                    friction=friction,
+                    restitution=restitution,
+                    initial=initial,
+                    max_periods=max_periods,
+                    samples_per_period=16,
+                )
+            except SimulationError:
+                cycles.append(None)
+                continue
+            amps[i] = ss.amplitude
+            mults[i] = ss.period_multiple
+            initial = ss.initial_state
+            cycles.append(ss if keep_cycles else None)
+        return amps, mults, cycles
+
+    nan = np.full(w.size, np.nan)
+    zeros = np.zeros(w.size, dtype=np.int64)
+    up, m_up, c_up = sweep(w) if direction in ("up", "both") else (nan, zeros, [])
+    if direction in ("down", "both"):
+        down_r, m_down_r, c_down_r = sweep(w[::-1])
+        down, m_down, c_down = down_r[::-1], m_down_r[::-1], c_down_r[::-1]
+    else:
+        down, m_down, c_down = nan.copy(), zeros.copy(), []
+    return FrequencySweep(w, up, down, m_up, m_down, tuple(c_up), tuple(c_down))
