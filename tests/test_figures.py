@@ -16,3 +16,29 @@ def test_stiffness_coefficient_figure_plots_every_curve_in_micrometres() -> None
     np.testing.assert_allclose(lines[0].get_xdata(), a * 1e6)
     assert "µm" in ax.get_xlabel()
     assert lines[0].get_linestyle() != lines[1].get_linestyle()  # apart in grey print
+
+
+def test_stage_figure_shades_each_stage_once_in_the_legend() -> None:
+    from clearjoint.figures import displacement_stages_figure
+
+    t = np.linspace(0.0, 1e-2, 50)
+    stages = [
+        ("free-play", 0.0, 2e-3),
+        ("compression", 2e-3, 4e-3),
+        ("free-play", 4e-3, 6e-3),
+        ("tension", 6e-3, 1e-2),
+    ]
+    fig = displacement_stages_figure(t, 1e-5 * np.sin(600 * t), stages)
+    (ax,) = fig.axes
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert labels == ["free-play", "compression", "tension", "displacement"]
+    assert len(ax.patches) == 4
+
+
+def test_loop_figure_closes_the_loop() -> None:
+    from clearjoint.figures import force_displacement_figure
+
+    x = np.sin(np.linspace(0, 2 * np.pi, 20, endpoint=False))
+    fig = force_displacement_figure(1e-5 * x, 100 * x)
+    line = fig.axes[0].get_lines()[0]
+    assert line.get_xdata()[0] == line.get_xdata()[-1]

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Iterable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from clearjoint.errors import ParameterError, ParameterTypeError
+from clearjoint.errors import OutputExistsError, ParameterError, ParameterTypeError
 
 
 def real_scalar(name: str, value: Any, *, unit: str = "") -> float:
@@ -59,3 +61,12 @@ def non_negative_array(name: str, value: Any, *, unit: str = "") -> NDArray[np.f
 
 def _in(unit: str) -> str:
     return f" (in {unit})" if unit else ""
+
+
+def refuse_to_overwrite(paths: Iterable[Path], *, force: bool) -> None:
+    """Raise OutputExistsError naming every path that exists, unless ``force``."""
+    existing = [str(path) for path in paths if path.exists()]
+    if existing and not force:
+        raise OutputExistsError(
+            f"will not overwrite {', '.join(existing)}; choose another --out or pass --force"
+        )

@@ -63,12 +63,29 @@ def _reproduce_parser(sub: Any) -> None:
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
 
 
+def _simulate_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "simulate",
+        help="exact forced response of a joint described in a study file",
+        description=(
+            "Run the study in STUDY.toml (joint, excitation, losses; see docs/simulate.md): "
+            "the exact steady state (or transient), its stages, impacts and energy ledger. "
+            "Prints a summary, or with --json one JSON object; --out writes netCDF."
+        ),
+    )
+    p.add_argument("study", help="study file (TOML)")
+    p.add_argument("--out", help="write the result to this netCDF file (.nc)")
+    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``clearjoint`` command."""
     parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
     parser.add_argument("--version", action="version", version=f"clearjoint {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     _stiffness_parser(sub)
+    _simulate_parser(sub)
     _reproduce_parser(sub)
     return parser
 
@@ -133,6 +150,47 @@ def _run_stiffness(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_simulate(args: argparse.Namespace) -> int:
+    from clearjoint.simulate.study import load_study, run_study, summary, write_netcdf
+
+    study = load_study(args.study)
+    if args.out:
+        from clearjoint._checks import refuse_to_overwrite
+
+        refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
+    motion = run_study(study)
+    result = summary(study, motion)
+    if args.out:
+        write_netcdf(study, motion, args.out, force=args.force)
+    if args.json:
+        print(json.dumps(result))
+        return 0
+    energy = result["energy_j"]
+    lines = [
+        f"study: {study.source} ({study.mode})",
+        f"excitation: {study.force_amplitude:g} N at {result['frequency_hz']:g} Hz",
+        f"amplitude X = {result['amplitude_m'] * 1e6:.4g} um "
+        f"(x_max {result['x_max_m'] * 1e6:.4g} um, x_min {result['x_min_m'] * 1e6:.4g} um)",
+    ]
+    if "period_multiple" in result:
+        lines.append(
+            f"period-{result['period_multiple']} orbit, reached after "
+            f"{result['periods_to_converge']} forcing periods"
+        )
+    lines.append(
+        f"events {result['events']}, impacts {result['impacts']}, "
+        f"stuck {result['stick_time_s'] * 1e3:.4g} ms"
+    )
+    lines.append(
+        "energy per orbit (J): " + ", ".join(f"{key} {val:.5g}" for key, val in energy.items())
+    )
+    lines.append(f"balance error {result['balance_error']:.2e}")
+    if args.out:
+        lines.append(f"wrote {args.out}")
+    print("\n".join(lines))
+    return 0
+
+
 def _run_reproduce(args: argparse.Namespace) -> int:
     from clearjoint.report import NOT_BUILT, reproduce
 
@@ -149,7 +207,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    runners = {"stiffness": _run_stiffness, "reproduce": _run_reproduce}
+    runners = {
+        "stiffness": _run_stiffness,
+        "simulate": _run_simulate,
+        "reproduce": _run_reproduce,
+    }
     try:
         return runners[args.command](args)
     except ClearjointError as exc:

@@ -18,3 +18,7 @@ class ParameterError(ClearjointError, ValueError):
 
 class ParameterTypeError(ClearjointError, TypeError):
     """A parameter has the wrong type (a string where a number is needed...)."""
+
+
+class OutputExistsError(ClearjointError, FileExistsError):
+    """An output file exists and overwriting it was not asked for."""

@@ -1,9 +1,10 @@
 """The reproduction of the paper's study, written as a self-contained report.
 
 Today the study covers MODEL.md section 1 (the stiffness coefficient of eq 9
-and its exact generalisation, the paper's Fig. 12); the later stages
-(simulation, dissipation, virtual rig, identification, fitted laws) are listed
-in the report as not built yet.
+and its exact generalisation, the paper's Fig. 12) and one exact steady cycle
+of the forced joint with its energy ledger (Fig. 7); the later stages
+(dissipation model, virtual rig, identification, fitted laws) are listed in the
+report as not built yet.
 """
 
 from __future__ import annotations
@@ -20,25 +21,21 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from clearjoint import stiffness
-from clearjoint.errors import ClearjointError
-from clearjoint.figures import Curve, stiffness_coefficient_figure
-from clearjoint.joint import Joint
+from clearjoint._checks import refuse_to_overwrite
+from clearjoint.figures import Curve, displacement_stages_figure, stiffness_coefficient_figure
+from clearjoint.joint import Friction, Joint
+from clearjoint.simulate import SteadyState, steady_state
 
 #: The paper's two joints (c = 0.106 mm and 0.196 mm).
 PAPER_CLEARANCES: tuple[float, ...] = (0.106e-3, 0.196e-3)
 
 #: Stages of the paper's study that this version does not run yet.
 NOT_BUILT: tuple[str, ...] = (
-    "exact time-domain simulation of the forced joint",
     "energy-dissipation model (sliding friction, Hertz contact friction, impact)",
     "virtual test rig and test records",
     "identification of clearance, stiffness and energy from records",
     "fitted laws (eq 19-22) and the joint stiffness of eq 20",
 )
-
-
-class OutputExistsError(ClearjointError, FileExistsError):
-    """An output file exists and overwriting was not asked for."""
 
 
 @dataclass(frozen=True)
@@ -102,6 +99,20 @@ def stiffness_study(
     return StiffnessStudy(amplitudes, tuple(curves), tuple(joints))
 
 
+def example_cycle() -> SteadyState:
+    """The exact steady cycle of the c = 0.106 mm joint at 1 kN, 400 Hz (examples/study.toml)."""
+    joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, tension_stiffness=5e7)
+    return steady_state(
+        joint,
+        1000.0,
+        2.0 * np.pi * 400.0,
+        damping_ratio=0.01,
+        restitution=0.8,
+        friction=Friction(0.2, 300.0),
+        samples_per_period=512,
+    )
+
+
 def _png(fig: Figure) -> bytes:
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=120)
@@ -162,17 +173,19 @@ def reproduce(
         "report": out_dir / "report.html",
         "results": out_dir / "results.json",
         "fig12": out_dir / "fig12_stiffness_coefficient.png",
+        "fig7": out_dir / "fig7_displacement_stages.png",
     }
-    existing = [str(path) for path in targets.values() if path.exists()]
-    if existing and not force:
-        raise OutputExistsError(
-            f"will not overwrite {', '.join(existing)}; choose another --out or pass --force"
-        )
+    refuse_to_overwrite(targets.values(), force=force)
     say("stiffness study (MODEL.md section 1, Fig. 12)")
     study = stiffness_study()
     png = _png(stiffness_coefficient_figure(study.curves))
+    say("exact steady cycle of the forced joint (MODEL.md section 2, Fig. 7)")
+    cycle = example_cycle()
+    stages = [(st.name, st.start, st.end) for st in cycle.stages]
+    png7 = _png(displacement_stages_figure(cycle.time, cycle.displacement, stages))
     out_dir.mkdir(parents=True, exist_ok=True)
     targets["fig12"].write_bytes(png)
+    targets["fig7"].write_bytes(png7)
     results = {
         "stiffness_coefficient": {
             "amplitude_m": study.amplitudes.tolist(),
@@ -188,11 +201,24 @@ def reproduce(
                 for curve, joint in zip(study.curves, study.joints, strict=True)
             ],
         },
+        "example_cycle": {
+            "amplitude_m": cycle.amplitude,
+            "period_multiple": cycle.period_multiple,
+            "energy_j": cycle.energy.as_dict(),
+            "balance_error": cycle.energy.balance_error,
+        },
         "not_built_yet": list(NOT_BUILT),
     }
     targets["results"].write_text(json.dumps(results, indent=1), encoding="utf-8")
     targets["report"].write_text(
-        _html_report({"Fig. 12: stiffness coefficient against amplitude": png}, study),
+        _html_report(
+            {
+                "Fig. 12: stiffness coefficient against amplitude": png,
+                "Fig. 7: exact steady cycle of the c = 0.106 mm joint, 1 kN at 400 Hz, "
+                f"energy balance error {cycle.energy.balance_error:.1e}": png7,
+            },
+            study,
+        ),
         encoding="utf-8",
     )
     return list(targets.values())

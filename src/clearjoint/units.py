@@ -23,6 +23,7 @@ SI_UNITS: dict[str, str] = {
     "frequency": "Hz",
     "time": "s",
     "pressure": "Pa",
+    "velocity": "m/s",
     "dimensionless": "",
 }
 

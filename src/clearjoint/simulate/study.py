@@ -1,0 +1,313 @@
+"""A simulation study in one TOML file, with documented defaults, and its netCDF output.
+
+A study names the joint, the excitation and the losses; every value may carry
+a unit (``"0.106mm"``, ``"8e7N/m"``, ``"400Hz"``) or be a bare SI number.
+Anything left out takes the default in ``DEFAULT_STUDY``; an unknown key is an
+error (it is almost always a typo). The file format is documented in
+docs/simulate.md, with an example in examples/study.toml.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from clearjoint._checks import refuse_to_overwrite
+from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.simulate.core import Motion, SteadyState, steady_state, time_response
+from clearjoint.units import parse_quantity
+
+#: Every key a study may give, with its default (None: required) and the kind of quantity.
+DEFAULT_STUDY: dict[str, dict[str, tuple[Any, str]]] = {
+    "joint": {
+        "mass": (None, "mass"),
+        "clearance": (None, "length"),
+        "compression_stiffness": (None, "stiffness"),
+        "tension_stiffness": ("same as compression_stiffness", "stiffness"),
+        "gap_stiffness": (0.0, "stiffness"),
+        "gap_offset": (0.0, "length"),
+    },
+    "excitation": {
+        "force_amplitude": (None, "force"),
+        "frequency": (None, "frequency"),
+        "mode": ("steady", "text"),  # "steady" or "transient"
+        "duration": ("ten forcing periods", "time"),  # transient only
+        "initial_displacement": (0.0, "length"),
+        "initial_velocity": (0.0, "velocity"),
+    },
+    "losses": {
+        "damping_ratio": (0.0, "dimensionless"),
+        "restitution": (1.0, "dimensionless"),
+        "friction_coefficient": (0.0, "dimensionless"),
+        "lateral_load": (0.0, "force"),
+        "friction_region": ("everywhere", "text"),
+        "contact_friction_coefficient": (0.0, "dimensionless"),
+    },
+    "pin": {
+        "radius": (None, "length"),
+        "hole_radius": ("pin radius + clearance / 2", "length"),
+        "length": (None, "length"),
+        "youngs_modulus": (2.06e11, "pressure"),
+        "poisson_ratio": (0.3, "dimensionless"),
+    },
+    "output": {
+        "samples_per_period": (256, "count"),
+    },
+}
+
+
+class StudyError(ClearjointError, ValueError):
+    """A study file is missing, unreadable or holds a bad value."""
+
+
+@dataclass(frozen=True)
+class Study:
+    """A parsed study: everything needed to run one simulation (SI, omega in rad/s)."""
+
+    joint: Joint
+    force_amplitude: float
+    omega: float
+    mode: str
+    duration: float
+    initial: tuple[float, float]
+    damping_ratio: float
+    restitution: float
+    friction: Friction | None
+    pin: Pin | None
+    contact_friction_coefficient: float
+    samples_per_period: int
+    source: str
+
+
+def _value(section: str, key: str, raw: Any, kind: str, where: str) -> Any:
+    name = f"{where}: [{section}] {key}"
+    if kind == "text":
+        if not isinstance(raw, str):
+            raise StudyError(f"{name} must be text, got {raw!r}")
+        return raw
+    if kind == "count":
+        if isinstance(raw, bool) or not isinstance(raw, int):
+            raise StudyError(f"{name} must be a whole number, got {raw!r}")
+        return raw
+    if isinstance(raw, bool):
+        raise StudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
+    if isinstance(raw, int | float):
+        return float(raw)
+    if isinstance(raw, str):
+        return parse_quantity(raw, kind, name=name)
+    raise StudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
+
+
+def load_study(path: str | Path) -> Study:
+    """Read a study TOML file, merge the defaults and validate every value.
+
+    Raises
+    ------
+    StudyError
+        The file is missing or not TOML, a section or key is unknown, a required
+        key is absent, or a value is invalid; the message names the file and key.
+    """
+    path = Path(path)
+    where = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise StudyError(f"{where}: no such study file") from None
+    except UnicodeDecodeError:
+        raise StudyError(f"{where}: not a text file; a study is a TOML file") from None
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"{where}: not valid TOML ({exc})") from None
+    unknown = sorted(set(raw) - set(DEFAULT_STUDY))
+    if unknown:
+        raise StudyError(f"{where}: unknown section(s) {unknown}; known: {sorted(DEFAULT_STUDY)}")
+    values: dict[str, dict[str, Any]] = {}
+    for section, spec in DEFAULT_STUDY.items():
+        given = raw.get(section, {})
+        if not isinstance(given, dict):
+            raise StudyError(f"{where}: [{section}] must be a table")
+        extra = sorted(set(given) - set(spec))
+        if extra:
+            raise StudyError(
+                f"{where}: unknown key(s) {extra} in [{section}]; known: {sorted(spec)}"
+            )
+        values[section] = {}
+        for key, (default, kind) in spec.items():
+            if key in given:
+                try:
+                    values[section][key] = _value(section, key, given[key], kind, where)
+                except ParameterError as exc:  # a unit that does not parse: already names the key
+                    raise StudyError(str(exc)) from None
+            elif default is None and (section != "pin" or "pin" in raw):
+                raise StudyError(f"{where}: [{section}] {key} is required")
+            else:
+                values[section][key] = default
+    try:
+        return _build(values, raw, where)
+    except ParameterError as exc:
+        raise StudyError(f"{where}: {exc}") from None
+
+
+def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -> Study:
+    j = values["joint"]
+    k_c = j["compression_stiffness"]
+    tension = j["tension_stiffness"]
+    joint = Joint(
+        mass=j["mass"],
+        clearance=j["clearance"],
+        compression_stiffness=k_c,
+        tension_stiffness=k_c if isinstance(tension, str) else tension,
+        gap_stiffness=j["gap_stiffness"],
+        gap_offset=j["gap_offset"],
+    )
+    ex = values["excitation"]
+    frequency = ex["frequency"]
+    if not frequency > 0.0:
+        raise StudyError(f"{where}: [excitation] frequency must be > 0 Hz, got {frequency!r}")
+    omega = 2.0 * math.pi * frequency
+    mode = ex["mode"]
+    if mode not in ("steady", "transient"):
+        raise StudyError(
+            f"{where}: [excitation] mode must be 'steady' or 'transient', got {mode!r}"
+        )
+    duration = ex["duration"]
+    if isinstance(duration, str):
+        duration = 10.0 * 2.0 * math.pi / omega
+    losses = values["losses"]
+    friction = None
+    if losses["friction_coefficient"] > 0.0 and losses["lateral_load"] > 0.0:
+        friction = Friction(
+            losses["friction_coefficient"], losses["lateral_load"], losses["friction_region"]
+        )
+    pin = None
+    if "pin" in raw:
+        pv = values["pin"]
+        hole = pv["hole_radius"]
+        pin = Pin(
+            radius=pv["radius"],
+            hole_radius=pv["radius"] + 0.5 * joint.clearance if isinstance(hole, str) else hole,
+            length=pv["length"],
+            youngs_modulus=pv["youngs_modulus"],
+            poisson_ratio=pv["poisson_ratio"],
+        )
+    samples = values["output"]["samples_per_period"]
+    return Study(
+        joint=joint,
+        force_amplitude=ex["force_amplitude"],
+        omega=omega,
+        mode=mode,
+        duration=duration,
+        initial=(ex["initial_displacement"], ex["initial_velocity"]),
+        damping_ratio=losses["damping_ratio"],
+        restitution=losses["restitution"],
+        friction=friction,
+        pin=pin,
+        contact_friction_coefficient=losses["contact_friction_coefficient"],
+        samples_per_period=samples,
+        source=where,
+    )
+
+
+def run_study(study: Study) -> Motion:
+    """Run the study: the steady state (default) or the transient response."""
+    common: dict[str, Any] = {
+        "damping_ratio": study.damping_ratio,
+        "friction": study.friction,
+        "restitution": study.restitution,
+        "pin": study.pin,
+        "contact_friction_coefficient": study.contact_friction_coefficient,
+        "samples_per_period": study.samples_per_period,
+        "initial": study.initial,
+    }
+    if study.mode == "transient":
+        return time_response(
+            study.joint, study.force_amplitude, study.omega, study.duration, **common
+        )
+    return steady_state(study.joint, study.force_amplitude, study.omega, **common)
+
+
+def summary(study: Study, motion: Motion) -> dict[str, Any]:
+    """The result's summary as JSON-ready values (SI units in the key names, Hz)."""
+    energy = motion.energy
+    out: dict[str, Any] = {
+        "mode": study.mode,
+        "frequency_hz": study.omega / (2.0 * math.pi),
+        "force_amplitude_n": study.force_amplitude,
+        "amplitude_m": motion.amplitude,
+        "x_max_m": motion.x_max,
+        "x_min_m": motion.x_min,
+        "events": motion.events,
+        "impacts": int(motion.impact_velocities.size),
+        "stick_time_s": motion.stick_time,
+        "energy_j": {key: float(val) for key, val in energy.as_dict().items()},
+        "balance_error": energy.balance_error,
+    }
+    if isinstance(motion, SteadyState):
+        out["period_multiple"] = motion.period_multiple
+        out["period_s"] = motion.period
+        out["periods_to_converge"] = motion.periods_to_converge
+        out["compression_penetration_m"] = motion.compression_penetration
+        out["tension_penetration_m"] = motion.tension_penetration
+    return out
+
+
+def write_netcdf(study: Study, motion: Motion, path: str | Path, *, force: bool = False) -> Path:
+    """Write the motion, its stages, impacts and ledger to netCDF (xarray, h5netcdf engine).
+
+    Raises
+    ------
+    FileExistsError (a ClearjointError)
+        ``path`` exists and ``force`` is False.
+    """
+    import xarray as xr
+
+    path = Path(path)
+    refuse_to_overwrite([path], force=force)
+    joint = study.joint
+    stage_names = np.array([s.name for s in motion.stages], dtype=object)
+    data = xr.Dataset(
+        {
+            "displacement": ("time", motion.displacement, {"units": "m"}),
+            "velocity": ("time", motion.velocity, {"units": "m/s"}),
+            "acceleration": ("time", motion.acceleration, {"units": "m/s^2"}),
+            "excitation_force": ("time", motion.excitation, {"units": "N"}),
+            "restoring_force": ("time", motion.restoring_force, {"units": "N"}),
+            "stage_name": ("stage", stage_names.astype(str)),
+            "stage_start": ("stage", np.array([s.start for s in motion.stages]), {"units": "s"}),
+            "stage_end": ("stage", np.array([s.end for s in motion.stages]), {"units": "s"}),
+            "impact_time": ("impact", motion.impact_times, {"units": "s"}),
+            "impact_velocity": ("impact", motion.impact_velocities, {"units": "m/s"}),
+        },
+        coords={"time": ("time", motion.time, {"units": "s"})},
+        attrs={
+            "title": "clearjoint simulation",
+            "study": study.source,
+            "mass_kg": joint.mass,
+            "clearance_m": joint.clearance,
+            "compression_stiffness_n_per_m": joint.compression_stiffness,
+            "tension_stiffness_n_per_m": joint.tension_stiffness,
+            "gap_stiffness_n_per_m": joint.gap_stiffness,
+            "gap_offset_m": joint.gap_offset,
+            "force_amplitude_n": study.force_amplitude,
+            "frequency_hz": study.omega / (2.0 * math.pi),
+            "damping_ratio": study.damping_ratio,
+            "restitution": study.restitution,
+            "friction_force_n": study.friction.force if study.friction else 0.0,
+            **{f"energy_{key}_j": float(val) for key, val in motion.energy.as_dict().items()},
+            **{
+                key: val
+                for key, val in summary(study, motion).items()
+                if isinstance(val, int | float) and not isinstance(val, bool)
+            },
+        },
+    )
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data.to_netcdf(path, engine="h5netcdf")
+    return path

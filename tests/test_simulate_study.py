@@ -1,0 +1,126 @@
+"""simulate.study and `clearjoint simulate`: study files, defaults, netCDF and JSON."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from clearjoint.cli import main
+from clearjoint.simulate import steady_state
+from clearjoint.simulate.study import StudyError, load_study
+
+ROOT = Path(__file__).resolve().parents[1]
+
+MINIMAL = """
+[joint]
+mass = "2kg"
+clearance = "0.106mm"
+compression_stiffness = "8e7N/m"
+
+[excitation]
+force_amplitude = "1kN"
+frequency = "400Hz"
+
+[losses]
+damping_ratio = 0.02
+"""
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "study.toml"
+    path.write_text(text)
+    return path
+
+
+def test_defaults_are_merged_and_units_converted(tmp_path: Path) -> None:
+    study = load_study(write(tmp_path, MINIMAL))
+    assert study.joint.clearance == pytest.approx(0.106e-3)
+    assert study.joint.tension_stiffness == study.joint.compression_stiffness
+    assert study.joint.gap_stiffness == 0.0
+    assert study.force_amplitude == pytest.approx(1000.0)
+    assert study.omega == pytest.approx(2 * math.pi * 400.0)
+    assert study.restitution == 1.0
+    assert study.friction is None
+    assert study.pin is None
+    assert study.mode == "steady"
+
+
+def test_shipped_example_study_loads_and_its_pin_takes_the_clearance() -> None:
+    study = load_study(ROOT / "examples" / "study.toml")
+    assert study.pin is not None
+    assert study.pin.hole_radius == pytest.approx(5e-3 + 0.053e-3)
+    assert study.friction is not None
+    assert study.friction.force == pytest.approx(60.0)
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        (MINIMAL.replace("mass", "mas"), "unknown key(s) ['mas'] in [joint]"),
+        (MINIMAL + "\n[solver]\nx = 1\n", "unknown section(s) ['solver']"),
+        (MINIMAL.replace('mass = "2kg"\n', ""), "[joint] mass is required"),
+        (MINIMAL.replace('"0.106mm"', '"-0.1mm"'), "clearance must be >= 0"),
+        (MINIMAL.replace('"400Hz"', '"400N"'), "is not a frequency"),
+        (MINIMAL.replace('"400Hz"', '"0Hz"'), "frequency must be > 0"),
+        (MINIMAL + 'restitution = "high"\n', "cannot read 'high'"),
+        ("this is not = = toml", "not valid TOML"),
+    ],
+)
+def test_bad_studies_name_file_and_key(tmp_path: Path, text: str, words: str) -> None:
+    path = write(tmp_path, text)
+    with pytest.raises(StudyError) as info:
+        load_study(path)
+    assert words in str(info.value)
+    assert str(path) in str(info.value)
+
+
+def test_missing_file(tmp_path: Path) -> None:
+    with pytest.raises(StudyError, match="no such study file"):
+        load_study(tmp_path / "nope.toml")
+
+
+def test_cli_json_and_netcdf_match_the_library(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = write(tmp_path, MINIMAL)
+    out = tmp_path / "result.nc"
+    assert main(["simulate", str(path), "--json", "--out", str(out)]) == 0
+    result = json.loads(capsys.readouterr().out)
+    study = load_study(path)
+    direct = steady_state(study.joint, 1000.0, study.omega, damping_ratio=0.02)
+    assert result["amplitude_m"] == pytest.approx(direct.amplitude, rel=1e-12)
+    assert result["energy_j"]["input"] == pytest.approx(direct.energy.input, rel=1e-12)
+    assert result["balance_error"] < 1e-9
+    with xr.open_dataset(out, engine="h5netcdf") as data:
+        np.testing.assert_allclose(data["displacement"].values, direct.displacement)
+        assert data["displacement"].attrs["units"] == "m"
+        assert data.attrs["clearance_m"] == pytest.approx(0.106e-3)
+        assert set(data["stage_name"].values) <= {"free-play", "compression", "tension"}
+    # never overwrite without being asked, and say so in one line
+    before = out.stat().st_mtime_ns
+    assert main(["simulate", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "will not overwrite" in err
+    assert len(err.strip().splitlines()) == 1
+    assert out.stat().st_mtime_ns == before
+
+
+def test_cli_table_and_transient(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = MINIMAL.replace(
+        'frequency = "400Hz"',
+        'frequency = "400Hz"\nmode = "transient"\nduration = "5ms"\ninitial_displacement = "10um"',
+    )
+    assert main(["simulate", str(write(tmp_path, text))]) == 0
+    out = capsys.readouterr().out
+    assert "transient" in out
+    assert "balance error" in out
+
+
+def test_cli_bad_study_exit_code_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["simulate", str(tmp_path / "missing.toml")]) == 2
+    assert "no such study file" in capsys.readouterr().err
