@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
-from clearjoint import Friction, Joint
 from clearjoint.figures import (
     displacement_stages_figure,
     force_displacement_figure,
     stiffness_coefficient_figure,
 )
-from clearjoint.report import stiffness_study
-from clearjoint.simulate import steady_state
+from clearjoint.report import example_cycle, stiffness_study
 
 HERE = Path(__file__).parent / "figures"
 
@@ -27,16 +24,7 @@ def main() -> None:
     print(f"wrote {HERE / 'fig12_stiffness_coefficient.png'}")
 
     # the exact steady cycle of examples/study.toml's joint, without the pin
-    joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, tension_stiffness=5e7)
-    ss = steady_state(
-        joint,
-        1000.0,
-        2 * math.pi * 400.0,
-        damping_ratio=0.01,
-        restitution=0.8,
-        friction=Friction(0.2, 300.0),
-        samples_per_period=1024,
-    )
+    ss = example_cycle()
     stages = [(s.name, s.start, s.end) for s in ss.stages]
     fig = displacement_stages_figure(
         ss.time,

@@ -499,6 +499,14 @@ def time_scale(p: np.ndarray) -> float:
 
 
 @njit(cache=True)
+def _store(state: np.ndarray, x: float, v: float, region: int, slip: int) -> None:
+    state[S_X] = x
+    state[S_V] = v
+    state[S_REGION] = region
+    state[S_SLIP] = slip
+
+
+@njit(cache=True)
 def advance(
     p: np.ndarray,
     state: np.ndarray,
@@ -545,10 +553,7 @@ def advance(
             x1, v1, _, _ = evaluate(q, slip, tau)
             if record:
                 if n_seg >= segments.shape[0]:
-                    state[S_X] = x
-                    state[S_V] = v
-                    state[S_REGION] = region
-                    state[S_SLIP] = slip
+                    _store(state, x, v, region, slip)
                     return n_seg, n_imp, n_events, STATUS_SEGMENTS_FULL
                 row = segments[n_seg]
                 row[SEG_PERIOD] = period
@@ -574,10 +579,7 @@ def advance(
             n_events += 1
             events_here += 1
             if events_here > MAX_EVENTS_PER_PERIOD:
-                state[S_X] = x
-                state[S_V] = v
-                state[S_REGION] = region
-                state[S_SLIP] = slip
+                _store(state, x, v, region, slip)
                 return n_seg, n_imp, n_events, STATUS_TOO_MANY_EVENTS
             phi = w * t_in
             if code in (EV_ENTER_COMPRESSION, EV_ENTER_TENSION):
@@ -610,15 +612,9 @@ def advance(
             elif code == EV_RELEASE_DOWN:
                 slip = -1
                 v = 0.0
-        strobe[period, S_X] = x
-        strobe[period, S_V] = v
-        strobe[period, S_REGION] = region
-        strobe[period, S_SLIP] = slip
+        _store(strobe[period], x, v, region, slip)
         # the next period starts at forcing phase 0 with the same state
-    state[S_X] = x
-    state[S_V] = v
-    state[S_REGION] = region
-    state[S_SLIP] = slip
+    _store(state, x, v, region, slip)
     return n_seg, n_imp, n_events, STATUS_OK
 
 
