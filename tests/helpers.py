@@ -25,9 +25,13 @@ def _region_force(joint: Joint, region: str) -> tuple[float, float]:
     return k0, 0.0
 
 
-def _half_swing(joint: Joint, x: float, direction: int, rtol: float) -> tuple[float, float]:
-    """Integrate from a turning point x (v = 0) to the next turning point; return (time, x_end).
+def _half_swing(
+    joint: Joint, x: float, direction: int, rtol: float
+) -> tuple[float, float, np.ndarray]:
+    """Integrate from a turning point x (v = 0) to the next turning point.
 
+    Returns (time, x_end, integrals) with integrals = [int v^2 dt, int v^2 dt in the
+    gap, int |v| dt, int F_n^1.5 |v| dt], carried as extra states of the ODE.
     ``direction`` is -1 for a swing toward tension, +1 toward compression.
     Within a swing x is monotonic, so each smooth piece ends either at the next
     gap edge in the direction of travel or at the turning point.
@@ -40,6 +44,7 @@ def _half_swing(joint: Joint, x: float, direction: int, rtol: float) -> tuple[fl
     w_min = math.sqrt((joint.gap_stiffness + k_soft) / m)
     total = 0.0
     v = 0.0
+    integrals = np.zeros(4)
     while True:
         probe = x + direction * 1e-12 * scale
         if probe > g_c:
@@ -53,10 +58,32 @@ def _half_swing(joint: Joint, x: float, direction: int, rtol: float) -> tuple[fl
         # to the penetration, not to the gap it sits beyond
         origin = {"compression": g_c, "tension": -g_t, "free": 0.0}[region]
 
+        contact_k = {
+            "compression": joint.compression_stiffness,
+            "tension": -joint.tension_stiffness,
+            "free": 0.0,
+        }[region]
+        in_gap = 1.0 if region == "free" else 0.0
+
         def rhs(
-            _t: float, y: np.ndarray, k: float = k, offset: float = offset, origin: float = origin
+            _t: float,
+            y: np.ndarray,
+            k: float = k,
+            offset: float = offset,
+            origin: float = origin,
+            contact_k: float = contact_k,
+            in_gap: float = in_gap,
         ) -> list[float]:
-            return [y[1], -(k * (y[0] + origin) - offset) / m]
+            speed = abs(y[1])
+            force = max(contact_k * y[0], 0.0)
+            return [
+                y[1],
+                -(k * (y[0] + origin) - offset) / m,
+                y[1] ** 2,
+                in_gap * y[1] ** 2,
+                speed,
+                force**1.5 * speed,
+            ]
 
         def turning(_t: float, y: np.ndarray) -> float:
             return float(y[1])
@@ -93,10 +120,20 @@ def _half_swing(joint: Joint, x: float, direction: int, rtol: float) -> tuple[fl
         sol = solve_ivp(
             rhs,
             (0.0, horizon),
-            [x - origin, v],
+            [x - origin, v, 0.0, 0.0, 0.0, 0.0],
             method="DOP853",
             rtol=rtol,
-            atol=[1e-15 * scale, 1e-15 * scale * w_max],
+            atol=1e-15
+            * np.array(
+                [
+                    scale,
+                    scale * w_max,
+                    scale**2 * w_max,
+                    scale**2 * w_max,
+                    scale,
+                    (k_hard * scale) ** 1.5 * scale,
+                ]
+            ),
             events=events,
             max_step=max_step,
         )
@@ -105,19 +142,27 @@ def _half_swing(joint: Joint, x: float, direction: int, rtol: float) -> tuple[fl
         hit = [i for i, te in enumerate(sol.t_events) if len(te)]
         i = hit[0]
         total += float(sol.t_events[i][0])
-        x, v = (float(val) for val in sol.y_events[i][0])
-        x += origin
+        state = sol.y_events[i][0]
+        x, v = float(state[0]) + origin, float(state[1])
+        integrals += state[2:]
         if i == 0:  # turning point
-            return total, x
+            return total, x, integrals
         x = edge  # land exactly on the edge before the next piece
 
 
 def reference_period(joint: Joint, amplitude: float, rtol: float = 1e-11) -> float:
     """The free-vibration period at penetration A by numerical integration (solve_ivp)."""
+    return reference_cycle(joint, amplitude, rtol)[0]
+
+
+def reference_cycle(
+    joint: Joint, amplitude: float, rtol: float = 1e-11
+) -> tuple[float, np.ndarray]:
+    """(period, integrals over the free cycle) by numerical integration; see _half_swing."""
     x_max = joint.compression_gap + amplitude
-    t_down, x_min = _half_swing(joint, x_max, -1, rtol)
-    t_up, _ = _half_swing(joint, x_min, +1, rtol)
-    return t_down + t_up
+    t_down, x_min, first = _half_swing(joint, x_max, -1, rtol)
+    t_up, _, second = _half_swing(joint, x_min, +1, rtol)
+    return t_down + t_up, first + second
 
 
 def reference_describing_stiffness(joint: Joint, amplitude: float, n: int = 200_001) -> float:

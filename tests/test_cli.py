@@ -141,3 +141,94 @@ def test_reproduce_writes_the_report_and_refuses_to_overwrite(
     assert (out / "results.json").stat().st_mtime_ns == before
     code, _, _ = run(["reproduce", "--out", str(out), "--force"], capsys)
     assert code == 0
+
+
+DISSIPATION = ["dissipation", "--mass", "2kg", "--stiffness", "8e7N/m", "--clearance", "0.106mm"]
+
+
+def test_dissipation_json_keys_and_values(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(
+        [
+            *DISSIPATION,
+            "--amplitude",
+            "20um",
+            "--json",
+            "--friction-coefficient",
+            "0.2",
+            "--lateral-load",
+            "300N",
+            "--restitution",
+            "0.8",
+            "--pin-radius",
+            "5mm",
+            "--pin-length",
+            "25mm",
+            "--contact-friction-coefficient",
+            "0.15",
+        ],
+        capsys,
+    )
+    assert code == 0
+    data = json.loads(out)
+    for key in (
+        "sliding_friction_j",
+        "sliding_friction_paper_j",
+        "contact_friction_j",
+        "impact_j",
+        "total_j",
+        "loss_factor",
+        "hertz_half_width_m",
+    ):
+        assert isinstance(data[key], float)
+    a, x = 20e-6, 20e-6 + 0.106e-3 / 2
+    assert data["sliding_friction_j"] == pytest.approx(4 * 60.0 * x, rel=1e-9)  # 4 mu P X
+    w1 = math.sqrt(8e7 / 2.0)
+    assert data["impact_j"] == pytest.approx(2 * 0.18 * 2.0 * (a * w1) ** 2, rel=1e-9)
+    assert data["total_j"] == pytest.approx(
+        data["sliding_friction_j"] + data["contact_friction_j"] + data["impact_j"], rel=1e-12
+    )
+
+
+def test_dissipation_from_a_study_with_an_override(capsys: pytest.CaptureFixture[str]) -> None:
+    study = str(Path(__file__).resolve().parents[1] / "examples" / "study.toml")
+    code, out, _ = run(["dissipation", "--study", study, "--amplitude", "20um", "--json"], capsys)
+    assert code == 0
+    assert json.loads(out)["impact_j"] > 0.0
+    code, out, _ = run(
+        ["dissipation", "--study", study, "--amplitude", "20um", "--json", "--restitution", "1"],
+        capsys,
+    )
+    assert json.loads(out)["impact_j"] == 0.0
+
+
+def test_dissipation_table(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run([*DISSIPATION, "--amplitude", "5um,20um", "--restitution", "0.9"], capsys)
+    assert code == 0
+    assert "E_I (mJ)" in out
+    assert len(out.strip().splitlines()) == 5
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["--amplitude", "5um", "--pin-radius", "5mm"], "give both --pin-radius and --pin-length"),
+        (["--amplitude", "5um", "--restitution", "2"], "restitution must satisfy"),
+        (
+            ["--amplitude", "5um", "--lateral-load", "3m", "--friction-coefficient", "0.1"],
+            "is not a force",
+        ),
+    ],
+)
+def test_dissipation_bad_input(
+    extra: list[str], words: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = run([*DISSIPATION, *extra], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert words in err
+
+
+def test_dissipation_needs_a_joint(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(["dissipation", "--amplitude", "5um"], capsys)
+    assert code == 2
+    assert "--mass is required" in err

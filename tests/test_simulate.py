@@ -178,7 +178,7 @@ def test_period_two_orbit_is_detected_not_assumed() -> None:
 
 
 def test_contact_friction_along_the_orbit_matches_the_closed_form_per_excursion() -> None:
-    pin = Pin.for_clearance(radius=5e-3, clearance=JOINT.clearance, length=10e-3)
+    pin = Pin.for_clearance(radius=5e-3, clearance=JOINT.clearance, length=25e-3)
     mu_c = 0.15
     ss = steady_state(
         JOINT,

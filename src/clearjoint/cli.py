@@ -17,7 +17,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from clearjoint import __version__
-from clearjoint.errors import ClearjointError
+from clearjoint.errors import ClearjointError, ParameterError
 
 EXIT_BAD_INPUT = 2
 
@@ -40,15 +40,48 @@ def _stiffness_parser(sub: Any) -> None:
             "(0.106mm, 5um, 8e7N/m); a bare number is SI."
         ),
     )
-    p.add_argument("--mass", required=True, help="moving mass, e.g. 2kg")
-    p.add_argument("--stiffness", required=True, help="compression contact stiffness, e.g. 8e7N/m")
+    _add_joint_options(p, required=True)
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+
+
+def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
+    p.add_argument("--mass", required=required, help="moving mass, e.g. 2kg")
+    p.add_argument(
+        "--stiffness", required=required, help="compression contact stiffness, e.g. 8e7N/m"
+    )
     p.add_argument("--tension-stiffness", help="tension contact stiffness (default: --stiffness)")
     p.add_argument("--gap-stiffness", default="0", help="stiffness inside the gap k0 (default 0)")
-    p.add_argument("--clearance", required=True, help="total axial clearance, e.g. 0.106mm")
+    p.add_argument("--clearance", required=required, help="total axial clearance, e.g. 0.106mm")
     p.add_argument("--gap-offset", default="0", help="offset of the gap centre (default 0)")
     p.add_argument(
         "--amplitude", required=True, help="penetration(s) beyond the gap edge, e.g. 1um,5um,20um"
     )
+
+
+def _dissipation_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "dissipation",
+        help="energy dissipated per cycle by each mechanism (MODEL.md sec. 2)",
+        description=(
+            "Sliding friction (exact and the paper's viscous form), Hertz contact friction on "
+            "the pin, impact and their total per cycle, with the loss factor, on the free "
+            "cycle at penetration A. The joint, losses and pin come from options or from a "
+            "study file (--study); options given beside --study override it."
+        ),
+    )
+    p.add_argument("--study", help="take the joint, losses and pin from this study TOML")
+    _add_joint_options(p, required=False)
+    p.add_argument("--friction-coefficient", help="sliding-friction coefficient mu_s")
+    p.add_argument("--lateral-load", help="lateral load P, e.g. 300N")
+    p.add_argument("--friction-region", choices=["everywhere", "free-play"])
+    p.add_argument("--restitution", help="coefficient of restitution e (default 1)")
+    p.add_argument("--damping-ratio", help="viscous damping ratio of the linear part")
+    p.add_argument("--pin-radius", help="pin radius, e.g. 5mm (gives a pin)")
+    p.add_argument("--pin-length", help="pin contact length, e.g. 25mm")
+    p.add_argument("--hole-radius", help="hole radius (default: pin radius + clearance/2)")
+    p.add_argument("--youngs-modulus", help="Young's modulus of pin and hole (default 206GPa)")
+    p.add_argument("--poisson-ratio", help="Poisson's ratio of pin and hole (default 0.3)")
+    p.add_argument("--contact-friction-coefficient", help="friction coefficient on the pin mu_c")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
 
 
@@ -86,6 +119,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     _stiffness_parser(sub)
     _simulate_parser(sub)
+    _dissipation_parser(sub)
     _reproduce_parser(sub)
     return parser
 
@@ -94,6 +128,9 @@ def _joint_from(args: argparse.Namespace) -> Any:
     from clearjoint.joint import Joint
     from clearjoint.units import parse_quantity
 
+    for option in ("mass", "stiffness", "clearance"):
+        if getattr(args, option) is None:
+            raise ParameterError(f"--{option} is required (or give a --study file)")
     stiffness = parse_quantity(args.stiffness, "stiffness", name="--stiffness")
     return Joint(
         mass=parse_quantity(args.mass, "mass", name="--mass"),
@@ -147,6 +184,95 @@ def _run_stiffness(args: argparse.Namespace) -> int:
     print("-" * len(header))
     for a, t, f, k, c in zip(amplitudes, period, frequency_hz, k_d, c_d, strict=True):
         print(f"{a * 1e6:12.4g} {t * 1e3:12.5g} {f:12.5g} {k:12.5g} {c:8.4f}")
+    return 0
+
+
+def _losses_from(args: argparse.Namespace, base: Any | None) -> dict[str, Any]:
+    """Friction, restitution, damping, pin and mu_c from options, over a study's values."""
+    from clearjoint.joint import Friction, Pin
+    from clearjoint.units import parse_quantity
+
+    def number(option: str, kind: str, default: float) -> float:
+        text = getattr(args, option.replace("-", "_"))
+        return default if text is None else parse_quantity(text, kind, name=f"--{option}")
+
+    friction = base.friction if base is not None else None
+    mu_s = number("friction-coefficient", "dimensionless", friction.coefficient if friction else 0)
+    load = number("lateral-load", "force", friction.lateral_load if friction else 0.0)
+    region = args.friction_region or (friction.region if friction else "everywhere")
+    pin = base.pin if base is not None else None
+    if args.pin_radius is not None or args.pin_length is not None:
+        if args.pin_radius is None or args.pin_length is None:
+            raise ParameterError("give both --pin-radius and --pin-length for a pin")
+        radius = number("pin-radius", "length", 0.0)
+        clearance = number("clearance", "length", base.joint.clearance if base else 0.0)
+        pin = Pin(
+            radius=radius,
+            hole_radius=number("hole-radius", "length", radius + 0.5 * clearance),
+            length=number("pin-length", "length", 0.0),
+            youngs_modulus=number("youngs-modulus", "pressure", 2.06e11),
+            poisson_ratio=number("poisson-ratio", "dimensionless", 0.3),
+        )
+    return {
+        "friction": Friction(mu_s, load, region) if mu_s > 0 and load > 0 else None,
+        "restitution": number("restitution", "dimensionless", base.restitution if base else 1.0),
+        "damping_ratio": number(
+            "damping-ratio", "dimensionless", base.damping_ratio if base else 0.0
+        ),
+        "pin": pin,
+        "contact_friction_coefficient": number(
+            "contact-friction-coefficient",
+            "dimensionless",
+            base.contact_friction_coefficient if base else 0.0,
+        ),
+    }
+
+
+def _run_dissipation(args: argparse.Namespace) -> int:
+    from clearjoint import dissipation
+    from clearjoint.units import parse_quantity_list
+
+    base = None
+    if args.study:
+        from clearjoint.simulate.study import load_study
+
+        base = load_study(args.study)
+    joint = base.joint if base is not None and args.mass is None else _joint_from(args)
+    losses = _losses_from(args, base)
+    amplitudes = np.array(parse_quantity_list(args.amplitude, "length", name="--amplitude"))
+    values = dissipation.energies(joint, amplitudes, **losses)
+    several = amplitudes.size > 1
+    if args.json:
+        out = {"amplitude_m": _json_value(amplitudes, several)}
+        out.update({key: _json_value(val, several) for key, val in values.items()})
+        print(json.dumps(out))
+        return 0
+    print(
+        f"joint: m = {joint.mass:g} kg, c = {joint.clearance * 1e3:g} mm, "
+        f"k_c = {joint.compression_stiffness:.4g} N/m, k_t = {joint.tension_stiffness:.4g} N/m"
+    )
+    friction = losses["friction"]
+    pin = losses["pin"]
+    print(
+        f"losses: mu_s P = {friction.force if friction else 0.0:g} N "
+        f"({friction.region if friction else 'none'}), e = {losses['restitution']:g}, "
+        f"zeta = {losses['damping_ratio']:g}, mu_c = {losses['contact_friction_coefficient']:g}"
+        + (f", pin R = {pin.radius * 1e3:g} mm, L = {pin.length * 1e3:g} mm" if pin else "")
+    )
+    columns = [
+        ("A (um)", amplitudes * 1e6),
+        ("E_P (mJ)", values["sliding_friction_j"] * 1e3),
+        ("E_P paper", values["sliding_friction_paper_j"] * 1e3),
+        ("E_C (mJ)", values["contact_friction_j"] * 1e3),
+        ("E_I (mJ)", values["impact_j"] * 1e3),
+        ("E_v (mJ)", values["viscous_j"] * 1e3),
+        ("total (mJ)", values["total_j"] * 1e3),
+        ("eta", values["loss_factor"]),
+        ("b (um)", values["hertz_half_width_m"] * 1e6),
+    ]
+    print(" ".join(f"{name:>11}" for name, _ in columns))
+    for row in zip(*(np.atleast_1d(col) for _, col in columns), strict=True):
+        print(" ".join(f"{value:11.4g}" for value in row))
     return 0
 
 
@@ -210,6 +336,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     runners = {
         "stiffness": _run_stiffness,
         "simulate": _run_simulate,
+        "dissipation": _run_dissipation,
         "reproduce": _run_reproduce,
     }
     try:

@@ -67,6 +67,9 @@ class FreeOrbit:
         Time spent inside the gap per cycle, s.
     period : ndarray
         The period T, s (inf when the mass never moves: k0 = 0 and A = 0 with c > 0).
+    contact_action, free_play_action : ndarray
+        The integral of x'^2 dt over one cycle, in contact and inside the gap, m^2/s
+        (what viscous damping and the paper's equivalent friction damping dissipate).
     """
 
     compression_penetration: FloatArray
@@ -81,6 +84,8 @@ class FreeOrbit:
     tension_time: FloatArray
     free_play_time: FloatArray
     period: FloatArray
+    contact_action: FloatArray
+    free_play_action: FloatArray
 
     @property
     def displacement_amplitude(self) -> FloatArray:
@@ -112,6 +117,18 @@ def _crossing_time(gap: float, speed: FloatArray, omega_0: float) -> FloatArray:
         return np.arctan2(omega_0 * gap, speed) / omega_0
     with np.errstate(divide="ignore"):
         return gap / speed
+
+
+def _free_play_action(
+    gap: float, speed: FloatArray, crossing: FloatArray, omega_0: float
+) -> FloatArray:
+    """Integral of x'^2 dt from x = 0 to an edge at ``gap`` reached at ``speed`` in ``crossing``.
+
+    (g v_g + (v_g^2 + w0^2 g^2) t_g) / 2, which is g v_g at constant speed (k0 = 0).
+    """
+    if omega_0 > 0.0:
+        return 0.5 * (gap * speed + (speed**2 + (omega_0 * gap) ** 2) * crossing)
+    return gap * speed
 
 
 def _edge_speeds_squared(joint: Joint, amplitude: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -198,10 +215,23 @@ def free_orbit(joint: Joint, amplitude: ArrayLike) -> FreeOrbit:
     )
     t_c = _contact_time(v_c, y0_c, omega_c)
     t_t = _contact_time(v_t, y0_t, omega_t)
-    t_free = 2.0 * (
-        _crossing_time(joint.compression_gap, v_c, omega_0)
-        + _crossing_time(joint.tension_gap, v_t, omega_0)
+    cross_c = _crossing_time(joint.compression_gap, v_c, omega_0)
+    cross_t = _crossing_time(joint.tension_gap, v_t, omega_0)
+    t_free = 2.0 * (cross_c + cross_t)
+    # integral of x'^2 dt. Contact on side s (a sinusoid about its equilibrium, entered
+    # y0 outside it at speed v_s): w_s B^2 theta_s - y0 v_s, theta_s = w_s t_s / 2.
+    contact_action = (
+        omega_c * (y0_c**2 + (v_c / omega_c) ** 2) * (0.5 * omega_c * t_c)
+        - y0_c * v_c
+        + omega_t * (y0_t**2 + q_t) * (0.5 * omega_t * t_t)
+        - y0_t * v_t
     )
+    # Free-play, one way from 0 to an edge g reached at v_g in time t_g:
+    # (g v_g + (v_g^2 + w0^2 g^2) t_g) / 2; a side never reached gives its quarter swing.
+    one_way = _free_play_action(joint.compression_gap, v_c, cross_c, omega_0)
+    reach_t = _free_play_action(joint.tension_gap, v_t, cross_t, omega_0)
+    quarter = 0.25 * math.pi * omega_0 * free_turn**2
+    free_play_action = 2.0 * (one_way + np.where(touched_t, reach_t, quarter))
     return FreeOrbit(
         compression_penetration=a_c,
         tension_penetration=a_t,
@@ -215,6 +245,8 @@ def free_orbit(joint: Joint, amplitude: ArrayLike) -> FreeOrbit:
         tension_time=t_t,
         free_play_time=t_free,
         period=t_c + t_t + t_free,
+        contact_action=contact_action,
+        free_play_action=free_play_action,
     )
 
 

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import _checks
-from clearjoint.contact import hertz_coefficient
+from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.joint import Friction, Joint, Pin
 from clearjoint.simulate import _kernel as kn
@@ -295,6 +295,7 @@ def _contact_friction(
     nodes, weights = np.polynomial.legendre.leggauss(64)
     tf = p[kn.P_TF]
     total = 0.0
+    peak = 0.0
     for row in run.segments:
         region = int(row[kn.SEG_REGION])
         if region == kn.FREE or row[kn.SEG_DT] <= 0.0 or row[kn.SEG_SLIP] == 0:
@@ -308,6 +309,8 @@ def _contact_friction(
         else:
             force = joint.tension_stiffness * np.maximum(-joint.tension_gap - out[:, 0], 0)
         total += 0.5 * row[kn.SEG_DT] * float(np.sum(weights * force**1.5 * np.abs(out[:, 1])))
+        peak = max(peak, float(force.max()))
+    hertz_contact(pin, peak)  # warns when the arc is too wide for Hertz
     return factor * total
 
 

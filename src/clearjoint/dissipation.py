@@ -1,0 +1,343 @@
+"""Energy dissipated per cycle by the joint: closed forms, exact cycles, and their gap.
+
+MODEL.md section 2 (paper eqs 10-18). Each mechanism has two routes:
+
+* the closed form on the *free-vibration cycle* at penetration A (fast, the
+  paper's estimate): the orbit of ``stiffness.free_orbit``, whose stages are
+  sinusoids (or straight lines when k0 = 0), so every integral is exact;
+* the integral over the *exact steady cycle* of the forced joint from
+  ``clearjoint.simulate`` (the reference), gathered by :func:`compare`.
+
+Mechanisms, per cycle:
+
+* sliding friction (eq 10): exact Coulomb mu_s P x (distance slid), or the paper's
+  equivalent viscous form c_P * integral of x'^2 dt with c_P = 4 mu_s P / (pi w X),
+  w = w_n(A) on the free cycle;
+* contact friction on the pin (eq 12-15): 16 mu_c beta_H k_s^1.5 A_s^2.5 / (15 pi R_p)
+  per excursion;
+* impact (eq 16): beta m v_s^2 per entry into contact, beta = (1 - e^2) / 2;
+* viscous loss of the linear part: c_v * integral of x'^2 dt (when modelled);
+* total (eq 17) and the work of the excitation (eq 18).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from clearjoint import _checks
+from clearjoint.contact import hertz_coefficient, hertz_contact
+from clearjoint.errors import ParameterError
+from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.simulate import SteadyState, steady_state
+from clearjoint.stiffness import FreeOrbit, free_orbit, viscous_coefficient
+
+FloatArray = NDArray[np.float64]
+
+#: Keys of :func:`energies` (and of ``clearjoint dissipation --json``).
+ENERGY_KEYS = (
+    "sliding_friction_j",
+    "sliding_friction_paper_j",
+    "contact_friction_j",
+    "impact_j",
+    "viscous_j",
+    "total_j",
+    "loss_factor",
+    "equivalent_damping_ratio",
+    "hertz_half_width_m",
+)
+
+
+# ---- integrals over the free-vibration cycle ------------------------------------------------
+
+
+def _friction_path(joint: Joint, orbit: FreeOrbit, region: str) -> FloatArray:
+    """Distance slid per cycle: the whole path, or only the part inside the gap."""
+    if region == "everywhere":
+        return 2.0 * (orbit.x_max - orbit.x_min)
+    top = np.minimum(orbit.x_max, joint.compression_gap)
+    bottom = np.maximum(orbit.x_min, -joint.tension_gap)
+    return 2.0 * (top - bottom)
+
+
+def sliding_friction(
+    joint: Joint,
+    amplitude: ArrayLike,
+    friction: Friction,
+    *,
+    form: Literal["exact", "paper"] = "exact",
+) -> FloatArray:
+    """Return the sliding-friction energy per free cycle at penetration A, J (MODEL.md eq 10).
+
+    ``form="exact"``: Coulomb, mu_s P times the distance slid: 4 mu_s P X over the
+    whole path (the default, ``friction.region == "everywhere"``), 2 mu_s P c over
+    the free-play stroke only. ``form="paper"``: the equivalent viscous form
+    c_P * integral of x'^2 dt over the stages where friction acts, with
+    c_P = 4 mu_s P / (pi w_n(A) X). The two agree only for sinusoidal motion.
+    """
+    if not isinstance(friction, Friction):
+        raise ParameterError(f"friction must be a clearjoint.Friction, got {friction!r}")
+    orbit = free_orbit(joint, amplitude)
+    if form == "exact":
+        return friction.force * _friction_path(joint, orbit, friction.region)
+    if form != "paper":
+        raise ParameterError(f"form must be 'exact' or 'paper', got {form!r}")
+    action = orbit.free_play_action
+    if friction.region == "everywhere":
+        action = action + orbit.contact_action
+    omega_n = 2.0 * math.pi / orbit.period
+    x_amp = orbit.displacement_amplitude
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c_p = 4.0 * friction.force / (math.pi * omega_n * x_amp)
+        return np.where(np.isfinite(c_p), c_p * action, 0.0)
+
+
+def contact_friction(
+    joint: Joint, amplitude: ArrayLike, pin: Pin, coefficient: float
+) -> FloatArray:
+    """Return the pin's contact-friction energy per free cycle at penetration A, J (eq 15).
+
+    Two excursions a cycle, each 0 -> A_s -> 0 under F_n = k_s (x - g_s):
+    16 mu_c beta_H k_s^1.5 A_s^2.5 / (15 pi R_p) per side.
+    """
+    mu = _checks.non_negative("contact_friction_coefficient", coefficient)
+    orbit = free_orbit(joint, amplitude)
+    factor = 16.0 * mu * hertz_coefficient(pin) / (15.0 * math.pi * pin.radius)
+    k_c, k_t = joint.compression_stiffness, joint.tension_stiffness
+    compression: FloatArray = orbit.compression_penetration**2.5
+    tension: FloatArray = orbit.tension_penetration**2.5
+    return factor * (k_c * math.sqrt(k_c) * compression + k_t * math.sqrt(k_t) * tension)
+
+
+def _restitution(restitution: float) -> float:
+    e = _checks.real_scalar("restitution", restitution)
+    if not 0.0 <= e <= 1.0:
+        raise ParameterError(f"restitution must satisfy 0 <= e <= 1, got {e!r}")
+    return e
+
+
+def impact(joint: Joint, amplitude: ArrayLike, restitution: float) -> FloatArray:
+    """Return the impact energy per free cycle at penetration A, J (MODEL.md eq 16).
+
+    beta m (v_c^2 + v_t^2), beta = (1 - e^2) / 2, with v_s the speed at which the
+    free orbit reaches each gap edge (v_s = A_s w_s when k0 = 0).
+    """
+    e = _restitution(restitution)
+    orbit = free_orbit(joint, amplitude)
+    beta = 0.5 * (1.0 - e * e)
+    return beta * joint.mass * (orbit.compression_speed**2 + orbit.tension_speed**2)
+
+
+def viscous(joint: Joint, amplitude: ArrayLike, damping_ratio: float) -> FloatArray:
+    """Return the viscous loss c_v * integral of x'^2 dt per free cycle at penetration A, J."""
+    c_v = viscous_coefficient(joint, damping_ratio)
+    orbit = free_orbit(joint, amplitude)
+    return c_v * (orbit.contact_action + orbit.free_play_action)
+
+
+def total(
+    joint: Joint,
+    amplitude: ArrayLike,
+    *,
+    friction: Friction | None = None,
+    pin: Pin | None = None,
+    contact_friction_coefficient: float = 0.0,
+    restitution: float = 1.0,
+    damping_ratio: float = 0.0,
+    form: Literal["exact", "paper"] = "exact",
+) -> FloatArray:
+    """Return E_Z = E_P + E_C + E_I (+ viscous) per free cycle at penetration A, J (eq 17)."""
+    result = impact(joint, amplitude, restitution)
+    if friction is not None:
+        result = result + sliding_friction(joint, amplitude, friction, form=form)
+    if pin is not None:
+        result = result + contact_friction(joint, amplitude, pin, contact_friction_coefficient)
+    if damping_ratio:
+        result = result + viscous(joint, amplitude, damping_ratio)
+    return result
+
+
+def excitation_work(
+    time: ArrayLike, velocity: ArrayLike, force_amplitude: float, omega: float
+) -> float:
+    """Return E_F, the work of F0 sin(w t) over a sampled periodic motion, J (MODEL.md eq 18).
+
+    ``time`` (N,) s, uniformly sampled over a whole number of forcing periods
+    without repeating the end point; ``velocity`` (N,) m/s. The rectangle rule is
+    spectrally accurate for smooth periodic integrands. For the exact steady
+    cycle, ``SteadyState.energy.input`` gives the same integral to round-off.
+    """
+    t = np.asarray(time, dtype=np.float64)
+    v = np.asarray(velocity, dtype=np.float64)
+    if t.ndim != 1 or t.shape != v.shape or t.size < 8:
+        raise ParameterError("time and velocity must be 1-D arrays of the same length (>= 8)")
+    f0 = _checks.positive("force_amplitude", force_amplitude, unit="N")
+    w = _checks.positive("omega", omega, unit="rad/s")
+    dt = np.diff(t)
+    if not np.all(np.isfinite(t)) or np.any(dt <= 0.0):
+        raise ParameterError("time must be finite and strictly increasing")
+    if np.ptp(dt) > 1e-6 * dt.mean():
+        raise ParameterError("time must be uniformly sampled")
+    return float(np.sum(f0 * np.sin(w * t) * v) * dt.mean())
+
+
+def loss_factor(joint: Joint, amplitude: ArrayLike, energy: ArrayLike) -> FloatArray:
+    """Return eta = E / (2 pi U_max), U_max = V(x_max) of the free cycle at penetration A."""
+    orbit = free_orbit(joint, amplitude)
+    u_max = joint.potential_energy(orbit.x_max)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(u_max > 0.0, np.asarray(energy) / (2.0 * math.pi * u_max), np.nan)
+
+
+def energies(
+    joint: Joint,
+    amplitude: ArrayLike,
+    *,
+    friction: Friction | None = None,
+    pin: Pin | None = None,
+    contact_friction_coefficient: float = 0.0,
+    restitution: float = 1.0,
+    damping_ratio: float = 0.0,
+) -> dict[str, FloatArray]:
+    """Return every energy per free cycle at penetration A, keyed as ``ENERGY_KEYS`` (SI).
+
+    ``total_j`` uses the exact sliding-friction form; ``sliding_friction_paper_j``
+    is the paper's equivalent-viscous form beside it. ``hertz_half_width_m`` is the
+    half-width at the largest contact force of the cycle (0 without a pin).
+    """
+    a = _checks.non_negative_array("amplitude", amplitude, unit="m")
+    zero = np.zeros_like(a)
+    slide = sliding_friction(joint, a, friction) if friction else zero
+    slide_paper = sliding_friction(joint, a, friction, form="paper") if friction else zero
+    contact = (
+        contact_friction(joint, a, pin, contact_friction_coefficient) if pin is not None else zero
+    )
+    hits = impact(joint, a, restitution)
+    loss = viscous(joint, a, damping_ratio) if damping_ratio else zero
+    everything = slide + contact + hits + loss
+    eta = loss_factor(joint, a, everything)
+    if pin is not None:
+        orbit = free_orbit(joint, a)
+        peak = np.maximum(
+            joint.compression_stiffness * orbit.compression_penetration,
+            joint.tension_stiffness * orbit.tension_penetration,
+        )
+        width = hertz_contact(pin, peak).half_width
+    else:
+        width = zero
+    return {
+        "sliding_friction_j": slide,
+        "sliding_friction_paper_j": slide_paper,
+        "contact_friction_j": contact,
+        "impact_j": hits,
+        "viscous_j": loss,
+        "total_j": everything,
+        "loss_factor": eta,
+        "equivalent_damping_ratio": 0.5 * eta,
+        "hertz_half_width_m": width,
+    }
+
+
+# ---- closed form against the exact steady cycle --------------------------------------------
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """The same energies by two routes, with their relative gap (closed / exact - 1).
+
+    ``closed`` is on the free cycle at the exact cycle's compression penetration;
+    ``exact`` integrates over the forced steady cycle; ``cycle`` is that cycle.
+    Energy keys are those of :data:`ENERGY_KEYS` ending in ``_j``.
+    """
+
+    penetration: float
+    closed: dict[str, float]
+    exact: dict[str, float]
+    gap: dict[str, float]
+    cycle: SteadyState
+
+
+def _exact_energies(
+    cycle: SteadyState,
+    joint: Joint,
+    friction: Friction | None,
+    omega: float,
+) -> dict[str, float]:
+    ledger = cycle.energy
+    paper = 0.0
+    if friction is not None and friction.force > 0.0:
+        # c_P with the forcing frequency and the cycle's own X, over the stages where it acts
+        v2 = cycle.velocity**2
+        if friction.region == "free-play":
+            inside = (cycle.displacement < joint.compression_gap) & (
+                cycle.displacement > -joint.tension_gap
+            )
+            v2 = np.where(inside, v2, 0.0)
+        action = float(np.mean(v2)) * cycle.period
+        paper = 4.0 * friction.force / (math.pi * omega * cycle.amplitude) * action
+    return {
+        "sliding_friction_j": ledger.sliding_friction,
+        "sliding_friction_paper_j": paper,
+        "contact_friction_j": ledger.contact_friction,
+        "impact_j": ledger.impact,
+        "viscous_j": ledger.viscous,
+        "total_j": ledger.sliding_friction
+        + ledger.contact_friction
+        + ledger.impact
+        + ledger.viscous,
+    }
+
+
+def compare(
+    joint: Joint,
+    force_amplitude: float,
+    omega: float,
+    *,
+    friction: Friction | None = None,
+    pin: Pin | None = None,
+    contact_friction_coefficient: float = 0.0,
+    restitution: float = 1.0,
+    damping_ratio: float = 0.0,
+    initial: ArrayLike | None = None,
+) -> Comparison:
+    """Return each energy by the closed form and over the exact steady cycle, with their gap.
+
+    The forced steady cycle at F0 sin(omega t) (omega in rad/s) is simulated
+    exactly; the closed forms are evaluated on the free cycle at that cycle's
+    compression penetration A = x_max - g_c.
+    """
+    cycle = steady_state(
+        joint,
+        force_amplitude,
+        omega,
+        damping_ratio=damping_ratio,
+        friction=friction,
+        restitution=restitution,
+        pin=pin,
+        contact_friction_coefficient=contact_friction_coefficient,
+        initial=initial,
+        samples_per_period=1024,
+    )
+    a = cycle.compression_penetration
+    closed_all = energies(
+        joint,
+        a,
+        friction=friction,
+        pin=pin,
+        contact_friction_coefficient=contact_friction_coefficient,
+        restitution=restitution,
+        damping_ratio=damping_ratio,
+    )
+    exact = _exact_energies(cycle, joint, friction, omega)
+    closed = {key: float(closed_all[key]) for key in exact}
+    gap = {
+        key: (closed[key] / exact[key] - 1.0)
+        if exact[key] != 0.0
+        else (0.0 if closed[key] == 0.0 else math.inf)
+        for key in exact
+    }
+    return Comparison(penetration=a, closed=closed, exact=exact, gap=gap, cycle=cycle)
