@@ -303,6 +303,8 @@ def compare(
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
     initial: ArrayLike | None = None,
+    samples_per_period: int = 1024,
+    max_periods: int = 20_000,
 ) -> Comparison:
     """Return each energy by the closed form and over the exact steady cycle, with their gap.
 
@@ -320,7 +322,8 @@ def compare(
         pin=pin,
         contact_friction_coefficient=contact_friction_coefficient,
         initial=initial,
-        samples_per_period=1024,
+        samples_per_period=samples_per_period,
+        max_periods=max_periods,
     )
     a = cycle.compression_penetration
     closed_all = energies(
@@ -341,3 +344,68 @@ def compare(
         for key in exact
     }
     return Comparison(penetration=a, closed=closed, exact=exact, gap=gap, cycle=cycle)
+
+
+@dataclass(frozen=True)
+class AgreementMap:
+    """Where the closed forms agree with the exact cycle, over forcing frequency and force.
+
+    ``omega`` (F,) rad/s and ``force`` (N,) N span the grid; ``penetration`` (F, N)
+    is the exact cycle's A = x_max - g_c in m; ``gap[key]`` (F, N) is closed / exact - 1
+    for each energy key of :class:`Comparison`. NaN where no periodic orbit was found.
+    """
+
+    omega: FloatArray
+    force: FloatArray
+    penetration: FloatArray
+    gap: dict[str, FloatArray]
+
+
+def agreement_map(
+    joint: Joint,
+    omegas: ArrayLike,
+    forces: ArrayLike,
+    *,
+    friction: Friction | None = None,
+    pin: Pin | None = None,
+    contact_friction_coefficient: float = 0.0,
+    restitution: float = 1.0,
+    damping_ratio: float = 0.0,
+    max_periods: int = 2000,
+) -> AgreementMap:
+    """Return the closed-form-to-exact gap of every energy over a grid of (omega, F0).
+
+    At each frequency the forces are stepped upward, each step starting from the
+    last steady state (as a test rig would), so every point is an exact steady
+    cycle compared with the closed forms at its own penetration (:func:`compare`).
+    """
+    from clearjoint.simulate import SimulationError
+
+    w = np.atleast_1d(np.asarray(omegas, dtype=np.float64))
+    f = np.sort(np.atleast_1d(np.asarray(forces, dtype=np.float64)))
+    penetration = np.full((w.size, f.size), np.nan)
+    gaps: dict[str, FloatArray] = {}
+    for i, omega in enumerate(w):
+        initial: tuple[float, float, int, int] | None = None
+        for n, force in enumerate(f):
+            try:
+                result = compare(
+                    joint,
+                    float(force),
+                    float(omega),
+                    friction=friction,
+                    pin=pin,
+                    contact_friction_coefficient=contact_friction_coefficient,
+                    restitution=restitution,
+                    damping_ratio=damping_ratio,
+                    initial=initial,
+                    samples_per_period=128,
+                    max_periods=max_periods,
+                )
+            except SimulationError:
+                continue
+            initial = result.cycle.initial_state
+            penetration[i, n] = result.penetration
+            for key, value in result.gap.items():
+                gaps.setdefault(key, np.full((w.size, f.size), np.nan))[i, n] = value
+    return AgreementMap(omega=w, force=f, penetration=penetration, gap=gaps)

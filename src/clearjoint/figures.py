@@ -127,3 +127,97 @@ def force_displacement_figure(
     if title:
         ax.set_title(title)
     return fig
+
+
+#: Line styles and markers of the energy mechanisms, apart in grey print.
+MECHANISM_STYLES: dict[str, tuple[str, str, str]] = {
+    "sliding_friction_j": ("sliding friction", "-", "o"),
+    "contact_friction_j": ("contact friction (pin)", "--", "s"),
+    "impact_j": ("impact", "-.", "^"),
+    "viscous_j": ("viscous", ":", "v"),
+    "total_j": ("total", "-", "D"),
+}
+
+
+@dataclass(frozen=True)
+class EnergyPanel:
+    """One panel of energies against amplitude: closed-form curves and exact points (SI)."""
+
+    title: str
+    amplitude: NDArray[np.float64]
+    closed: dict[str, NDArray[np.float64]]
+    exact_amplitude: NDArray[np.float64]
+    exact: dict[str, NDArray[np.float64]]
+
+
+def dissipation_figure(panels: Sequence[EnergyPanel]) -> Figure:
+    """Return each mechanism's energy per cycle against A: closed form (lines), exact (markers)."""
+    fig = Figure(figsize=(5.2 * len(panels), 4.4), layout="constrained")
+    axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
+    for ax, panel in zip(axes, panels, strict=True):
+        for key, (label, style, marker) in MECHANISM_STYLES.items():
+            if key not in panel.closed or not np.any(panel.closed[key] > 0):
+                continue
+            weight = 2.2 if key == "total_j" else 1.2
+            ax.plot(
+                panel.amplitude * 1e6,
+                panel.closed[key] * 1e3,
+                linestyle=style,
+                color="black",
+                lw=weight,
+                label=f"{label}, closed form",
+            )
+            ax.plot(
+                panel.exact_amplitude * 1e6,
+                panel.exact[key] * 1e3,
+                linestyle="none",
+                marker=marker,
+                mfc="white",
+                mec="0.3",
+                ms=5,
+                label=f"{label}, exact cycle",
+            )
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("amplitude beyond the gap edge A (µm)")
+        ax.set_title(panel.title)
+        ax.grid(True, which="both", color="0.9", lw=0.5)
+    axes[0].set_ylabel("energy per cycle (mJ)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(
+        handles, labels, loc="outside lower center", ncols=3, frameon=False, fontsize="small"
+    )
+    return fig
+
+
+def agreement_map_figure(
+    omega: NDArray[np.float64],
+    force: NDArray[np.float64],
+    gap: NDArray[np.float64],
+    penetration: NDArray[np.float64],
+    *,
+    tolerance: float = 0.05,
+    title: str | None = None,
+) -> Figure:
+    """Return the map of where |closed / exact - 1| <= tolerance over frequency (Hz) and force.
+
+    Grey: within tolerance; white: outside; hatched: no periodic orbit. Contours
+    give the exact cycle's penetration A in um.
+    """
+    fig = Figure(figsize=(6.0, 4.6), layout="constrained")
+    ax = fig.add_subplot()
+    freq = omega / (2.0 * np.pi)
+    inside = np.where(np.isnan(gap), np.nan, (np.abs(gap) <= tolerance).astype(float))
+    ax.pcolormesh(freq, force, inside.T, cmap="Greys", vmin=0.0, vmax=2.5, shading="nearest")
+    missing = np.isnan(gap).T.astype(float)
+    if missing.any():
+        ax.contourf(freq, force, missing, levels=[0.5, 1.5], colors="none", hatches=["xxx"])
+    if np.any(np.isfinite(penetration)):
+        lines = ax.contour(
+            freq, force, penetration.T * 1e6, colors="black", linewidths=0.7, levels=6
+        )
+        ax.clabel(lines, fmt="%.0f µm", fontsize="x-small")
+    ax.set_xlabel("forcing frequency (Hz)")
+    ax.set_ylabel("force amplitude F0 (N)")
+    ax.set_title(title or f"grey: closed form within {tolerance:.0%} of the exact cycle")
+    return fig
