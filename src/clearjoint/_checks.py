@@ -67,6 +67,7 @@ def refuse_to_overwrite(paths: Iterable[Path], *, force: bool) -> None:
     """Raise OutputExistsError naming every path that exists, unless ``force``."""
     existing = [str(path) for path in paths if path.exists()]
     if existing and not force:
-        raise OutputExistsError(
-            f"will not overwrite {', '.join(existing)}; choose another --out or pass --force"
-        )
+        named = ", ".join(existing[:3])
+        if len(existing) > 3:
+            named += f" and {len(existing) - 3} more"
+        raise OutputExistsError(f"will not overwrite {named}; choose another --out or pass --force")

@@ -112,6 +112,23 @@ def _simulate_parser(sub: Any) -> None:
     p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
 
 
+def _rig_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "rig",
+        help="run a campaign of the virtual test rig and write its records",
+        description=(
+            "Simulate every test of CAMPAIGN.toml (the shipped default when none is given: "
+            "the paper's two joints and the bare beam over a grid of forces and frequencies) "
+            "and write one record per test and DIR/manifest.csv with the truth of each."
+        ),
+    )
+    p.add_argument("campaign", nargs="?", help="campaign file (TOML); default: the shipped one")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
+    p.add_argument("--force", action="store_true", help="overwrite existing records")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``clearjoint`` command."""
     parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
@@ -120,6 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     _stiffness_parser(sub)
     _simulate_parser(sub)
     _dissipation_parser(sub)
+    _rig_parser(sub)
     _reproduce_parser(sub)
     return parser
 
@@ -276,6 +294,36 @@ def _run_dissipation(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_rig(args: argparse.Namespace) -> int:
+    import os
+    import time
+
+    from clearjoint.rig import load_campaign, run_campaign
+
+    campaign = load_campaign(args.campaign)
+    if args.jobs is not None and args.jobs < 1:
+        raise ParameterError(f"--jobs must be >= 1, got {args.jobs}")
+    jobs = args.jobs or os.cpu_count() or 1
+    start = time.perf_counter()
+    total = len(campaign.tests)
+    if args.quiet:
+        manifest = run_campaign(campaign, args.out, jobs=jobs, force=args.force)
+    else:
+        from rich.progress import Progress
+
+        with Progress(transient=True) as bar:
+            task = bar.add_task(f"{total} tests on {jobs} processes", total=total)
+            manifest = run_campaign(
+                campaign,
+                args.out,
+                jobs=jobs,
+                force=args.force,
+                progress=lambda done, _total: bar.update(task, completed=done),
+            )
+    print(f"wrote {total} records and {manifest} in {time.perf_counter() - start:.1f} s")
+    return 0
+
+
 def _run_simulate(args: argparse.Namespace) -> int:
     from clearjoint.simulate.study import load_study, run_study, summary, write_netcdf
 
@@ -337,6 +385,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "stiffness": _run_stiffness,
         "simulate": _run_simulate,
         "dissipation": _run_dissipation,
+        "rig": _run_rig,
         "reproduce": _run_reproduce,
     }
     try:

@@ -24,7 +24,23 @@ SI_UNITS: dict[str, str] = {
     "time": "s",
     "pressure": "Pa",
     "velocity": "m/s",
+    "acceleration": "m/s^2",
     "dimensionless": "",
+}
+
+
+#: A value of each kind that parses, for error messages.
+EXAMPLES: dict[str, str] = {
+    "length": "0.106mm",
+    "mass": "1.5kg",
+    "stiffness": "8e7N/m",
+    "force": "200N",
+    "frequency": "20Hz",
+    "time": "2s",
+    "pressure": "206GPa",
+    "velocity": "0.1m/s",
+    "acceleration": "100m/s^2",
+    "dimensionless": "0.3",
 }
 
 
@@ -48,16 +64,7 @@ def parse_quantity(text: str, kind: str, *, name: str) -> float:
     import pint
 
     si = SI_UNITS[kind]
-    example = {
-        "length": "0.106mm",
-        "mass": "1.5kg",
-        "stiffness": "8e7N/m",
-        "force": "200N",
-        "frequency": "20Hz",
-        "time": "2s",
-        "pressure": "206GPa",
-        "dimensionless": "0.3",
-    }[kind]
+    example = EXAMPLES[kind]
     raw = text.strip()
     if not raw:
         raise ParameterError(f"{name}: empty value; give a {kind} such as {example}")

@@ -319,16 +319,11 @@ def _motion_fields(
     joint: Joint,
     run: _Run,
     start_state: FloatArray,
-    duration: float,
-    samples_per_period: int,
+    time: FloatArray,
     pin: Pin | None,
     contact_friction_coefficient: float,
 ) -> dict[str, object]:
     tf = p[kn.P_TF]
-    n = max(round(samples_per_period * duration / tf), 2)
-    time = (
-        np.linspace(0.0, duration, n + 1)[:-1] if duration >= tf else np.linspace(0.0, duration, n)
-    )
     out = np.zeros((time.size, 3))
     kn.sample(p, run.segments, run.segments.shape[0], time, out)
     x, v, a = out[:, 0], out[:, 1], out[:, 2]
@@ -391,15 +386,18 @@ def time_response(
     pin: Pin | None = None,
     contact_friction_coefficient: float = 0.0,
     samples_per_period: int = 256,
+    sampling_rate: float | None = None,
 ) -> Motion:
     """Return the exact transient response from ``initial`` = (x0, v0) over ``duration`` s.
 
     The forcing is F0 sin(omega t) from t = 0 (omega in rad/s). The ledger covers
-    the whole run, so input = losses + mechanical_energy_change.
+    the whole run, so input = losses + mechanical_energy_change. The motion is
+    sampled ``samples_per_period`` times per forcing period, or at
+    ``sampling_rate`` (Hz) when that is given.
     """
     p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
     duration = _checks.positive("duration", duration, unit="s")
-    _check_samples(samples_per_period)
+    time = _sample_times(duration, p[kn.P_TF], samples_per_period, sampling_rate)
     mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
     state = _initial_state(p, initial)
     start = state.copy()
@@ -411,8 +409,23 @@ def time_response(
     else:
         n_periods, t_last = n_full + 1, remainder
     run = _run(p, state, n_periods, t_last, record=True)
-    fields = _motion_fields(p, joint, run, start, duration, samples_per_period, pin, mu_c)
+    fields = _motion_fields(p, joint, run, start, time, pin, mu_c)
     return Motion(**fields)  # type: ignore[arg-type]
+
+
+def _sample_times(
+    duration: float, period: float, samples_per_period: int, sampling_rate: float | None
+) -> FloatArray:
+    """Uniform sample times over [0, duration): per forcing period, or at a rate in Hz."""
+    if sampling_rate is not None:
+        rate = _checks.positive("sampling_rate", sampling_rate, unit="Hz")
+        n = max(math.floor(duration * rate * (1.0 + 1e-12)), 2)
+        return np.arange(n) / rate
+    _check_samples(samples_per_period)
+    n = max(round(samples_per_period * duration / period), 2)
+    if duration >= period:
+        return np.linspace(0.0, duration, n + 1)[:-1]
+    return np.linspace(0.0, duration, n)
 
 
 def _check_samples(samples_per_period: int) -> None:
@@ -530,7 +543,8 @@ def steady_state(
     start = state.copy()
     run = _run(p, state, multiple, p[kn.P_TF], record=True)
     duration = multiple * p[kn.P_TF]
-    fields = _motion_fields(p, joint, run, start, duration, samples_per_period, pin, mu_c)
+    time = _sample_times(duration, p[kn.P_TF], samples_per_period, None)
+    fields = _motion_fields(p, joint, run, start, time, pin, mu_c)
     x_max = float(fields["x_max"])  # type: ignore[arg-type]
     x_min = float(fields["x_min"])  # type: ignore[arg-type]
     return SteadyState(

@@ -1,0 +1,230 @@
+"""records.py: file formats, round trips, the BRFD adapter, and every bad-input case."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from clearjoint.errors import OutputExistsError
+from clearjoint.records import (
+    CSV_MAGIC,
+    Record,
+    RecordError,
+    read_brfd,
+    read_record,
+    resample,
+    sniff,
+    write_record,
+)
+
+#: The real records, in shared/ beside the clone (as on the developers' machines and CI).
+BRFD = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
+
+
+def record(**changes: object) -> Record:
+    t = np.arange(2000) / 1000.0
+    values: dict[str, object] = {
+        "time": t,
+        "force": 100.0 * np.sin(2 * np.pi * 10 * t),
+        "displacement": 1e-5 * np.sin(2 * np.pi * 10 * t - 0.3),
+        "acceleration": np.cos(t),
+        "joint_id": "J1",
+        "clearance": 0.106e-3,
+        "force_amplitude": 100.0,
+        "frequency_hz": 10.0,
+        "mass": 1.5,
+        "notes": 'a "quoted" note',
+    }
+    values.update(changes)
+    return Record(**values)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".nc"])
+def test_round_trip_keeps_data_and_metadata(tmp_path: Path, suffix: str) -> None:
+    original = record()
+    path = write_record(original, tmp_path / f"r{suffix}")
+    back = read_record(path)
+    for name in ("time", "force", "displacement", "acceleration"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(original, name))
+    assert back.velocity is None
+    for key in (
+        "joint_id",
+        "clearance",
+        "force_amplitude",
+        "frequency_hz",
+        "mass",
+        "notes",
+        "control",
+    ):
+        assert getattr(back, key) == getattr(original, key)
+    assert back.source == str(path)
+
+
+def test_csv_units_are_converted_to_si(tmp_path: Path) -> None:
+    path = tmp_path / "lab.csv"
+    t = np.arange(100) / 100.0
+    lines = [
+        CSV_MAGIC,
+        '# frequency = "5 Hz"',
+        '# clearance = "0.1 mm"',
+        "time [ms],force [kN],displacement [mm]",
+    ]
+    lines += [f"{1000 * ti},{0.5},{0.01 * ti}" for ti in t]
+    path.write_text("\n".join(lines) + "\n")
+    r = read_record(path)
+    np.testing.assert_allclose(r.time, t)
+    np.testing.assert_allclose(r.force, 500.0)
+    np.testing.assert_allclose(r.displacement, 1e-5 * t)
+    assert r.clearance == pytest.approx(1e-4)
+    assert r.units == {"time": "ms", "force": "kN", "displacement": "mm"}
+
+
+def test_plain_csv_with_a_sidecar_toml(tmp_path: Path) -> None:
+    path = tmp_path / "plain.csv"
+    t = np.arange(100) / 100.0
+    path.write_text(
+        "time [s], force [N], displacement [um]\n" + "\n".join(f"{ti},{ti},{ti}" for ti in t) + "\n"
+    )
+    (tmp_path / "plain.toml").write_text('[record]\njoint_id = "side"\nmass = "2 kg"\n')
+    r = read_record(path)
+    assert r.joint_id == "side"
+    assert r.mass == 2.0
+    np.testing.assert_allclose(r.displacement, 1e-6 * t)
+
+
+def write_csv(tmp_path: Path, body: str, name: str = "bad.csv") -> Path:
+    path = tmp_path / name
+    path.write_text(body)
+    return path
+
+
+def csv_body(times: list[float], values: str = "1,1") -> str:
+    return "time [s],force [N],displacement [m]\n" + "".join(f"{t},{values}\n" for t in times)
+
+
+UNIFORM = [i / 100 for i in range(50)]
+
+
+@pytest.mark.parametrize(
+    ("body", "words"),
+    [
+        (csv_body([*UNIFORM[:10], 0.05, *UNIFORM[11:]]), "not strictly increasing"),
+        (csv_body(UNIFORM, "nan,1"), "NaN or infinite"),
+        (
+            csv_body([0.0, 0.01, 0.03] + [0.03 + i / 100 for i in range(1, 40)]),
+            "not uniformly sampled",
+        ),
+        (csv_body(UNIFORM[:5]), "only 5 samples"),
+        ("time [s],force [lbf],displacement [m/s]\n" + "0,1,1\n" * 20, "not a unit of m"),
+        ("time [s],force [N],displacement [furlongz]\n" + "0,1,1\n" * 20, "unknown unit"),
+        ("time [s],force [N]\n" + "".join(f"{t},1\n" for t in UNIFORM), "no displacement"),
+        ("time,force [N],displacement [m]\n0,1,1\n", "has no unit"),
+        (CSV_MAGIC + '\n# frequency = "2 Hz"\n' + csv_body(UNIFORM), "spans 0.98 cycles"),
+        (CSV_MAGIC + '\n# colour = "red"\n' + csv_body(UNIFORM), "unknown metadata"),
+        (csv_body(UNIFORM, "1,abc"), "not numeric"),
+    ],
+)
+def test_bad_records_name_the_file_and_the_problem(tmp_path: Path, body: str, words: str) -> None:
+    path = write_csv(tmp_path, body)
+    with pytest.raises(RecordError) as info:
+        read_record(path)
+    assert words in str(info.value)
+    assert str(path) in str(info.value)
+
+
+def test_resampling_is_offered_and_works(tmp_path: Path) -> None:
+    times = [0.0, 0.011] + [0.011 + i / 100 for i in range(1, 60)]
+    path = write_csv(tmp_path, csv_body(times))
+    with pytest.raises(RecordError, match="resample=True"):
+        read_record(path)
+    r = read_record(path, resample=True)
+    assert np.ptp(np.diff(r.time)) < 1e-12
+
+
+def test_resample_interpolates_linearly() -> None:
+    t = np.array([0.0, 0.1, 0.25, 0.3, 0.4])
+    grid, out = resample(t, {"x": 2 * t}, rate=20.0)
+    np.testing.assert_allclose(out["x"], 2 * grid)
+    np.testing.assert_allclose(np.diff(grid), 0.05)
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "words"),
+    [
+        ("fake.nc", b"time [s],force [N]\n", "named as netCDF but its content is CSV"),
+        ("fake.json", b"time [s]\n", "named as JSON but its content is CSV"),
+        ("fake.csv", b"\x89HDF\r\n\x1a\n" + b"\x00" * 32, "named as CSV but its content is NETCDF"),
+        ("empty.csv", b"", "empty file"),
+        ("blob.dat", b"\x00\x01\x02garbage", "binary file of unknown format"),
+        ("other.json", b'{"a": 1}', "not a BRFD record"),
+        ("broken.json", b'{"data": [1, 2', "not a JSON file"),
+        ("broken.nc", b"\x89HDF\r\n\x1a\n" + b"\x00" * 64, "not a readable netCDF/HDF5 file"),
+    ],
+)
+def test_files_that_are_not_what_they_claim(
+    tmp_path: Path, name: str, content: bytes, words: str
+) -> None:
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(RecordError, match=words):
+        read_record(path)
+
+
+def test_missing_file_and_folder(tmp_path: Path) -> None:
+    with pytest.raises(RecordError, match="no such file"):
+        read_record(tmp_path / "none.csv")
+    with pytest.raises(RecordError, match="is a folder"):
+        sniff(tmp_path)
+
+
+def test_never_overwrites_unless_asked(tmp_path: Path) -> None:
+    path = write_record(record(), tmp_path / "r.csv")
+    before = path.read_bytes()
+    with pytest.raises(OutputExistsError, match="will not overwrite"):
+        write_record(record(force_amplitude=5.0), path)
+    assert path.read_bytes() == before
+    write_record(record(force_amplitude=5.0), path, force=True)
+    assert read_record(path).force_amplitude == 5.0
+    with pytest.raises(RecordError, match=r"\.csv or \.nc"):
+        write_record(record(), tmp_path / "r.xlsx")
+
+
+def test_record_checks_its_own_fields() -> None:
+    with pytest.raises(RecordError, match="force has 3 samples but time has 2000"):
+        record(force=[1.0, 2.0, 3.0])
+    with pytest.raises(RecordError, match="control must be"):
+        record(control="temperature")
+    with pytest.raises(RecordError, match="clearance must be finite and >= 0"):
+        record(clearance=-1.0)
+
+
+@pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
+def test_brfd_adapter_reads_all_31_files_in_si() -> None:
+    files = sorted(BRFD.glob("*.json"))
+    assert len(files) == 31
+    for path in files:
+        r = read_record(path)
+        raw = np.asarray(json.loads(path.read_text())["data"])
+        np.testing.assert_allclose(r.time, raw[:, 0])
+        np.testing.assert_allclose(r.displacement, raw[:, 1] * 0.0254, rtol=1e-12)
+        np.testing.assert_allclose(r.force, raw[:, 2] * 4448.2216152605, rtol=1e-9)
+        np.testing.assert_allclose(r.velocity, raw[:, 3] * 0.0254, rtol=1e-12)
+        assert r.control == "displacement"
+        assert r.sampling_rate == pytest.approx(1024.0, rel=1e-6)
+        assert r.frequency_hz in (0.25, 0.5, 1.0, 2.0)
+        assert any(r.displacement_amplitude == pytest.approx(a) for a in (0.0127, 0.0254, 0.0381))
+        assert "band tension" in r.notes
+        assert "Coble" in r.notes
+        # the nominal amplitude is reached (within the ramps' and the actuator's error)
+        assert np.max(np.abs(r.displacement)) == pytest.approx(r.displacement_amplitude, rel=0.25)
+
+
+@pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
+def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
+    path = tmp_path / "1Hz0lbtension1amplitude.json"
+    path.write_text(json.dumps({"data": [[0.0, 1.0]] * 20, "displacement units": "in"}))
+    with pytest.raises(RecordError, match="must have 6 columns"):
+        read_brfd(path)
