@@ -129,6 +129,32 @@ def _rig_parser(sub: Any) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _identify_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "identify",
+        help="clearance, stiffness, friction and energy per cycle from test records",
+        description=(
+            "Identify every record (CSV, netCDF, BRFD JSON; recognised by content): one row "
+            "per file in --out (.csv or .nc) with each quantity's mean over the steady "
+            "cycles and its spread in a _std column; one line for every file not used."
+        ),
+    )
+    p.add_argument("files", nargs="+", help="record files")
+    p.add_argument("--out", required=True, help="results file, .csv or .nc")
+    p.add_argument("--figures", help="write two figures per test into this folder")
+    p.add_argument(
+        "--resample", action="store_true", help="interpolate records that are not uniformly sampled"
+    )
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.03,
+        help="steady-cycle amplitude tolerance (default 0.03)",
+    )
+    p.add_argument("--force", action="store_true", help="overwrite existing output")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``clearjoint`` command."""
     parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
@@ -138,6 +164,7 @@ def build_parser() -> argparse.ArgumentParser:
     _simulate_parser(sub)
     _dissipation_parser(sub)
     _rig_parser(sub)
+    _identify_parser(sub)
     _reproduce_parser(sub)
     return parser
 
@@ -324,6 +351,90 @@ def _run_rig(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_identify(args: argparse.Namespace) -> int:
+    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.identify import identify_files
+
+    out = Path(args.out)
+    if out.suffix.lower() not in (".csv", ".nc"):
+        raise ParameterError(f"--out must end in .csv or .nc, got {out.name!r}")
+    if not 0.0 < args.tolerance < 1.0:
+        raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
+    refuse_to_overwrite([out], force=args.force)
+    if args.quiet:
+        results, failures = identify_files(
+            args.files, resample=args.resample, tolerance=args.tolerance
+        )
+    else:
+        from rich.progress import Progress
+
+        with Progress(transient=True) as bar:
+            task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
+            results, failures = identify_files(
+                args.files,
+                resample=args.resample,
+                tolerance=args.tolerance,
+                progress=lambda done, _total: bar.update(task, completed=done),
+            )
+    for line in failures:
+        print(f"not used: {line}", file=sys.stderr)
+    if not results:
+        print("clearjoint identify: error: no record could be used", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    rows = [ident.row() for _, ident in results]
+    _write_rows(rows, out)
+    if args.figures:
+        _identify_figures(results, Path(args.figures), force=args.force)
+    print(f"identified {len(results)} of {len(args.files)} records; wrote {out}")
+    return 0
+
+
+def _write_rows(rows: list[dict[str, Any]], out: Path) -> None:
+    import csv
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if out.suffix.lower() == ".csv":
+        with out.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+            writer.writeheader()
+            writer.writerows(rows)
+        return
+    import xarray as xr
+
+    columns = {key: [row[key] for row in rows] for key in rows[0]}
+    data = xr.Dataset(
+        {key: ("file", np.asarray(values)) for key, values in columns.items() if key != "file"},
+        coords={"file": ("file", np.asarray(columns["file"], dtype=str))},
+        attrs={"title": "clearjoint identification"},
+    )
+    data.to_netcdf(out, engine="h5netcdf")
+
+
+def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
+    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.figures import displacement_stages_figure, identified_loop_figure
+
+    folder.mkdir(parents=True, exist_ok=True)
+    for record, ident in results:
+        stem = Path(ident.source).stem
+        targets = [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
+        refuse_to_overwrite(targets, force=force)
+        first = ident.cycles[0]
+        span = slice(first.start, ident.cycles[-1].stop)
+        runs = ident.stage_runs(record.time)
+        fig = displacement_stages_figure(record.time, record.displacement, runs, title=stem)
+        fig.savefig(targets[0], dpi=100)
+        fig = identified_loop_figure(
+            record.displacement[span],
+            ident.restoring_force[span],
+            ident.stage[span],
+            (first.upper_edge, first.lower_edge),
+            first.lines,
+            title=stem,
+        )
+        fig.savefig(targets[1], dpi=100)
+
+
 def _run_simulate(args: argparse.Namespace) -> int:
     from clearjoint.simulate.study import load_study, run_study, summary, write_netcdf
 
@@ -386,6 +497,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "simulate": _run_simulate,
         "dissipation": _run_dissipation,
         "rig": _run_rig,
+        "identify": _run_identify,
         "reproduce": _run_reproduce,
     }
     try:

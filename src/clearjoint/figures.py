@@ -221,3 +221,52 @@ def agreement_map_figure(
     ax.set_ylabel("force amplitude F0 (N)")
     ax.set_title(title or f"grey: closed form within {tolerance:.0%} of the exact cycle")
     return fig
+
+
+def identified_loop_figure(
+    displacement: NDArray[np.float64],
+    force: NDArray[np.float64],
+    stage: NDArray[np.int8],
+    edges: tuple[float, float],
+    lines: Sequence[tuple[float, float]] = (),
+    *,
+    title: str | None = None,
+) -> Figure:
+    """Return a record's loop, its samples marked by stage, the gap edges and fitted lines.
+
+    ``stage`` is -1 (tension), 0 (free-play) or 1 (compression) per sample; ``lines``
+    the (intercept, slope) of the fitted tension, free-play and compression lines.
+    """
+    fig = Figure(figsize=(6.0, 4.6), layout="constrained")
+    ax = fig.add_subplot()
+    marks = {
+        -1: ("tension", "v", "0.55"),
+        0: ("free-play", ".", "0.75"),
+        1: ("compression", "^", "0.25"),
+    }
+    for value, (name, marker, colour) in marks.items():
+        sel = stage == value
+        if sel.any():
+            ax.plot(
+                displacement[sel] * 1e6,
+                force[sel],
+                linestyle="none",
+                marker=marker,
+                ms=2.5,
+                color=colour,
+                label=name,
+            )
+    span = np.array([displacement.min(), displacement.max()])
+    for (intercept, slope), (low, high) in zip(
+        lines, ((span[0], edges[1]), (edges[1], edges[0]), (edges[0], span[1])), strict=False
+    ):
+        xs = np.array([low, high])
+        ax.plot(xs * 1e6, intercept + slope * xs, color="black", lw=1.4)
+    for edge in edges:
+        ax.axvline(edge * 1e6, color="black", lw=0.8, linestyle="--")
+    ax.set_xlabel("displacement x (µm)")
+    ax.set_ylabel("restoring force (N)")
+    ax.legend(frameon=False, fontsize="small")
+    if title:
+        ax.set_title(title)
+    return fig
