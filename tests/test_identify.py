@@ -138,11 +138,11 @@ def test_exact_friction_loop_with_backlash() -> None:
 def test_real_brfd_records() -> None:
     identified = 0
     for path in sorted(BRFD.glob("*.json")):
-        try:
-            result = identify(read_record(path))
-        except IdentificationError as exc:
-            assert "steady cycles" in str(exc)  # the one short file: explained in the docs
+        if path.name == "2Hz0lbtension1amplitude.json":  # two steady cycles only (docs)
+            with pytest.raises(IdentificationError, match="steady cycles"):
+                identify(read_record(path))
             continue
+        result = identify(read_record(path))
         identified += 1
         s = result.summary
         assert result.cycles_used >= 2
@@ -154,7 +154,7 @@ def test_real_brfd_records() -> None:
             estimate = 2 * s["friction_force_n"] * (2 * s["amplitude_m"] - s["clearance_m"])
             assert 0.7 < s["energy_per_cycle_j"] / estimate < 1.25, path.name
             assert 3e-3 < s["clearance_m"] < 8e-3, path.name
-    assert identified >= 30
+    assert identified == 30
 
 
 def test_short_and_shapeless_records_are_refused() -> None:
