@@ -31,7 +31,6 @@ PAPER_CLEARANCES: tuple[float, ...] = (0.106e-3, 0.196e-3)
 
 #: Stages of the paper's study that this version does not run yet.
 NOT_BUILT: tuple[str, ...] = (
-    "identification of clearance, stiffness and energy from records",
     "fitted laws (eq 19-22) and the joint stiffness of eq 20",
 )
 
