@@ -156,9 +156,8 @@ def rig_picture() -> None:
 
 def main() -> None:
     HERE.mkdir(exist_ok=True)
-    study = stiffness_study()
     fig = stiffness_coefficient_figure(
-        study.curves, title="Stiffness coefficient against amplitude (paper Fig. 12)"
+        stiffness_study(), title="Stiffness coefficient against amplitude (paper Fig. 12)"
     )
     fig.savefig(HERE / "fig12_stiffness_coefficient.png", dpi=110)
     print(f"wrote {HERE / 'fig12_stiffness_coefficient.png'}")

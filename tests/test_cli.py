@@ -120,29 +120,6 @@ def test_runs_as_a_module() -> None:
     assert "period_s" in json.loads(result.stdout)
 
 
-def test_reproduce_writes_the_report_and_refuses_to_overwrite(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    out = tmp_path / "out"
-    code, stdout, _ = run(["reproduce", "--out", str(out)], capsys)
-    assert code == 0
-    assert "not built yet" in stdout
-    html = (out / "report.html").read_text()
-    assert "data:image/png;base64," in html
-    assert "http://" not in html
-    assert "https://" not in html
-    results = json.loads((out / "results.json").read_text())
-    assert len(results["stiffness_coefficient"]["curves"]) == 4
-    before = (out / "results.json").stat().st_mtime_ns
-    code, _, err = run(["reproduce", "--out", str(out)], capsys)
-    assert code == 2
-    assert "will not overwrite" in err
-    assert "--force" in err
-    assert (out / "results.json").stat().st_mtime_ns == before
-    code, _, _ = run(["reproduce", "--out", str(out), "--force"], capsys)
-    assert code == 0
-
-
 DISSIPATION = ["dissipation", "--mass", "2kg", "--stiffness", "8e7N/m", "--clearance", "0.106mm"]
 
 

@@ -6,6 +6,7 @@ Figure. Axes are labelled in engineering units (um, mm, Hz).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -269,4 +270,184 @@ def identified_loop_figure(
     ax.legend(frameon=False, fontsize="small")
     if title:
         ax.set_title(title)
+    return fig
+
+
+_MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*")
+_LINES = ("-", "--", "-.", ":", (0, (5, 1, 1, 1)), (0, (3, 1, 1, 1, 1, 1)))
+
+
+@dataclass(frozen=True)
+class StiffnessPanel:
+    """Measured stiffness points and their eq 19 (or eq 20) lines, for one joint and side.
+
+    ``frequency`` in Hz, ``amplitude`` in m, ``stiffness`` (and ``error``) in N/m;
+    ``lines`` maps a frequency (Hz) to (amplitude grid, law values).
+    """
+
+    title: str
+    frequency: NDArray[np.float64]
+    amplitude: NDArray[np.float64]
+    stiffness: NDArray[np.float64]
+    lines: dict[float, tuple[NDArray[np.float64], NDArray[np.float64]]]
+    error: NDArray[np.float64] | None = None
+
+
+def stiffness_panels_figure(
+    panels: Sequence[StiffnessPanel], *, ylabel: str, title: str | None = None
+) -> Figure:
+    """Return Figs. 8 and 10: stiffness against amplitude, one marker and line per frequency."""
+    cols = min(len(panels), 2)
+    rows = math.ceil(len(panels) / cols)
+    fig = Figure(figsize=(5.2 * cols, 3.8 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    for ax, panel in zip(axes, panels, strict=False):
+        for n, f in enumerate(sorted(set(panel.frequency.tolist()))):
+            sel = panel.frequency == f
+            marker = _MARKERS[n % len(_MARKERS)]
+            if panel.error is not None:
+                ax.errorbar(
+                    panel.amplitude[sel] * 1e6,
+                    panel.stiffness[sel] / 1e6,
+                    yerr=panel.error[sel] / 1e6,
+                    fmt=marker,
+                    color="0.3",
+                    mfc="white",
+                    ms=5,
+                    capsize=2,
+                    label=f"{f:g} Hz",
+                )
+            else:
+                ax.plot(
+                    panel.amplitude[sel] * 1e6,
+                    panel.stiffness[sel] / 1e6,
+                    marker,
+                    color="0.3",
+                    mfc="white",
+                    ms=5,
+                    label=f"{f:g} Hz",
+                )
+            if f in panel.lines:
+                grid, values = panel.lines[f]
+                ax.plot(
+                    grid * 1e6,
+                    values / 1e6,
+                    linestyle=_LINES[n % len(_LINES)],
+                    color="black",
+                    lw=1.0,
+                )
+        ax.set_title(panel.title, fontsize="medium")
+        ax.set_xlabel("amplitude A (µm)")
+        ax.set_ylabel(ylabel)
+        ax.grid(True, color="0.9", lw=0.5)
+    for ax in axes[len(panels) :]:
+        ax.set_visible(False)
+    axes[0].legend(frameon=False, fontsize="small")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def coefficient_bars_figure(
+    labels: Sequence[str], frequency_part: Sequence[float], amplitude_part: Sequence[float]
+) -> Figure:
+    """Return Fig. 9: the normalised eq 19 coefficients, a bar pair per joint and side."""
+    fig = Figure(figsize=(6.5, 3.8), layout="constrained")
+    ax = fig.add_subplot()
+    x = np.arange(len(labels))
+    ax.bar(x - 0.2, frequency_part, 0.4, color="0.35", label="a1 mean(w) / mean(k)")
+    ax.bar(
+        x + 0.2,
+        amplitude_part,
+        0.4,
+        color="white",
+        edgecolor="black",
+        hatch="//",
+        label="a2 mean(A) / mean(k)",
+    )
+    ax.set_xticks(x, labels, rotation=20, ha="right")
+    ax.axhline(0.0, color="black", lw=0.6)
+    ax.set_ylabel("normalised coefficient")
+    ax.legend(frameon=False, fontsize="small")
+    return fig
+
+
+@dataclass(frozen=True)
+class EnergyLawPanel:
+    """Measured energy per cycle and eq 21 curves for one joint (``frequency`` in Hz)."""
+
+    title: str
+    frequency: NDArray[np.float64]
+    amplitude: NDArray[np.float64]
+    energy: NDArray[np.float64]
+    curves: dict[float, tuple[NDArray[np.float64], NDArray[np.float64]]]
+
+
+def energy_law_figure(panels: Sequence[EnergyLawPanel]) -> Figure:
+    """Return Fig. 11: energy per cycle against amplitude, with the eq 21 exponentials."""
+    fig = Figure(figsize=(5.2 * len(panels), 4.0), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(panels), squeeze=False)).ravel()
+    for ax, panel in zip(axes, panels, strict=True):
+        for n, f in enumerate(sorted(set(panel.frequency.tolist()))):
+            sel = panel.frequency == f
+            ax.plot(
+                panel.amplitude[sel] * 1e6,
+                panel.energy[sel],
+                _MARKERS[n % len(_MARKERS)],
+                color="0.3",
+                mfc="white",
+                ms=5,
+                label=f"{f:g} Hz",
+            )
+            if f in panel.curves:
+                grid, values = panel.curves[f]
+                ax.plot(
+                    grid * 1e6, values, linestyle=_LINES[n % len(_LINES)], color="black", lw=1.0
+                )
+        ax.set_yscale("log")
+        ax.set_xlabel("amplitude Abar = X - c/2 (µm)")
+        ax.set_ylabel("energy per cycle (J)")
+        ax.set_title(panel.title, fontsize="medium")
+        ax.grid(True, which="both", color="0.9", lw=0.5)
+    axes[0].legend(frameon=False, fontsize="small")
+    return fig
+
+
+def law_versus_measured_figure(
+    measured: NDArray[np.float64],
+    law: NDArray[np.float64],
+    model: NDArray[np.float64] | None = None,
+    groups: NDArray[np.str_] | None = None,
+) -> Figure:
+    """Return Fig. 13: eq 22 (and the section-2 model) against the measured energy."""
+    fig = Figure(figsize=(5.2, 4.6), layout="constrained")
+    ax = fig.add_subplot()
+    names = sorted(set(groups.tolist())) if groups is not None else [""]
+    for n, name in enumerate(names):
+        sel = groups == name if groups is not None else np.ones(measured.size, dtype=bool)
+        ax.plot(
+            measured[sel],
+            law[sel],
+            _MARKERS[n % len(_MARKERS)],
+            color="black",
+            mfc="white",
+            ms=5,
+            label=f"eq 22 {name}".strip(),
+        )
+        if model is not None:
+            ax.plot(
+                measured[sel],
+                model[sel],
+                _MARKERS[n % len(_MARKERS)],
+                color="0.55",
+                ms=4,
+                label=f"section 2 model {name}".strip(),
+            )
+    span = np.array([np.nanmin(measured), np.nanmax(measured)])
+    ax.plot(span, span, color="0.6", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("measured energy per cycle (J)")
+    ax.set_ylabel("predicted energy per cycle (J)")
+    ax.legend(frameon=False, fontsize="small")
     return fig

@@ -1,0 +1,45 @@
+"""Ship the reports' figures in docs/figures: ``python docs/make_report_figures.py [BRFD]``.
+
+Runs ``clearjoint reproduce`` (the default campaign) and ``clearjoint report`` on the
+BRFD records (default: ../shared/data/brfd beside the clone) into a temporary folder and
+saves every figure of both reports as docs/figures/reproduce_*.png and brfd_*.png.
+"""
+
+from __future__ import annotations
+
+import base64
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+from clearjoint.cli import main as cli
+
+HERE = Path(__file__).parent / "figures"
+
+
+def save_figures(report: Path, prefix: str) -> None:
+    page = report.read_text(encoding="utf-8")
+    pattern = r'<img alt="Fig\. (\d+)[^"]*" src="data:image/png;base64,([^"]+)"'
+    for number, data in re.findall(pattern, page):
+        path = HERE / f"{prefix}_fig{number}.png"
+        path.write_bytes(base64.b64decode(data))
+        print(f"wrote {path}")
+
+
+def main() -> None:
+    brfd = (
+        Path(sys.argv[1])
+        if len(sys.argv) > 1
+        else (Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd")
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        out = Path(folder)
+        cli(["reproduce", "--out", str(out / "reproduce")])
+        save_figures(out / "reproduce" / "report.html", "reproduce")
+        cli(["report", "--records", str(brfd), "--out", str(out / "brfd")])
+        save_figures(out / "brfd" / "report.html", "brfd")
+
+
+if __name__ == "__main__":
+    main()
