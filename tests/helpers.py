@@ -14,6 +14,27 @@ from scipy.integrate import simpson, solve_ivp
 
 from clearjoint import Joint
 
+#: The paper's first clearance, m.
+C1 = 0.106e-3
+
+
+def joint(**changes: float) -> Joint:
+    """A 2 kg joint with c = 0.106 mm and k_c = 80 MN/m, with ``changes`` applied."""
+    values = {"mass": 2.0, "clearance": C1, "compression_stiffness": 8e7}
+    values.update(changes)
+    return Joint(**values)
+
+
+#: Joints that exercise every branch of the period and the free cycle.
+CASES = {
+    "symmetric": joint(),
+    "asymmetric": joint(tension_stiffness=3e7),
+    "gap spring": joint(tension_stiffness=3e7, gap_stiffness=1e6),
+    "off-centre": joint(tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=0.03e-3),
+    "off-centre, tension edge far": joint(gap_stiffness=4e6, gap_offset=-0.045e-3),
+    "off-centre, k0 = 0": joint(tension_stiffness=5e7, gap_offset=0.02e-3),
+}
+
 
 def _region_force(joint: Joint, region: str) -> tuple[float, float]:
     """(stiffness, offset) with f(x) = stiffness * x - offset in that region."""

@@ -7,29 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from clearjoint import Friction, Joint, ParameterError, Pin
+from clearjoint import Friction, ParameterError, Pin
 from clearjoint import dissipation as ds
 from clearjoint.contact import hertz_coefficient
 from clearjoint.stiffness import free_orbit, natural_frequency
-from helpers import reference_cycle
+from helpers import C1, CASES, joint, reference_cycle
 
-C1 = 0.106e-3
 PIN = Pin.for_clearance(radius=5e-3, clearance=C1, length=10e-3)
-
-
-def joint(**changes: float) -> Joint:
-    values = {"mass": 2.0, "clearance": C1, "compression_stiffness": 8e7}
-    values.update(changes)
-    return Joint(**values)
-
-
-CASES = {
-    "symmetric": joint(),
-    "asymmetric": joint(tension_stiffness=3e7),
-    "gap spring": joint(tension_stiffness=3e7, gap_stiffness=1e6),
-    "off-centre": joint(tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=0.03e-3),
-    "tension edge never reached": joint(gap_stiffness=4e6, gap_offset=-0.045e-3),
-}
 
 
 @pytest.mark.parametrize("name", list(CASES))

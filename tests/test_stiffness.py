@@ -12,25 +12,7 @@ from hypothesis import strategies as st
 
 from clearjoint import Joint, ParameterError
 from clearjoint import stiffness as sk
-from helpers import reference_describing_stiffness, reference_period
-
-C1 = 0.106e-3
-
-
-def joint(**changes: float) -> Joint:
-    values = {"mass": 2.0, "clearance": C1, "compression_stiffness": 8e7}
-    values.update(changes)
-    return Joint(**values)
-
-
-CASES = {
-    "symmetric": joint(),
-    "asymmetric": joint(tension_stiffness=3e7),
-    "gap spring": joint(tension_stiffness=3e7, gap_stiffness=1e6),
-    "off-centre": joint(tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=0.03e-3),
-    "off-centre, tension edge far": joint(gap_stiffness=4e6, gap_offset=-0.045e-3),
-    "off-centre, k0 = 0": joint(tension_stiffness=5e7, gap_offset=0.02e-3),
-}
+from helpers import C1, CASES, joint, reference_describing_stiffness, reference_period
 
 
 @pytest.mark.parametrize("name", list(CASES))

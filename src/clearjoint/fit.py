@@ -204,16 +204,21 @@ def exponential_law(amplitude: ArrayLike, energy: ArrayLike, *, what: str = "eq 
     )
 
 
+def _energy_data(
+    what: str, *columns: ArrayLike
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """(w, c, A, E) as arrays; the energies must be > 0 to fit on ln E."""
+    w, c, a, e = (np.asarray(column, dtype=np.float64) for column in columns)
+    if np.any(e <= 0):
+        raise FitError(f"{what}: energies must be > 0 to fit on ln E")
+    return w, c, a, e
+
+
 def dissipation_law(
     omega: ArrayLike, clearance: ArrayLike, amplitude: ArrayLike, energy: ArrayLike
 ) -> LinearFit:
     """Return eq 22, ln E = (d0 + d1 w + d2 c) + (e0 + e1 w + e2 c) A, for all tests."""
-    w = np.asarray(omega, dtype=np.float64)
-    c = np.asarray(clearance, dtype=np.float64)
-    a = np.asarray(amplitude, dtype=np.float64)
-    e = np.asarray(energy, dtype=np.float64)
-    if np.any(e <= 0):
-        raise FitError("eq 22: energies must be > 0 to fit on ln E")
+    w, c, a, e = _energy_data("eq 22", omega, clearance, amplitude, energy)
     design = np.column_stack((np.ones_like(w), w, c, a, w * a, c * a))
     return linear_fit(
         design,
@@ -228,12 +233,9 @@ def power_law(
     omega: ArrayLike, clearance: ArrayLike, amplitude: ArrayLike, energy: ArrayLike
 ) -> LinearFit:
     """The alternative to eq 22: ln E = g0 + g1 ln w + g2 ln A + g3 c."""
-    w = np.asarray(omega, dtype=np.float64)
-    c = np.asarray(clearance, dtype=np.float64)
-    a = np.asarray(amplitude, dtype=np.float64)
-    e = np.asarray(energy, dtype=np.float64)
-    if np.any(e <= 0) or np.any(a <= 0):
-        raise FitError("power law: energies and amplitudes must be > 0")
+    w, c, a, e = _energy_data("power law", omega, clearance, amplitude, energy)
+    if np.any(a <= 0):
+        raise FitError("power law: amplitudes must be > 0 to fit on ln A")
     design = np.column_stack((np.ones_like(w), np.log(w), np.log(a), c))
     return linear_fit(
         design, np.log(e), ("g0", "g1", "g2", "g3"), ("ln J", "1", "1", "1/m"), what="power law"
