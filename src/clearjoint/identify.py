@@ -424,18 +424,11 @@ def _damper_fit(x: FloatArray, f: FloatArray, parts: tuple[slice, slice]) -> _Fi
         if level == 0.0 or reached.size == 0 or reached[0] < 12:
             return None
         xa, fa = xb[: reached[0] + 1], fb[: reached[0] + 1]
-        order = np.argsort(xa, kind="stable")
-        xs, fs = xa[order], fa[order]
-        pieces = _segments(xs, fs, 3, BINS)
-        lines = []
-        for a, b in pieces:
-            if b - a < 3:
-                return None
-            k, c = np.polyfit(xs[a:b], fs[a:b], 1)
-            lines.append((float(c), float(k)))
+        backlash = _backlash_pieces(xa, fa)
+        if backlash is None:
+            return None
+        xs, pieces, lines = backlash
         (a1, k1), (a0, k0), (a2, k2) = lines
-        if min(abs(k1), abs(k2)) <= abs(k0):
-            return None  # the middle piece is not the flattest: no backlash seen
         e1, e2 = (a0 - a1) / (k1 - k0), (a0 - a2) / (k2 - k0)
         uppers.append(max(e1, e2))
         lowers.append(min(e1, e2))
@@ -453,6 +446,32 @@ def _damper_fit(x: FloatArray, f: FloatArray, parts: tuple[slice, slice]) -> _Fi
         0.0,
         float(np.mean(levels)),
     )
+
+
+def _backlash_pieces(
+    xa: FloatArray, fa: FloatArray
+) -> tuple[FloatArray, list[tuple[int, int]], list[tuple[float, float]]] | None:
+    """Unloading, backlash and loading from the start of a branch, by a segmented fit.
+
+    Three pieces first; if the middle one is not the flattest (ringing at the plateau's
+    start can bend the loading piece), four, keeping the three nearest the reversal.
+    Returns (x sorted, the three pieces in x order, their (intercept, slope)).
+    """
+    order = np.argsort(xa, kind="stable")
+    xs, fs = xa[order], fa[order]
+    rising = bool(xa[-1] > xa[0])  # travel from the reversal goes up in x
+    for n in (3, 4):
+        pieces = _segments(xs, fs, n, BINS)
+        pieces = pieces[:3] if rising else pieces[-3:]
+        if any(b - a < 3 for a, b in pieces):
+            continue
+        lines = []
+        for a, b in pieces:
+            k, c = np.polyfit(xs[a:b], fs[a:b], 1)
+            lines.append((float(c), float(k)))
+        if min(abs(lines[0][1]), abs(lines[2][1])) > abs(lines[1][1]):
+            return xs, pieces, lines
+    return None
 
 
 def _line_fit(x: FloatArray, f: FloatArray, v: FloatArray) -> _Fit:

@@ -398,9 +398,7 @@ def _read_netcdf(path: Path, resample_: bool) -> Record:
             unit = _text(variable.attrs.get("units", ""))
             if not unit:
                 raise RecordError(f"{where}: variable {name!r} has no units attribute")
-            columns[name] = np.asarray(variable[...], dtype=np.float64) * _factor(
-                where, name, unit
-            )
+            columns[name] = np.asarray(variable[...], dtype=np.float64) * _factor(where, name, unit)
             units[name] = unit
         meta: dict[str, Any] = {}
         for attr, key in _NC_META.items():
