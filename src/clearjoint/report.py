@@ -437,9 +437,9 @@ def _html(analysis: Analysis, figures: dict[str, bytes], extra: dict[str, str], 
     comparison = ""
     if analysis.dissipation_law is not None and analysis.alternative_law is not None:
         better = (
-            "eq 22"
+            "Eq 22"
             if analysis.dissipation_law.aic <= analysis.alternative_law.aic
-            else "the power law"
+            else "The power law"
         )
         comparison = (
             f"<p>By AIC (lower is better), eq 22: {analysis.dissipation_law.aic:.1f} "
@@ -467,7 +467,7 @@ def _html(analysis: Analysis, figures: dict[str, bytes], extra: dict[str, str], 
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
 <style>body{{font-family:sans-serif;max-width:70em;margin:2em auto;line-height:1.4}}
-table{{border-collapse:collapse;font-size:0.85em;margin:1em 0}}
+table{{border-collapse:collapse;font-size:0.85em;margin:1em 0;display:block;overflow-x:auto}}
 td,th{{border:1px solid #999;padding:0.15em 0.4em}}img{{max-width:100%}}</style>
 </head><body>
 <h1>{html.escape(title)}</h1>
