@@ -81,7 +81,10 @@ def sliding_friction(
     """
     if not isinstance(friction, Friction):
         raise ParameterError(f"friction must be a clearjoint.Friction, got {friction!r}")
-    orbit = free_orbit(joint, amplitude)
+    return _sliding(joint, free_orbit(joint, amplitude), friction, form)
+
+
+def _sliding(joint: Joint, orbit: FreeOrbit, friction: Friction, form: str) -> FloatArray:
     if form == "exact":
         return friction.force * _friction_path(joint, orbit, friction.region)
     if form != "paper":
@@ -105,7 +108,10 @@ def contact_friction(
     16 mu_c beta_H k_s^1.5 A_s^2.5 / (15 pi R_p) per side.
     """
     mu = _checks.non_negative("contact_friction_coefficient", coefficient)
-    orbit = free_orbit(joint, amplitude)
+    return _contact(joint, free_orbit(joint, amplitude), pin, mu)
+
+
+def _contact(joint: Joint, orbit: FreeOrbit, pin: Pin, mu: float) -> FloatArray:
     factor = 16.0 * mu * hertz_coefficient(pin) / (15.0 * math.pi * pin.radius)
     k_c, k_t = joint.compression_stiffness, joint.tension_stiffness
     compression: FloatArray = orbit.compression_penetration**2.5
@@ -126,8 +132,10 @@ def impact(joint: Joint, amplitude: ArrayLike, restitution: float) -> FloatArray
     beta m (v_c^2 + v_t^2), beta = (1 - e^2) / 2, with v_s the speed at which the
     free orbit reaches each gap edge (v_s = A_s w_s when k0 = 0).
     """
-    e = _restitution(restitution)
-    orbit = free_orbit(joint, amplitude)
+    return _impact(joint, free_orbit(joint, amplitude), _restitution(restitution))
+
+
+def _impact(joint: Joint, orbit: FreeOrbit, e: float) -> FloatArray:
     beta = 0.5 * (1.0 - e * e)
     return beta * joint.mass * (orbit.compression_speed**2 + orbit.tension_speed**2)
 
@@ -135,7 +143,10 @@ def impact(joint: Joint, amplitude: ArrayLike, restitution: float) -> FloatArray
 def viscous(joint: Joint, amplitude: ArrayLike, damping_ratio: float) -> FloatArray:
     """Return the viscous loss c_v * integral of x'^2 dt per free cycle at penetration A, J."""
     c_v = viscous_coefficient(joint, damping_ratio)
-    orbit = free_orbit(joint, amplitude)
+    return _viscous(free_orbit(joint, amplitude), c_v)
+
+
+def _viscous(orbit: FreeOrbit, c_v: float) -> FloatArray:
     return c_v * (orbit.contact_action + orbit.free_play_action)
 
 
@@ -187,7 +198,10 @@ def excitation_work(
 
 def loss_factor(joint: Joint, amplitude: ArrayLike, energy: ArrayLike) -> FloatArray:
     """Return eta = E / (2 pi U_max), U_max = V(x_max) of the free cycle at penetration A."""
-    orbit = free_orbit(joint, amplitude)
+    return _loss_factor(joint, free_orbit(joint, amplitude), energy)
+
+
+def _loss_factor(joint: Joint, orbit: FreeOrbit, energy: ArrayLike) -> FloatArray:
     u_max = joint.potential_energy(orbit.x_max)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(u_max > 0.0, np.asarray(energy) / (2.0 * math.pi * u_max), np.nan)
@@ -209,19 +223,21 @@ def energies(
     is the paper's equivalent-viscous form beside it. ``hertz_half_width_m`` is the
     half-width at the largest contact force of the cycle (0 without a pin).
     """
-    a = _checks.non_negative_array("amplitude", amplitude, unit="m")
-    zero = np.zeros_like(a)
-    slide = sliding_friction(joint, a, friction) if friction else zero
-    slide_paper = sliding_friction(joint, a, friction, form="paper") if friction else zero
-    contact = (
-        contact_friction(joint, a, pin, contact_friction_coefficient) if pin is not None else zero
-    )
-    hits = impact(joint, a, restitution)
-    loss = viscous(joint, a, damping_ratio) if damping_ratio else zero
+    if friction is not None and not isinstance(friction, Friction):
+        raise ParameterError(f"friction must be a clearjoint.Friction, got {friction!r}")
+    mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
+    e = _restitution(restitution)
+    c_v = viscous_coefficient(joint, damping_ratio)
+    orbit = free_orbit(joint, amplitude)  # once, for every mechanism
+    zero = np.zeros_like(orbit.period)
+    slide = _sliding(joint, orbit, friction, "exact") if friction else zero
+    slide_paper = _sliding(joint, orbit, friction, "paper") if friction else zero
+    contact = _contact(joint, orbit, pin, mu_c) if pin is not None else zero
+    hits = _impact(joint, orbit, e)
+    loss = _viscous(orbit, c_v) if damping_ratio else zero
     everything = slide + contact + hits + loss
-    eta = loss_factor(joint, a, everything)
+    eta = _loss_factor(joint, orbit, everything)
     if pin is not None:
-        orbit = free_orbit(joint, a)
         peak = np.maximum(
             joint.compression_stiffness * orbit.compression_penetration,
             joint.tension_stiffness * orbit.tension_penetration,
