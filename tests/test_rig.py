@@ -159,3 +159,14 @@ def test_beam_stiffness_varies_mildly_with_frequency_and_amplitude() -> None:
     assert rig.beam_stiffness_at(100.0, 0.0) == pytest.approx(k * 1.03)
     assert 1.0 < rig.beam_stiffness_at(20.0, 3000.0) / k < 1.05
     assert math.isfinite(rig.beam_stiffness_at(0.0, 0.0))
+
+
+def test_jobs_must_be_positive_and_default_to_every_core(tmp_path: Path) -> None:
+    from clearjoint.errors import ParameterError
+
+    campaign = load_campaign(small(tmp_path))
+    with pytest.raises(ParameterError, match="jobs must be >= 1"):
+        run_campaign(campaign, tmp_path / "zero", jobs=0)
+    assert not (tmp_path / "zero").exists()
+    manifest = run_campaign(campaign, tmp_path / "default")  # every core
+    assert len(manifest_rows(manifest.parent)) == 4

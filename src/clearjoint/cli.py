@@ -348,13 +348,11 @@ def _run_rig(args: argparse.Namespace) -> int:
     from clearjoint.rig import load_campaign, run_campaign
 
     campaign = load_campaign(args.campaign)
-    if args.jobs is not None and args.jobs < 1:
-        raise ParameterError(f"--jobs must be >= 1, got {args.jobs}")
-    jobs = args.jobs or os.cpu_count() or 1
+    jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
     if args.quiet:
-        manifest = run_campaign(campaign, args.out, jobs=jobs, force=args.force)
+        manifest = run_campaign(campaign, args.out, jobs=args.jobs, force=args.force)
     else:
         from rich.progress import Progress
 
@@ -363,7 +361,7 @@ def _run_rig(args: argparse.Namespace) -> int:
             manifest = run_campaign(
                 campaign,
                 args.out,
-                jobs=jobs,
+                jobs=args.jobs,
                 force=args.force,
                 progress=lambda done, _total: bar.update(task, completed=done),
             )
@@ -497,17 +495,15 @@ def _run_simulate(args: argparse.Namespace) -> int:
 
 
 def _run_reproduce(args: argparse.Namespace) -> int:
-    import os
     import time
 
     from clearjoint.report import reproduce
 
     start = time.perf_counter()
-    jobs = args.jobs or os.cpu_count() or 1
     written = reproduce(
         Path(args.out),
         force=args.force,
-        jobs=jobs,
+        jobs=args.jobs,
         campaign_path=Path(args.campaign) if args.campaign else None,
         progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
     )

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 import tomllib
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -523,13 +524,15 @@ def run_campaign(
     OutputExistsError
         A record or the manifest exists in ``out_dir`` and ``force`` is False.
     """
+    if jobs is not None and jobs < 1:
+        raise ParameterError(f"jobs must be >= 1 (--jobs), got {jobs}")
     out_dir = Path(out_dir)
     tasks = list(_tasks(campaign, out_dir, force))
     refuse_to_overwrite([out_dir / "manifest.csv", *(Path(t[4]) for t in tasks)], force=force)
     out_dir.mkdir(parents=True, exist_ok=True)
     rows: dict[int, dict[str, Any]] = {}
     total = len(tasks)
-    workers = max(1, jobs or 1)
+    workers = jobs or os.cpu_count() or 1
     if workers == 1:
         for task in tasks:
             rows[task[1].index] = _run_one(task)
