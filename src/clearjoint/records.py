@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError
-from clearjoint.units import registry
+from clearjoint.units import SI_UNITS, registry
 
 FloatArray = NDArray[np.float64]
 
@@ -351,7 +351,7 @@ def _write_csv(record: Record, path: Path) -> None:
         if kind == "text":
             lines.append(f"# {key} = {json.dumps(str(value))}")
         else:
-            unit = {"length": "m", "force": "N", "frequency": "Hz", "mass": "kg"}[kind]
+            unit = SI_UNITS[kind]
             lines.append(f'# {key} = "{value!r} {unit}"')
     names = ["time", *[c for c in CHANNELS if getattr(record, c) is not None]]
     lines.append(",".join(f"{name} [{SI[name]}]" for name in names))
