@@ -130,5 +130,8 @@ def test_the_store_keeps_finished_chunks_and_refuses_what_it_should(tmp_path: Pa
     (tmp_path / "plain").mkdir()
     with pytest.raises(StoreError, match="not a clearjoint sweep store"):
         ResultStore.open(tmp_path / "plain")
+    with pytest.raises(StoreError, match="not a clearjoint sweep store"):
+        _store(tmp_path / "plain", force=True)  # force never deletes what is not a store
+    assert (tmp_path / "plain").is_dir()
     fresh = _store(path, force=True)
     assert fresh.done_chunks() == set()

@@ -281,6 +281,8 @@ class ResultStore:
         ------
         OutputExistsError
             ``path`` exists and ``force`` is False.
+        StoreError
+            ``path`` exists and is not a sweep store (it is never deleted, even with force).
         """
         import zarr
 
@@ -291,10 +293,8 @@ class ResultStore:
                     f"will not overwrite {path}; pass --resume to finish it, --force to "
                     f"start again, or choose another --out"
                 )
-            if path.is_dir():
-                shutil.rmtree(path)
-            else:
-                path.unlink()
+            cls.open(path)  # a StoreError unless it is a sweep store: never delete anything else
+            shutil.rmtree(path)
         group: Any = zarr.open_group(str(path), mode="w-", zarr_format=3)
         n_chunks = len(chunk_bounds(n_points, chunk_size))
         for var in variables:
@@ -338,8 +338,11 @@ class ResultStore:
             group: Any = zarr.open_group(str(path), mode="r+")
             stored = group.attrs[_FINGERPRINT]
             chunk_size = int(group.attrs["chunk_size"])
-        except (KeyError, FileNotFoundError, ValueError, TypeError) as exc:
-            raise StoreError(f"{path}: not a clearjoint sweep store ({exc})") from None
+        except (KeyError, FileNotFoundError, NotADirectoryError, ValueError, TypeError) as exc:
+            raise StoreError(
+                f"{path}: not a clearjoint sweep store ({type(exc).__name__}: {exc}); "
+                f"choose another --out"
+            ) from None
         if fingerprint is not None and stored != fingerprint:
             raise StoreError(
                 f"{path} was made from a different sweep file (hash {stored[:12]} here, "
