@@ -174,6 +174,27 @@ def _identify_parser(sub: Any) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _sweep_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "sweep",
+        help="parameter study or tolerance Monte Carlo from a sweep file, on Dask",
+        description=(
+            "Run the task of SWEEP.toml at every point of its grid axes and Monte Carlo "
+            "draws (see docs/sweep.md), on a local Dask cluster or on a running scheduler, "
+            "writing --out (a zarr store) chunk by chunk. With --plot STORE VAR: draw one "
+            "output (a map, a line or a histogram) to --out (PNG)."
+        ),
+    )
+    p.add_argument("sweep", nargs="?", help="sweep file (TOML)")
+    p.add_argument("--out", help="zarr store to write (.zarr); with --plot, the PNG")
+    p.add_argument("--scheduler", help="a running Dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--workers", type=int, help="local cluster's worker processes (default: cores)")
+    p.add_argument("--resume", action="store_true", help="finish an interrupted --out store")
+    p.add_argument("--force", action="store_true", help="replace an existing --out")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--plot", nargs=2, metavar=("STORE", "VAR"), help="draw VAR of a store")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``clearjoint`` command."""
     parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
@@ -186,6 +207,7 @@ def build_parser() -> argparse.ArgumentParser:
     _identify_parser(sub)
     _reproduce_parser(sub)
     _report_parser(sub)
+    _sweep_parser(sub)
     return parser
 
 
@@ -527,6 +549,80 @@ def _run_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_sweep(args: argparse.Namespace) -> int:
+    import contextlib
+    import time
+
+    if args.plot:
+        return _plot_sweep(args)
+    from clearjoint.parallel import dask_client
+    from clearjoint.sweep import Sweep, run_sweep
+
+    if args.sweep is None or args.out is None:
+        raise ParameterError("give a sweep file and --out results.zarr (or --plot STORE VAR)")
+    if Path(args.out).suffix != ".zarr":
+        raise ParameterError(f"--out must end in .zarr, got {args.out!r}")
+    if args.scheduler and args.workers is not None:
+        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    sweep = Sweep.from_toml(args.sweep)
+    start = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        client = stack.enter_context(dask_client(args.scheduler, workers=args.workers))
+        progress = None
+        if not args.quiet and sys.stderr.isatty():
+            from rich.progress import Progress, TimeRemainingColumn
+
+            bar = stack.enter_context(
+                Progress(
+                    *Progress.get_default_columns()[:-1], TimeRemainingColumn(), transient=True
+                )
+            )
+            task = bar.add_task(f"{sweep.n_points} points", total=sweep.n_points)
+            progress = lambda done, _total: bar.update(task, completed=done)  # noqa: E731
+        try:
+            results = run_sweep(
+                sweep,
+                client=client,
+                out=args.out,
+                resume=args.resume,
+                force=args.force,
+                progress=progress,
+            )
+        except KeyboardInterrupt:
+            print(
+                f"clearjoint sweep: interrupted; finished chunks are in {args.out}: "
+                f"run again with --resume to compute only the rest",
+                file=sys.stderr,
+            )
+            return 130
+    failed = results.attrs["points_failed"]
+    print(
+        f"wrote {results.attrs['points']} points ({failed} failed: see `status`) "
+        f"to {args.out} in {time.perf_counter() - start:.1f} s"
+    )
+    return 0
+
+
+def _plot_sweep(args: argparse.Namespace) -> int:
+    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.sweep import open_sweep
+    from clearjoint.sweep.plot import plot_sweep
+
+    store, variable = args.plot
+    if args.sweep is not None:
+        raise ParameterError("--plot STORE VAR takes no sweep file")
+    out = (
+        Path(args.out) if args.out else Path(store).with_name(f"{Path(store).stem}_{variable}.png")
+    )
+    if out.suffix.lower() != ".png":
+        raise ParameterError(f"with --plot, --out is the picture and must end in .png, got {out}")
+    refuse_to_overwrite([out], force=args.force)
+    ax = plot_sweep(open_sweep(store), variable)
+    ax.figure.savefig(out, dpi=110)
+    print(f"wrote {out}")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
@@ -539,6 +635,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "identify": _run_identify,
         "reproduce": _run_reproduce,
         "report": _run_report,
+        "sweep": _run_sweep,
     }
     try:
         return runners[args.command](args)

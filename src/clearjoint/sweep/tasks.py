@@ -1,0 +1,296 @@
+"""What a sweep computes at each point: the task registry and the joint tasks.
+
+A :class:`Task` names its base (a ``study`` file of ``clearjoint simulate`` or a rig
+``campaign``), the parameters a sweep may vary or fix, its outputs with their units,
+and ``evaluate(base, values, seed)``: a pure, module-level function of frozen values
+that returns one float per output (it runs on Dask workers). The physics is the
+library's; this module only maps a point's values onto it:
+
+* ``steady_state``: the exact steady cycle of the forced joint (clearjoint.simulate,
+  MODEL.md sec. 2): amplitude, extremes, penetrations and the energy ledger per period;
+* ``energies``: every energy per free cycle at penetration ``task.amplitude``
+  (clearjoint.dissipation.energies, MODEL.md eq 10-18);
+* ``rig_test``: one test of the virtual rig (clearjoint.rig), measured with the
+  point's own noise seed, then identified (clearjoint.identify): truth beside estimate.
+
+Structure, periodic-orbit and frequency-response tasks register themselves the same
+way with :func:`register_task` when their features land.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from clearjoint.errors import ParameterError
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A value a sweep may vary: its kind of quantity, SI unit (as shown) and valid range."""
+
+    kind: str
+    unit: str
+    lower: float = 0.0
+    upper: float = math.inf
+    open_lower: bool = False  # True: the value must be > lower (a mass), not >= lower
+
+
+@dataclass(frozen=True)
+class Task:
+    """One kind of computation a sweep can run at each point (see the module docstring).
+
+    ``options`` are task parameters with a default (None: must be given in [task] or
+    as an axis); ``evaluate(base, values, seed)`` gets every parameter the sweep names
+    plus every option, in SI (frequencies in Hz), and returns one float per output.
+    """
+
+    name: str
+    base: str
+    parameters: Mapping[str, Parameter]
+    options: Mapping[str, tuple[float | None, Parameter]]
+    outputs: Mapping[str, str]
+    evaluate: Callable[[Any, Mapping[str, float], np.random.SeedSequence], Mapping[str, float]]
+    description: str
+
+
+#: Every task a sweep file may name, by name.
+TASKS: dict[str, Task] = {}
+
+
+def register_task(task: Task) -> None:
+    """Add ``task`` to :data:`TASKS` (a name is registered once)."""
+    if task.name in TASKS and TASKS[task.name] is not task:
+        raise ParameterError(f"a sweep task named {task.name!r} is already registered")
+    TASKS[task.name] = task
+
+
+# ---- the joint of a study file ---------------------------------------------------------------
+
+_POSITIVE = {"open_lower": True}
+JOINT_PARAMETERS: dict[str, Parameter] = {
+    "joint.mass": Parameter("mass", "kg", **_POSITIVE),
+    "joint.clearance": Parameter("length", "m"),
+    "joint.compression_stiffness": Parameter("stiffness", "N/m", **_POSITIVE),
+    "joint.tension_stiffness": Parameter("stiffness", "N/m", **_POSITIVE),
+    "joint.gap_stiffness": Parameter("stiffness", "N/m"),
+    "joint.gap_offset": Parameter("length", "m", lower=-math.inf),
+    "losses.damping_ratio": Parameter("dimensionless", ""),
+    "losses.restitution": Parameter("dimensionless", "", upper=1.0),
+    "losses.friction_coefficient": Parameter("dimensionless", ""),
+    "losses.lateral_load": Parameter("force", "N"),
+    "losses.contact_friction_coefficient": Parameter("dimensionless", ""),
+}
+FORCING_PARAMETERS: dict[str, Parameter] = {
+    "excitation.force_amplitude": Parameter("force", "N", **_POSITIVE),
+    "excitation.frequency": Parameter("frequency", "Hz", **_POSITIVE),
+}
+
+
+def study_at(study: Any, values: Mapping[str, float]) -> Any:
+    """Return the study with the point's ``values`` applied (keys as in the study file).
+
+    A symmetric joint (k_t = k_c) stays symmetric when only k_c is varied, and a
+    pin's hole follows a varied clearance (R_h = R_p + c/2), as in a study file
+    that leaves them to their defaults.
+    """
+    from clearjoint.joint import Friction, Pin
+
+    joint = study.joint
+    changes = {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith("joint.")}
+    if (
+        "compression_stiffness" in changes
+        and "tension_stiffness" not in changes
+        and joint.tension_stiffness == joint.compression_stiffness
+    ):
+        changes["tension_stiffness"] = changes["compression_stiffness"]
+    joint = replace(joint, **changes)
+    pin = study.pin
+    if pin is not None and "clearance" in changes:
+        pin = replace(pin, hole_radius=pin.radius + 0.5 * joint.clearance)
+    friction = study.friction
+    mu_s = values.get("losses.friction_coefficient", friction.coefficient if friction else 0.0)
+    load = values.get("losses.lateral_load", friction.lateral_load if friction else 0.0)
+    region = friction.region if friction else "everywhere"
+    friction = Friction(mu_s, load, region) if mu_s > 0.0 and load > 0.0 else None
+    omega = study.omega
+    if "excitation.frequency" in values:
+        omega = 2.0 * math.pi * values["excitation.frequency"]
+    return replace(
+        study,
+        joint=joint,
+        pin=pin if isinstance(pin, Pin) else None,
+        friction=friction,
+        omega=omega,
+        force_amplitude=values.get("excitation.force_amplitude", study.force_amplitude),
+        damping_ratio=values.get("losses.damping_ratio", study.damping_ratio),
+        restitution=values.get("losses.restitution", study.restitution),
+        contact_friction_coefficient=values.get(
+            "losses.contact_friction_coefficient", study.contact_friction_coefficient
+        ),
+    )
+
+
+def _steady_state(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.simulate import steady_state
+
+    study = study_at(base, values)
+    cycle = steady_state(
+        study.joint,
+        study.force_amplitude,
+        study.omega,
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+        pin=study.pin,
+        contact_friction_coefficient=study.contact_friction_coefficient,
+        samples_per_period=int(values.get("task.samples_per_period", 64)),
+        max_periods=int(values.get("task.max_periods", 20_000)),
+    )
+    per = 1.0 / cycle.period_multiple  # per forcing period
+    ledger = cycle.energy
+    return {
+        "amplitude_m": cycle.amplitude,
+        "x_max_m": cycle.x_max,
+        "x_min_m": cycle.x_min,
+        "compression_penetration_m": cycle.compression_penetration,
+        "tension_penetration_m": cycle.tension_penetration,
+        "period_multiple": float(cycle.period_multiple),
+        "periods_to_converge": float(cycle.periods_to_converge),
+        "energy_input_j": ledger.input * per,
+        "viscous_j": ledger.viscous * per,
+        "sliding_friction_j": ledger.sliding_friction * per,
+        "impact_j": ledger.impact * per,
+        "contact_friction_j": ledger.contact_friction * per,
+        "balance_error": ledger.balance_error,
+    }
+
+
+register_task(
+    Task(
+        name="steady_state",
+        base="study",
+        parameters={**JOINT_PARAMETERS, **FORCING_PARAMETERS},
+        options={
+            "task.samples_per_period": (64.0, Parameter("dimensionless", "", lower=8.0)),
+            "task.max_periods": (20_000.0, Parameter("dimensionless", "", lower=10.0)),
+        },
+        outputs={
+            "amplitude_m": "m",
+            "x_max_m": "m",
+            "x_min_m": "m",
+            "compression_penetration_m": "m",
+            "tension_penetration_m": "m",
+            "period_multiple": "",
+            "periods_to_converge": "",
+            "energy_input_j": "J",
+            "viscous_j": "J",
+            "sliding_friction_j": "J",
+            "impact_j": "J",
+            "contact_friction_j": "J",
+            "balance_error": "",
+        },
+        evaluate=_steady_state,
+        description="exact steady cycle of the forced joint (energies per forcing period)",
+    )
+)
+
+
+def _energies(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.dissipation import energies
+
+    study = study_at(base, values)
+    result = energies(
+        study.joint,
+        values["task.amplitude"],
+        friction=study.friction,
+        pin=study.pin,
+        contact_friction_coefficient=study.contact_friction_coefficient,
+        restitution=study.restitution,
+        damping_ratio=study.damping_ratio,
+    )
+    return {key: float(value) for key, value in result.items()}
+
+
+register_task(
+    Task(
+        name="energies",
+        base="study",
+        parameters=JOINT_PARAMETERS,
+        options={"task.amplitude": (None, Parameter("length", "m"))},
+        outputs={
+            "sliding_friction_j": "J",
+            "sliding_friction_paper_j": "J",
+            "contact_friction_j": "J",
+            "impact_j": "J",
+            "viscous_j": "J",
+            "total_j": "J",
+            "loss_factor": "",
+            "equivalent_damping_ratio": "",
+            "hertz_half_width_m": "m",
+        },
+        evaluate=_energies,
+        description="energies per free cycle at penetration task.amplitude (MODEL.md eq 10-18)",
+    )
+)
+
+
+# ---- a test of the virtual rig ---------------------------------------------------------------
+
+
+def _rig_test(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.identify import identify
+    from clearjoint.rig import Structure, TestSpec, simulate_test
+
+    clearance = values.get("test.clearance", base.structures[0].clearance)
+    spec = TestSpec(
+        index=0,
+        structure=Structure("joint", True, clearance),
+        frequency_hz=values.get("test.frequency", base.frequencies[0]),
+        force_amplitude=values.get("test.force_amplitude", base.force_amplitudes[0]),
+    )
+    record, truth = simulate_test(base.rig, spec, base.periods, seed)
+    found = identify(record)
+    return {
+        "clearance_m": truth["clearance_m"],
+        "energy_per_cycle_j": truth["energy_per_cycle_j"],
+        "amplitude_m": truth["amplitude_m"],
+        "identified_clearance_m": float(found.summary["clearance_m"]),
+        "identified_energy_per_cycle_j": float(found.summary["energy_per_cycle_j"]),
+    }
+
+
+register_task(
+    Task(
+        name="rig_test",
+        base="campaign",
+        parameters={
+            "test.clearance": Parameter("length", "m", **_POSITIVE),
+            "test.frequency": Parameter("frequency", "Hz", **_POSITIVE),
+            "test.force_amplitude": Parameter("force", "N", **_POSITIVE),
+        },
+        options={},
+        outputs={
+            "clearance_m": "m",
+            "energy_per_cycle_j": "J",
+            "amplitude_m": "m",
+            "identified_clearance_m": "m",
+            "identified_energy_per_cycle_j": "J",
+        },
+        evaluate=_rig_test,
+        description=(
+            "one virtual-rig test (the campaign's first jointed structure, frequency and "
+            "force unless varied), measured with the point's own noise, then identified"
+        ),
+    )
+)
