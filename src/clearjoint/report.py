@@ -579,13 +579,15 @@ def reproduce(
     progress: Progress | None = None,
     campaign_path: Path | None = None,
     jobs: int | None = None,
+    executor: Any = None,
 ) -> list[Path]:
     """Run the paper's whole study on the virtual rig and write the report into ``out_dir``.
 
     The default campaign (or ``campaign_path``) is simulated into ``out_dir/records``;
     every record is identified; eq 19-22 are fitted; the figures and the report follow,
     with the identification checked against the rig's truth and the dissipation model
-    of section 2 set against the exact cycles.
+    of section 2 set against the exact cycles. The rig's tests run over ``jobs``
+    processes, or on ``executor`` (an Executor or a Dask client: clearjoint.parallel).
     """
     from clearjoint.rig import load_campaign, run_campaign, structure_under_test
 
@@ -594,7 +596,9 @@ def reproduce(
     refuse_to_overwrite([out_dir / n for n in ("report.html", "results.json")], force=force)
     campaign = load_campaign(campaign_path)
     say(f"virtual rig: {len(campaign.tests)} tests")
-    manifest = run_campaign(campaign, out_dir / "records", jobs=jobs, force=force)
+    manifest = run_campaign(
+        campaign, out_dir / "records", jobs=jobs, force=force, executor=executor
+    )
     with manifest.open() as handle:
         truth = {row["file"]: row for row in csv.DictReader(handle)}
     say("identifying the records")
