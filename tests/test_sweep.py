@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from distributed import LocalCluster
 from scipy import stats
 
 from clearjoint.cli import main
@@ -175,7 +176,19 @@ def test_monte_carlo_has_a_sample_dimension_with_the_draws_as_coordinates(tmp_pa
     assert "6 points (sample: 6)" in repr(sweep)
 
 
+CAMPAIGN = """
+seed = 1
+periods = 12
+[grid]
+frequencies = ["40Hz"]
+force_amplitudes = ["1500N"]
+[[structures]]
+name = "joint-1"
+clearance = "0.106mm"
+"""
+
 RIG_SWEEP = """
+base = "campaign.toml"
 seed = 5
 samples = 3
 chunk_size = {chunk}
@@ -190,6 +203,7 @@ force_amplitude = ["1.5kN"]
 def test_rig_tests_are_bit_for_bit_the_same_serial_and_on_a_local_cluster(
     tmp_path: Path,
 ) -> None:
+    (tmp_path / "campaign.toml").write_text(CAMPAIGN, encoding="utf-8")
     serial = run_sweep(Sweep.from_toml(_files(tmp_path, RIG_SWEEP.format(chunk=3))), client=SERIAL)
     # two worker processes of a LocalCluster, chunks of one point finishing in any order
     on_dask = run_sweep(Sweep.from_toml(_files(tmp_path, RIG_SWEEP.format(chunk=1))), workers=2)
@@ -295,7 +309,11 @@ def test_the_command_line_runs_refuses_and_plots(
 ) -> None:
     path = _files(tmp_path, STORE_SWEEP)
     out = tmp_path / "r.zarr"
-    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    # a "running cluster" in this process, reached by its address as --scheduler would
+    with LocalCluster(n_workers=1, processes=False, protocol="tcp", dashboard_address=":0") as c:
+        assert (
+            main(["sweep", str(path), "--out", str(out), "--scheduler", c.scheduler_address]) == 0
+        )
     assert "wrote 5 points (0 failed" in capsys.readouterr().out
     assert main(["sweep", str(path), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
@@ -327,8 +345,36 @@ compression_stiffness = ["5e7N/m", "8e7N/m", "1e8N/m"]
     )
     results = run_sweep(Sweep.from_toml(path), client=SERIAL)
     ax = plot_sweep(results, "total_j")
-    assert ax.get_xlabel() == "joint.clearance (m)"
-    assert ax.get_ylabel() == "joint.compression_stiffness (N/m)"
+    assert ax.get_xlabel() == "joint.clearance (um)"
+    assert ax.get_ylabel() == "joint.compression_stiffness (MN/m)"
     text = MONTE_CARLO.format(samples=20, chunk=20, lower='lower = "0mm"')
     ax = plot_sweep(run_sweep(Sweep.from_toml(_files(tmp_path, text)), client=SERIAL), "impact_j")
     assert ax.get_ylabel() == "samples"
+
+
+def test_stepped_sine_peak_is_the_linear_resonance_on_its_grid(tmp_path: Path) -> None:
+    path = _files(
+        tmp_path,
+        """
+base = "study.toml"
+[task]
+name = "stepped_sine"
+outputs = ["peak_amplitude_m", "peak_frequency_hz", "jump_m", "steps_failed"]
+frequency_start = "900Hz"
+frequency_stop = "1100Hz"
+frequency_steps = 9
+[axes.excitation]
+force_amplitude = ["100N", "300N"]
+""",
+        LINEAR_STUDY,
+    )
+    results = run_sweep(Sweep.from_toml(path), client=SERIAL)
+    m, k, zeta = 2.0, 8e7, 0.05
+    hz = np.linspace(900.0, 1100.0, 9)
+    w = 2 * np.pi * hz
+    curve = 1.0 / np.hypot(k - m * w**2, 2 * zeta * math.sqrt(m * k) * w)
+    f0 = results["excitation.force_amplitude"].values
+    np.testing.assert_allclose(results.peak_amplitude_m, f0 * curve.max(), rtol=1e-6)
+    np.testing.assert_array_equal(results.peak_frequency_hz, hz[np.argmax(curve)])
+    assert results.jump_m.max() < 1e-9 * results.peak_amplitude_m.max()  # linear: no jump
+    assert (results.steps_failed == 0).all()

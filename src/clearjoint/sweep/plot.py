@@ -7,16 +7,45 @@ Failed points (NaN) are left blank and counted in the title.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
 from clearjoint.errors import ParameterError
 
+#: Display units for SI lengths and energies: (largest magnitude below which, unit, scale).
+_SCALES = {
+    "m": [(1e-3, "um", 1e6), (1.0, "mm", 1e3)],
+    "J": [(1e-3, "mJ", 1e3)],
+    "N/m": [(math.inf, "MN/m", 1e-6)],
+}
 
-def _label(data: Any, name: str) -> str:
+
+def _factor(data: Any, name: str) -> tuple[float, str]:
+    """The factor to an engineering unit for ``name``'s values, and its axis label."""
+    values = np.asarray(data[name].values, dtype=np.float64)
     unit = data[name].attrs.get("units", "")
-    return f"{name} ({unit})" if unit else name
+    finite = np.abs(values[np.isfinite(values)])
+    top = float(finite.max()) if finite.size else 0.0
+    for below, shown, factor in _SCALES.get(unit, []):
+        if top < below and top * factor >= 1.0:
+            return factor, f"{name} ({shown})"
+    return 1.0, f"{name} ({unit})" if unit else name
+
+
+def _scaled(data: Any, name: str) -> tuple[Any, str]:
+    """The values of ``name`` in an engineering unit, and its axis label."""
+    factor, label = _factor(data, name)
+    return np.asarray(data[name].values, dtype=np.float64) * factor, label
+
+
+def _geometric(values: Any) -> bool:
+    v = np.asarray(values, dtype=np.float64)
+    if v.size < 3 or np.any(v <= 0):
+        return False
+    ratio = v[1:] / v[:-1]
+    return bool(np.allclose(ratio, ratio[0], rtol=1e-6) and not np.isclose(ratio[0], 1.0))
 
 
 def plot_sweep(results: Any, variable: str, ax: Any = None) -> Any:
@@ -53,26 +82,36 @@ def plot_sweep(results: Any, variable: str, ax: Any = None) -> Any:
             if not grid
             else [(v, data.sel({grid[0]: v})) for v in data[grid[0]].values]
         )
+        factor, label = _factor(results, variable)
         for value, part in groups:
-            finite = part.values[np.isfinite(part.values)]
-            label = None if value is None else f"{grid[0]} = {value:.4g}"
-            ax.hist(finite, bins="auto", alpha=0.6 if grid else 1.0, label=label)
-        ax.set_xlabel(_label(results, variable))
+            finite = part.values[np.isfinite(part.values)] * factor
+            name = None if value is None else f"{grid[0]} = {value:.4g}"
+            ax.hist(finite, bins="auto", alpha=0.6 if grid else 1.0, label=name)
+        ax.set_xlabel(label)
         ax.set_ylabel("samples")
         if grid:
             ax.legend()
     elif len(grid) == 1:
-        ax.plot(data[grid[0]].values, data.values, "o-")
-        ax.set_xlabel(_label(results, grid[0]))
-        ax.set_ylabel(_label(results, variable))
+        x, x_label = _scaled(results, grid[0])
+        y, y_label = _scaled(results, variable)
+        ax.plot(x, y, "o-")
+        ax.set_xlabel(x_label)
+        ax.set_ylabel(y_label)
+        if _geometric(x):
+            ax.set_xscale("log")
     elif len(grid) == 2:
         across, up = grid
-        mesh = ax.pcolormesh(
-            data[across].values, data[up].values, data.transpose(up, across).values, shading="auto"
-        )
-        ax.figure.colorbar(mesh, ax=ax, label=_label(results, variable))
-        ax.set_xlabel(_label(results, across))
-        ax.set_ylabel(_label(results, up))
+        x, x_label = _scaled(results, across)
+        y, y_label = _scaled(results, up)
+        z, z_label = _scaled(results.transpose(up, across, ...), variable)
+        mesh = ax.pcolormesh(x, y, z, shading="nearest")
+        ax.figure.colorbar(mesh, ax=ax, label=z_label)
+        ax.set_xlabel(x_label)
+        ax.set_ylabel(y_label)
+        if _geometric(x):
+            ax.set_xscale("log")
+        if _geometric(y):
+            ax.set_yscale("log")
     else:
         raise ParameterError(
             f"{variable} has {len(grid)} grid axes; select down to two with xarray first"

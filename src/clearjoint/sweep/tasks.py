@@ -10,10 +10,12 @@ library's; this module only maps a point's values onto it:
   MODEL.md sec. 2): amplitude, extremes, penetrations and the energy ledger per period;
 * ``energies``: every energy per free cycle at penetration ``task.amplitude``
   (clearjoint.dissipation.energies, MODEL.md eq 10-18);
+* ``stepped_sine``: the frequency-response curve by a stepped sine up and down
+  (clearjoint.simulate.frequency_sweep), reduced to its peak and its up/down jump;
 * ``rig_test``: one test of the virtual rig (clearjoint.rig), measured with the
   point's own noise seed, then identified (clearjoint.identify): truth beside estimate.
 
-Structure, periodic-orbit and frequency-response tasks register themselves the same
+Structure, periodic-orbit and continuation frequency-response tasks register themselves the same
 way with :func:`register_task` when their features land.
 """
 
@@ -239,6 +241,80 @@ register_task(
         },
         evaluate=_energies,
         description="energies per free cycle at penetration task.amplitude (MODEL.md eq 10-18)",
+    )
+)
+
+
+def _stepped_sine(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    import warnings
+
+    from clearjoint.simulate import frequency_sweep
+
+    study = study_at(base, values)
+    low, high = values["task.frequency_start"], values["task.frequency_stop"]
+    steps = int(values["task.frequency_steps"])
+    if not high > low:
+        raise ParameterError(f"task.frequency_stop must exceed frequency_start, got {low}, {high}")
+    hz = np.linspace(low, high, steps)
+    curve = frequency_sweep(
+        study.joint,
+        study.force_amplitude,
+        2.0 * math.pi * hz,
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+        max_periods=int(values["task.max_periods"]),
+    )
+    both = np.vstack([curve.amplitude_up, curve.amplitude_down])
+    failed = int(np.count_nonzero(np.isnan(both)))
+    if failed == both.size:
+        raise ParameterError("no step of the stepped sine found a steady state")
+    if failed:
+        warnings.warn(
+            f"{failed} of {both.size} steps found no steady state (NaN there)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    peak = int(np.nanargmax(np.nanmax(both, axis=0)))
+    return {
+        "peak_amplitude_m": float(np.nanmax(both)),
+        "peak_frequency_hz": float(hz[peak]),
+        "peak_amplitude_up_m": float(np.nanmax(curve.amplitude_up)),
+        "peak_amplitude_down_m": float(np.nanmax(curve.amplitude_down)),
+        "jump_m": float(np.nanmax(np.abs(curve.amplitude_up - curve.amplitude_down))),
+        "steps_failed": float(failed),
+    }
+
+
+register_task(
+    Task(
+        name="stepped_sine",
+        base="study",
+        parameters={
+            **JOINT_PARAMETERS,
+            "excitation.force_amplitude": FORCING_PARAMETERS["excitation.force_amplitude"],
+        },
+        options={
+            "task.frequency_start": (None, Parameter("frequency", "Hz", open_lower=True)),
+            "task.frequency_stop": (None, Parameter("frequency", "Hz", open_lower=True)),
+            "task.frequency_steps": (40.0, Parameter("dimensionless", "", lower=2.0)),
+            "task.max_periods": (20_000.0, Parameter("dimensionless", "", lower=10.0)),
+        },
+        outputs={
+            "peak_amplitude_m": "m",
+            "peak_frequency_hz": "Hz",
+            "peak_amplitude_up_m": "m",
+            "peak_amplitude_down_m": "m",
+            "jump_m": "m",
+            "steps_failed": "",
+        },
+        evaluate=_stepped_sine,
+        description=(
+            "frequency-response curve by a stepped sine up and down (simulate.frequency_sweep; "
+            "no pin contact friction): its peak, where, and the up/down jump"
+        ),
     )
 )
 
