@@ -378,3 +378,29 @@ force_amplitude = ["100N", "300N"]
     np.testing.assert_array_equal(results.peak_frequency_hz, hz[np.argmax(curve)])
     assert results.jump_m.max() < 1e-9 * results.peak_amplitude_m.max()  # linear: no jump
     assert (results.steps_failed == 0).all()
+
+
+def test_free_cycle_gives_eq_4_and_the_impact_damping(tmp_path: Path) -> None:
+    # k0 = 0, symmetric: T = 2 pi / w1 + 2 c / (A w1), w1 = sqrt(k / m)  (MODEL.md eq 4),
+    # and the impacts' (1 - e^2) k A^2 per cycle over 4 pi U_max, U_max = k A^2 / 2
+    path = _files(
+        tmp_path,
+        """
+base = "study.toml"
+[task]
+name = "free_cycle"
+amplitude = "10um"
+[axes.joint]
+clearance = ["0.05mm", "0.2mm"]
+[axes.losses]
+damping_ratio = [0.0]
+""",
+    )
+    results = run_sweep(Sweep.from_toml(path), client=SERIAL).squeeze("losses.damping_ratio")
+    w1 = math.sqrt(8e7 / 2.0)
+    c = results["joint.clearance"].values
+    period = 2 * math.pi / w1 + 2 * c / (10e-6 * w1)
+    np.testing.assert_allclose(results.natural_frequency_hz, 1 / period, rtol=1e-9)
+    np.testing.assert_allclose(results.dynamic_stiffness_n_per_m, 2.0 * (2 * np.pi / period) ** 2)
+    # impacts only: (1 - e^2) k A^2 / (4 pi k A^2 / 2), whatever the clearance
+    np.testing.assert_allclose(results.equivalent_damping_ratio, (1 - 0.8**2) / (2 * math.pi))

@@ -2,4 +2,5 @@
 
 from clearjoint.cli import main
 
-raise SystemExit(main())
+if __name__ == "__main__":  # not when a spawned worker (a Dask LocalCluster's) re-imports it
+    raise SystemExit(main())

@@ -10,6 +10,8 @@ library's; this module only maps a point's values onto it:
   MODEL.md sec. 2): amplitude, extremes, penetrations and the energy ledger per period;
 * ``energies``: every energy per free cycle at penetration ``task.amplitude``
   (clearjoint.dissipation.energies, MODEL.md eq 10-18);
+* ``free_cycle``: the joint's amplitude-dependent natural frequency, dynamic stiffness,
+  c_d (MODEL.md eq 5-9) and equivalent damping ratio on the free cycle at ``task.amplitude``;
 * ``stepped_sine``: the frequency-response curve by a stepped sine up and down
   (clearjoint.simulate.frequency_sweep), reduced to its peak and its up/down jump;
 * ``rig_test``: one test of the virtual rig (clearjoint.rig), measured with the
@@ -241,6 +243,54 @@ register_task(
         },
         evaluate=_energies,
         description="energies per free cycle at penetration task.amplitude (MODEL.md eq 10-18)",
+    )
+)
+
+
+def _free_cycle(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint import stiffness
+    from clearjoint.dissipation import energies
+
+    study = study_at(base, values)
+    amplitude = values["task.amplitude"]
+    period = float(stiffness.period(study.joint, amplitude))
+    damping = energies(
+        study.joint,
+        amplitude,
+        friction=study.friction,
+        pin=study.pin,
+        contact_friction_coefficient=study.contact_friction_coefficient,
+        restitution=study.restitution,
+        damping_ratio=study.damping_ratio,
+    )
+    return {
+        "natural_frequency_hz": 1.0 / period,
+        "dynamic_stiffness_n_per_m": float(stiffness.dynamic_stiffness(study.joint, amplitude)),
+        "stiffness_coefficient": float(stiffness.stiffness_coefficient(study.joint, amplitude)),
+        "equivalent_damping_ratio": float(damping["equivalent_damping_ratio"]),
+    }
+
+
+register_task(
+    Task(
+        name="free_cycle",
+        base="study",
+        parameters=JOINT_PARAMETERS,
+        options={"task.amplitude": (None, Parameter("length", "m"))},
+        outputs={
+            "natural_frequency_hz": "Hz",
+            "dynamic_stiffness_n_per_m": "N/m",
+            "stiffness_coefficient": "",
+            "equivalent_damping_ratio": "",
+        },
+        evaluate=_free_cycle,
+        description=(
+            "the joint's amplitude-dependent modal properties on the free cycle at "
+            "penetration task.amplitude: f_n (MODEL.md eq 5-6), k_d, c_d (eq 8-9), and the "
+            "equivalent damping ratio of every loss (eq 10-18)"
+        ),
     )
 )
 
