@@ -1,0 +1,163 @@
+"""Sweep throughput serial and on a Dask LocalCluster, and a SIGKILL-midway restart.
+
+Run on demand: ``python benchmarks/bench_sweep.py`` (about two minutes on 2 cores).
+Targets (issue 13): a LocalCluster of 2 workers at least 1.8x serial for tasks of
+about 50 ms; a sweep killed midway and resumed equal, bit for bit, to one run whole.
+
+1. Points per second for tasks of ~1 ms and ~50 ms of CPU (a spin on
+   ``time.thread_time``, so each point costs the same CPU of its own thread
+   whatever else the machine runs), serial in this process and on a LocalCluster of 1 and 2
+   workers. The cluster is started before the clock, so the ratios show the
+   per-point overhead and the parallel gain, not the start-up (printed apart).
+   On a machine shared with other jobs the 2-worker ratio is capped by the
+   cores actually free: the load average is printed beside it.
+2. ``clearjoint sweep`` on a 40-point steady-state sweep in its own process group,
+   SIGKILLed (client, scheduler and workers at once) once some chunks are in the
+   store, then ``--resume``d; every variable is compared with an uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from clearjoint.parallel import ResultStore, dask_client
+from clearjoint.sweep import SERIAL, Axis, Sweep, Task, run_sweep
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _spin(
+    base: object, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    """A task of ``task.cost_s`` seconds of CPU that returns a seeded draw."""
+    end = time.thread_time() + values["task.cost_s"]
+    while time.thread_time() < end:
+        pass
+    return {"value": float(np.random.default_rng(seed).normal())}
+
+
+SPIN = Task(
+    name="spin",
+    base="none",
+    parameters={},
+    options={},
+    outputs={"value": ""},
+    evaluate=_spin,
+    description="burn CPU for task.cost_s seconds",
+)
+
+
+def spin_sweep(points: int, cost_s: float, chunk_size: int) -> Sweep:
+    return Sweep(
+        task=SPIN,
+        base=None,
+        fixed=(("task.cost_s", cost_s),),
+        axes=(Axis("task.index", tuple(float(i) for i in range(points)), ""),),
+        draws=(),
+        samples=0,
+        seed=1,
+        outputs=("value",),
+        chunk_size=chunk_size,
+        source="bench",
+    )
+
+
+def throughput() -> None:
+    cases = [(0.001, 2000, 100), (0.050, 120, 2)]
+    print("points per second (higher is better); tasks spin on CPU time")
+    print(f"{'task':>8} {'serial':>10} {'1 worker':>10} {'2 workers':>10} {'2w/serial':>10}")
+    start = time.perf_counter()
+    with dask_client(workers=1) as one:
+        one_start = time.perf_counter() - start
+        start = time.perf_counter()
+        with dask_client(workers=2) as two:
+            two_start = time.perf_counter() - start
+            for cost, points, chunk in cases:
+                sweep = spin_sweep(points, cost, chunk)
+                rates = []
+                reference = None
+                for client in (SERIAL, one, two):
+                    t0 = time.perf_counter()
+                    result = run_sweep(sweep, client=client)
+                    rates.append(points / (time.perf_counter() - t0))
+                    if reference is None:
+                        reference = result.value.values
+                    # the same seeded numbers wherever they ran
+                    np.testing.assert_array_equal(result.value.values, reference)
+                print(
+                    f"{cost * 1e3:6.0f}ms {rates[0]:10.1f} {rates[1]:10.1f} {rates[2]:10.1f} "
+                    f"{rates[2] / rates[0]:9.2f}x"
+                )
+    print(f"cluster start-up: 1 worker {one_start:.1f} s, 2 workers {two_start:.1f} s")
+    print(f"load average while measuring: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+
+
+RESTART_SWEEP = """
+base = "{study}"
+seed = 3
+chunk_size = 2
+[task]
+name = "steady_state"
+outputs = ["amplitude_m", "energy_input_j", "period_multiple"]
+samples_per_period = 32
+[axes.joint]
+clearance = {{ start = "0.02mm", stop = "0.2mm", num = 5 }}
+[axes.excitation]
+force_amplitude = {{ start = "200N", stop = "2kN", num = 8 }}
+"""
+
+
+def _sweep_command(sweep: Path, out: Path, *extra: str) -> list[str]:
+    return [sys.executable, "-m", "clearjoint", "sweep", str(sweep), "--out", str(out), *extra]
+
+
+def restart() -> None:
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
+        sweep = tmp / "sweep.toml"
+        sweep.write_text(RESTART_SWEEP.format(study=EXAMPLES / "study.toml"), encoding="utf-8")
+        whole, cut = tmp / "whole.zarr", tmp / "cut.zarr"
+        quiet = ("--quiet", "--workers", "2")
+        subprocess.run(_sweep_command(sweep, whole, *quiet), check=True, capture_output=True)
+        run = subprocess.Popen(
+            _sweep_command(sweep, cut, *quiet),
+            start_new_session=True,  # its own process group: client, scheduler and workers
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        total = 20  # chunks
+        done = 0
+        while run.poll() is None:
+            time.sleep(0.2)
+            try:
+                done = len(ResultStore.open(cut).done_chunks())
+            except Exception:  # the store is being created
+                continue
+            if done >= total // 3:
+                os.killpg(run.pid, signal.SIGKILL)
+                run.wait()
+                break
+        left = len(ResultStore.open(cut).done_chunks())
+        print(f"SIGKILL after {left} of {total} chunks (exit {run.returncode})")
+        subprocess.run(_sweep_command(sweep, cut, *quiet, "--resume"), check=True)
+        a, b = ResultStore.open(whole).read(), ResultStore.open(cut).read()
+        same = all(np.array_equal(a[k][0], b[k][0], equal_nan=a[k][0].dtype.kind == "f") for k in a)
+        failed = [str(s) for s in a["status"][0] if not str(s).startswith("ok")]
+        print(f"points failed in both runs (NaN, reason in status): {failed}")
+        print(f"resumed store equal to the uninterrupted run, bit for bit: {same}")
+        if not same:
+            raise SystemExit(1)
+
+
+if __name__ == "__main__":  # LocalCluster workers are spawned processes: keep this guard
+    throughput()
+    restart()
