@@ -83,9 +83,12 @@ def plot_sweep(results: Any, variable: str, ax: Any = None) -> Any:
             else [(v, data.sel({grid[0]: v})) for v in data[grid[0]].values]
         )
         factor, label = _factor(results, variable)
+        if grid:
+            axis_factor, axis_label = _factor(results, grid[0])
+            axis_unit = axis_label[len(grid[0]) :].strip(" ()")
         for value, part in groups:
             finite = part.values[np.isfinite(part.values)] * factor
-            name = None if value is None else f"{grid[0]} = {value:.4g}"
+            name = None if value is None else f"{grid[0]} = {value * axis_factor:.4g} {axis_unit}"
             ax.hist(finite, bins="auto", alpha=0.6 if grid else 1.0, label=name)
         ax.set_xlabel(label)
         ax.set_ylabel("samples")
