@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -404,3 +405,38 @@ damping_ratio = [0.0]
     np.testing.assert_allclose(results.dynamic_stiffness_n_per_m, 2.0 * (2 * np.pi / period) ** 2)
     # impacts only: (1 - e^2) k A^2 / (4 pi k A^2 / 2), whatever the clearance
     np.testing.assert_allclose(results.equivalent_damping_ratio, (1 - 0.8**2) / (2 * math.pi))
+
+
+def test_a_chunk_that_dies_is_reported_and_the_rest_is_kept_for_resume(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import clearjoint.sweep.run as sweep_run
+    from clearjoint.parallel import ChunkFailedError
+
+    sweep = Sweep.from_toml(_files(tmp_path, STORE_SWEEP))
+    real = sweep_run._evaluate_chunk
+
+    def dies_on_the_second_chunk(chunk: Any) -> Any:
+        if chunk.first == 2:
+            raise MemoryError("worker lost")  # as a killed worker would surface
+        return real(chunk)
+
+    monkeypatch.setattr(sweep_run, "_evaluate_chunk", dies_on_the_second_chunk)
+    out = tmp_path / "r.zarr"
+    with pytest.raises(ChunkFailedError, match=r"1 of 3 chunks.*worker lost.*--resume"):
+        run_sweep(sweep, client=SERIAL, out=out)
+    assert open_sweep(out).attrs["points_missing"] == 2
+    monkeypatch.setattr(sweep_run, "_evaluate_chunk", real)
+    done = run_sweep(sweep, client=SERIAL, out=out, resume=True)
+    assert done.attrs["points_missing"] == 0
+    assert list(done.status.values) == ["ok"] * 5
+
+
+def test_the_shipped_sweep_files_read() -> None:
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    peak = Sweep.from_toml(examples / "sweep.toml")
+    assert peak.dims == ("joint.clearance", "excitation.force_amplitude")
+    assert peak.n_points == 20
+    tolerance = Sweep.from_toml(examples / "tolerance.toml")
+    assert tolerance.shape == (1000, 2)
+    assert tolerance.drawn()["joint.clearance"].min() > 0.0
