@@ -440,3 +440,11 @@ def test_the_shipped_sweep_files_read() -> None:
     tolerance = Sweep.from_toml(examples / "tolerance.toml")
     assert tolerance.shape == (1000, 2)
     assert tolerance.drawn()["joint.clearance"].min() > 0.0
+
+
+def test_the_sweep_file_in_the_docs_reads(tmp_path: Path) -> None:
+    docs = Path(__file__).resolve().parents[1] / "docs" / "sweep.md"
+    block = docs.read_text(encoding="utf-8").split("```toml\n", 1)[1].split("```", 1)[0]
+    sweep = Sweep.from_toml(_files(tmp_path, block))
+    assert sweep.dims == ("sample", "joint.compression_stiffness", "losses.restitution")
+    assert sweep.shape == (1000, 2, 5)
