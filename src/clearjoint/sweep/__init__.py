@@ -5,8 +5,9 @@ energies per cycle of MODEL.md eq 10-18, a virtual-rig test) over a grid of
 parameter values and/or Monte Carlo draws, in chunks of pure tasks on a
 dask.distributed cluster (clearjoint.parallel), writing a zarr store as chunks finish.
 
->>> from clearjoint.sweep import Sweep, run_sweep            # doctest: +SKIP
->>> results = run_sweep(Sweep.from_toml("examples/sweep.toml"), out="results.zarr")
+>>> from clearjoint.sweep import Sweep, run_sweep
+>>> sweep = Sweep.from_toml("examples/sweep.toml")  # doctest: +SKIP
+>>> results = run_sweep(sweep, out="results.zarr")  # doctest: +SKIP
 """
 
 from __future__ import annotations
