@@ -564,10 +564,13 @@ def _run_sweep(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .zarr, got {args.out!r}")
     if args.scheduler and args.workers is not None:
         raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
-    sweep = Sweep.from_toml(args.sweep)
     start = time.perf_counter()
     with contextlib.ExitStack() as stack:
-        client = stack.enter_context(dask_client(args.scheduler, workers=args.workers))
+        if args.scheduler:  # an unreachable scheduler is said first, within seconds
+            client = stack.enter_context(dask_client(args.scheduler))
+        sweep = Sweep.from_toml(args.sweep)
+        if not args.scheduler:  # a bad sweep file is said before a cluster starts
+            client = stack.enter_context(dask_client(workers=args.workers))
         progress = None
         if not args.quiet and sys.stderr.isatty():
             from rich.progress import Progress, TimeRemainingColumn

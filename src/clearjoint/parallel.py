@@ -43,7 +43,7 @@ R = TypeVar("R")
 Runner = Any
 
 #: Seconds to wait for a scheduler before giving up (the issue asks for an answer within 10 s).
-CONNECT_TIMEOUT_S = 5
+CONNECT_TIMEOUT_S = 4
 
 
 class SchedulerError(ClearjointError, ConnectionError):
