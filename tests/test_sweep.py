@@ -448,3 +448,36 @@ def test_the_sweep_file_in_the_docs_reads(tmp_path: Path) -> None:
     sweep = Sweep.from_toml(_files(tmp_path, block))
     assert sweep.dims == ("sample", "joint.compression_stiffness", "losses.restitution")
     assert sweep.shape == (1000, 2, 5)
+
+
+def test_a_record_set_is_identified_file_by_file(tmp_path: Path) -> None:
+    import csv
+
+    from clearjoint.rig import load_campaign, run_campaign
+
+    (tmp_path / "campaign.toml").write_text(
+        CAMPAIGN.replace('["1500N"]', '["1500N", "2500N"]'), encoding="utf-8"
+    )
+    manifest = run_campaign(load_campaign(tmp_path / "campaign.toml"), tmp_path / "rec", jobs=1)
+    (tmp_path / "rec" / "zz_broken.nc").write_text("not a record", encoding="utf-8")
+    path = _files(
+        tmp_path,
+        """
+base = "rec/*.nc"
+[task]
+name = "identify"
+outputs = ["clearance_m", "cycles_used"]
+""",
+    )
+    results = run_sweep(Sweep.from_toml(path), client=SERIAL)
+    names = [Path(f).name for f in results.file.values]
+    assert names == ["joint-1_40Hz_1500N.nc", "joint-1_40Hz_2500N.nc", "zz_broken.nc"]
+    with manifest.open() as handle:
+        truth = {row["file"]: float(row["clearance_m"]) for row in csv.DictReader(handle)}
+    for i, name in enumerate(names[:2]):
+        assert results.status.values[i] == "ok"
+        assert results.clearance_m.values[i] == pytest.approx(truth[name], rel=0.1)
+    assert np.isnan(results.clearance_m.values[2])
+    assert "zz_broken.nc" in results.status.values[2]
+    with pytest.raises(SweepError, match="matches no file"):
+        Sweep.from_toml(_files(tmp_path, 'base = "none/*.nc"\n[task]\nname = "identify"'))

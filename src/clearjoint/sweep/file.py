@@ -2,7 +2,7 @@
 
 The format (docs/sweep.md; an example in examples/sweep.toml)::
 
-    base = "study.toml"          # a study (joint tasks) or a rig campaign; relative to this file
+    base = "study.toml"          # a study, a rig campaign or a glob of records; relative here
     seed = 2026                  # the draws and every point's own seed
     samples = 200                # Monte Carlo samples (the `sample` dimension)
     chunk_size = 16              # points per task chunk and per zarr chunk
@@ -322,6 +322,18 @@ def _load_base(where: str, task: Task, raw: Any, folder: Path) -> Any:
             return load_study(folder / raw)
         except StudyError as exc:
             raise SweepError(f"{where}: base: {exc}") from None
+    if task.base == "records":
+        from clearjoint.sweep.tasks import RecordSet
+
+        if not isinstance(raw, str):
+            raise SweepError(f'{where}: base must be a glob of record files, e.g. "records/*.nc"')
+        pattern = Path(raw)
+        if not pattern.is_absolute():
+            pattern = folder / pattern
+        files = sorted(str(p) for p in pattern.parent.glob(pattern.name) if p.is_file())
+        if not files:
+            raise SweepError(f"{where}: base {raw!r} matches no file; check the folder and pattern")
+        return RecordSet(tuple(files), source=raw)
     raise SweepError(f"{where}: task {task.name!r} needs a {task.base} base, not readable yet")
 
 
@@ -355,6 +367,8 @@ def _read(path: Path) -> Sweep:
     base = _load_base(where, task, raw.get("base"), path.parent)
 
     axes: list[Axis] = []
+    if task.base == "records":  # one point per record file
+        axes.append(Axis("record", tuple(float(i) for i in range(len(base.files))), ""))
     for section, table in _table(where, raw.get("axes", {}), "axes").items():
         for key, value in _table(where, table, f"axes.{section}").items():
             p = _parameter(where, task, f"{section}.{key}")

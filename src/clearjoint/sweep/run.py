@@ -111,6 +111,7 @@ def _attrs(sweep: Sweep) -> dict[str, Any]:
         ),
         "draws": json.dumps([d.name for d in sweep.draws]),
         "fixed": json.dumps(dict(sweep.fixed)),
+        "files": json.dumps(list(getattr(sweep.base, "files", []))),
     }
 
 
@@ -276,6 +277,10 @@ def _dataset(
     }
     if "sample" in dims:
         coords["sample"] = ("sample", np.arange(shape[0]))
+    files = json.loads(attrs.get("files", "[]"))
+    if files:  # a record set: its files beside the record index
+        coords["record"] = ("record", np.arange(len(files)))
+        coords["file"] = ("record", np.asarray(files, dtype=str))
     variables: dict[str, Any] = {}
     for name, (values, var_attrs) in flat.items():
         full = values.reshape(shape)
@@ -289,7 +294,9 @@ def _dataset(
     failed = int(np.count_nonzero(~ok & (status != "")))
     missing = int(np.count_nonzero(status == ""))
     keep = {
-        k: v for k, v in attrs.items() if k not in ("dims", "shape", "axes", "draws", "chunk_size")
+        k: v
+        for k, v in attrs.items()
+        if k not in ("dims", "shape", "axes", "draws", "chunk_size", "files")
     }
     return xr.Dataset(
         variables,

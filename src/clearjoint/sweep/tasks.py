@@ -14,6 +14,8 @@ library's; this module only maps a point's values onto it:
   c_d (MODEL.md eq 5-9) and equivalent damping ratio on the free cycle at ``task.amplitude``;
 * ``stepped_sine``: the frequency-response curve by a stepped sine up and down
   (clearjoint.simulate.frequency_sweep), reduced to its peak and its up/down jump;
+* ``identify``: the identification of each record of a set (base: a glob of files),
+  one point per file along the ``record`` axis;
 * ``rig_test``: one test of the virtual rig (clearjoint.rig), measured with the
   point's own noise seed, then identified (clearjoint.identify): truth beside estimate.
 
@@ -417,6 +419,64 @@ register_task(
         description=(
             "one virtual-rig test (the campaign's first jointed structure, frequency and "
             "force unless varied), measured with the point's own noise, then identified"
+        ),
+    )
+)
+
+
+# ---- identification of a record set ----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RecordSet:
+    """The record files a sweep identifies: one point per file along the ``record`` axis."""
+
+    files: tuple[str, ...]
+    source: str = ""
+
+
+_IDENTIFIED = {
+    "amplitude_m": "m",
+    "clearance_m": "m",
+    "compression_stiffness_n_per_m": "N/m",
+    "tension_stiffness_n_per_m": "N/m",
+    "friction_force_n": "N",
+    "energy_per_cycle_j": "J",
+    "compression_penetration_m": "m",
+    "tension_penetration_m": "m",
+    "gap_stiffness_n_per_m": "N/m",
+    "secant_stiffness_n_per_m": "N/m",
+    "dynamic_stiffness_n_per_m": "N/m",
+}
+
+
+def _identify(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.identify import identify
+    from clearjoint.records import read_record
+
+    record = read_record(base.files[int(values["record"])])
+    found = identify(record, tolerance=values["task.tolerance"])
+    out = {key: float(found.summary[key]) for key in _IDENTIFIED}
+    out["frequency_hz"] = float(found.frequency_hz)
+    out["cycles_used"] = float(found.cycles_used)
+    return out
+
+
+register_task(
+    Task(
+        name="identify",
+        base="records",
+        parameters={},
+        options={
+            "task.tolerance": (0.03, Parameter("dimensionless", "", open_lower=True, upper=1.0))
+        },
+        outputs={**_IDENTIFIED, "frequency_hz": "Hz", "cycles_used": ""},
+        evaluate=_identify,
+        description=(
+            "identification of each record of a set (clearjoint.identify): the mean over its "
+            "steady cycles of each quantity; a record that cannot be identified says why"
         ),
     )
 )
