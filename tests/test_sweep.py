@@ -312,10 +312,11 @@ def test_the_command_line_runs_refuses_and_plots(
     out = tmp_path / "r.zarr"
     # a "running cluster" in this process, reached by its address as --scheduler would
     with LocalCluster(n_workers=1, processes=False, protocol="tcp", dashboard_address=":0") as c:
-        assert (
-            main(["sweep", str(path), "--out", str(out), "--scheduler", c.scheduler_address]) == 0
-        )
-    assert "wrote 5 points (0 failed" in capsys.readouterr().out
+        command = ["sweep", str(path), "--out", str(out), "--scheduler", c.scheduler_address]
+        assert main(command) == 0
+        assert "wrote 5 points (0 failed" in capsys.readouterr().out
+        assert main([*command, "--resume"]) == 0  # nothing left to compute
+        assert "5 of them kept from the store" in capsys.readouterr().out
     assert main(["sweep", str(path), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "will not overwrite" in err

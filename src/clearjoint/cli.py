@@ -571,7 +571,8 @@ def _run_sweep(args: argparse.Namespace) -> int:
         sweep = Sweep.from_toml(args.sweep)
         if not args.scheduler:  # a bad sweep file is said before a cluster starts
             client = stack.enter_context(dask_client(workers=args.workers))
-        progress = None
+        already: list[int] = []  # points found in the store on --resume
+        bar: Any = None
         if not args.quiet and sys.stderr.isatty():
             from rich.progress import Progress, TimeRemainingColumn
 
@@ -581,7 +582,13 @@ def _run_sweep(args: argparse.Namespace) -> int:
                 )
             )
             task = bar.add_task(f"{sweep.n_points} points", total=sweep.n_points)
-            progress = lambda done, _total: bar.update(task, completed=done)  # noqa: E731
+
+        def progress(done: int, _total: int) -> None:
+            if not already:
+                already.append(done)
+            if bar is not None:
+                bar.update(task, completed=done)
+
         try:
             results = run_sweep(
                 sweep,
@@ -599,8 +606,9 @@ def _run_sweep(args: argparse.Namespace) -> int:
             )
             return 130
     failed = results.attrs["points_failed"]
+    kept = f", {already[0]} of them kept from the store" if already and already[0] else ""
     print(
-        f"wrote {results.attrs['points']} points ({failed} failed: see `status`) "
+        f"wrote {results.attrs['points']} points{kept} ({failed} failed: see `status`) "
         f"to {args.out} in {time.perf_counter() - start:.1f} s"
     )
     return 0
