@@ -133,6 +133,10 @@ def test_the_store_keeps_finished_chunks_and_refuses_what_it_should(tmp_path: Pa
     with pytest.raises(StoreError, match="not a clearjoint sweep store"):
         _store(tmp_path / "plain", force=True)  # force never deletes what is not a store
     assert (tmp_path / "plain").is_dir()
+    (tmp_path / "file.zarr").write_text("mine", encoding="utf-8")
+    with pytest.raises(StoreError, match="not a clearjoint sweep store"):
+        _store(tmp_path / "file.zarr", force=True)
+    assert (tmp_path / "file.zarr").read_text(encoding="utf-8") == "mine"
     fresh = _store(path, force=True)
     assert fresh.done_chunks() == set()
 

@@ -334,11 +334,13 @@ class ResultStore:
         path = Path(path)
         if not path.exists():
             raise StoreError(f"{path}: no such result store; run the sweep without --resume")
+        if not (path / "zarr.json").is_file():  # a file, a folder of something else
+            raise StoreError(f"{path}: not a clearjoint sweep store (no zarr.json); left as it is")
         try:
             group: Any = zarr.open_group(str(path), mode="r+")
             stored = group.attrs[_FINGERPRINT]
             chunk_size = int(group.attrs["chunk_size"])
-        except (KeyError, FileNotFoundError, NotADirectoryError, ValueError, TypeError) as exc:
+        except (KeyError, OSError, ValueError, TypeError) as exc:
             raise StoreError(
                 f"{path}: not a clearjoint sweep store ({type(exc).__name__}: {exc}); "
                 f"choose another --out"
