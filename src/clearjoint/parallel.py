@@ -333,7 +333,7 @@ class ResultStore:
 
         path = Path(path)
         if not path.exists():
-            raise StoreError(f"{path}: no such result store; run the sweep without --resume")
+            raise StoreError(f"{path}: no such result store; check the path")
         if not (path / "zarr.json").is_file():  # a file, a folder of something else
             raise StoreError(f"{path}: not a clearjoint sweep store (no zarr.json); left as it is")
         try:
