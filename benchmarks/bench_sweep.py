@@ -10,7 +10,8 @@ about 50 ms; a sweep killed midway and resumed equal, bit for bit, to one run wh
    workers. The cluster is started before the clock, so the ratios show the
    per-point overhead and the parallel gain, not the start-up (printed apart).
    On a machine shared with other jobs the 2-worker ratio is capped by the
-   cores actually free: the load average is printed beside it.
+   cores actually free: the load average is printed beside it, and so is a
+   control, the same 50 ms points on a plain ProcessPoolExecutor of 2 processes.
 2. ``clearjoint sweep`` on a 40-point steady-state sweep in its own process group,
    SIGKILLed (client, scheduler and workers at once) once some chunks are in the
    store, then ``--resume``d; every variable is compared with an uninterrupted run.
@@ -25,6 +26,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Mapping
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +45,13 @@ def _spin(
     while time.thread_time() < end:
         pass
     return {"value": float(np.random.default_rng(seed).normal())}
+
+
+def _spin_point(index: int) -> float:
+    """One 50 ms point without Dask or the sweep machinery (the control)."""
+    return _spin(None, {"task.cost_s": 0.050}, np.random.SeedSequence(1, spawn_key=(index,)))[
+        "value"
+    ]
 
 
 SPIN = Task(
@@ -98,6 +107,21 @@ def throughput() -> None:
                     f"{rates[2] / rates[0]:9.2f}x"
                 )
     print(f"cluster start-up: 1 worker {one_start:.1f} s, 2 workers {two_start:.1f} s")
+    # the control: what two plain processes gain over one on this machine right now
+    points = 60
+    t0 = time.perf_counter()
+    for i in range(points):
+        _spin_point(i)
+    serial = time.perf_counter() - t0
+    with ProcessPoolExecutor(2) as pool:
+        list(pool.map(_spin_point, range(4)))  # started and warm
+        t0 = time.perf_counter()
+        list(pool.map(_spin_point, range(points)))
+        two = time.perf_counter() - t0
+    print(
+        f"control, 50 ms tasks without Dask: serial {points / serial:.1f}/s, "
+        f"ProcessPoolExecutor(2) {points / two:.1f}/s, {serial / two:.2f}x"
+    )
     print(f"load average while measuring: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
 
