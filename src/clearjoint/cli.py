@@ -17,7 +17,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from clearjoint import __version__
-from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.errors import ClearjointError, OutputExistsError, ParameterError
 
 EXIT_BAD_INPUT = 2
 
@@ -42,6 +42,7 @@ def _stiffness_parser(sub: Any) -> None:
     )
     _add_joint_options(p, required=True)
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    _add_plot_option(p, force=True)
 
 
 def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
@@ -83,6 +84,7 @@ def _dissipation_parser(sub: Any) -> None:
     p.add_argument("--poisson-ratio", help="Poisson's ratio of pin and hole (default 0.3)")
     p.add_argument("--contact-friction-coefficient", help="friction coefficient on the pin mu_c")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    _add_plot_option(p, force=True)
 
 
 def _reproduce_parser(sub: Any) -> None:
@@ -128,7 +130,8 @@ def _simulate_parser(sub: Any) -> None:
     p.add_argument("study", help="study file (TOML)")
     p.add_argument("--out", help="write the result to this netCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
-    p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
+    p.add_argument("--force", action="store_true", help="overwrite --out or --plot if it exists")
+    _add_plot_option(p, force=False)
 
 
 def _rig_parser(sub: Any) -> None:
@@ -172,6 +175,51 @@ def _identify_parser(sub: Any) -> None:
     )
     p.add_argument("--force", action="store_true", help="overwrite existing output")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+#: Figure formats ``--plot`` writes (matplotlib picks the format from the suffix).
+PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+def _add_plot_option(p: argparse.ArgumentParser, *, force: bool) -> None:
+    p.add_argument(
+        "--plot", metavar="FILE.png", help="draw the result into this figure (.png, .pdf or .svg)"
+    )
+    if force:
+        p.add_argument("--force", action="store_true", help="overwrite --plot if it exists")
+
+
+def _plot_target(args: argparse.Namespace) -> Path | None:
+    """The --plot file, checked before any work: a figure suffix, not overwritten unasked."""
+    if args.plot is None:
+        return None
+    path = Path(args.plot)
+    if path.suffix.lower() not in PLOT_SUFFIXES:
+        raise ParameterError(
+            f"--plot must end in {', '.join(PLOT_SUFFIXES)}, got {path.name!r}; "
+            "e.g. --plot result.png"
+        )
+    if path.is_dir():
+        raise ParameterError(f"--plot {path} is a folder; give a file name such as {path}/plot.png")
+    if path.exists() and not args.force:
+        raise OutputExistsError(
+            f"will not overwrite {path}; choose another --plot file or pass --force"
+        )
+    return path
+
+
+def _save_plot(result: Any, path: Path | None, *, quiet: bool) -> None:
+    """Draw ``result.plot(ax)`` on a new figure and save it to ``path`` (nothing if None)."""
+    if path is None:
+        return
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
+    result.plot(fig.add_subplot())
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    if not quiet:
+        print(f"wrote {path}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -223,6 +271,8 @@ def _run_stiffness(args: argparse.Namespace) -> int:
 
     joint = _joint_from(args)
     amplitudes = np.array(parse_quantity_list(args.amplitude, "length", name="--amplitude"))
+    plot = _plot_target(args)
+    _save_plot(stiffness.stiffness_curve(joint, amplitudes), plot, quiet=args.json)
     period = stiffness.period(joint, amplitudes)
     with np.errstate(divide="ignore"):
         frequency_hz = 1.0 / period
@@ -305,7 +355,9 @@ def _run_dissipation(args: argparse.Namespace) -> int:
     joint = base.joint if base is not None and args.mass is None else _joint_from(args)
     losses = _losses_from(args, base)
     amplitudes = np.array(parse_quantity_list(args.amplitude, "length", name="--amplitude"))
+    plot = _plot_target(args)
     values = dissipation.energies(joint, amplitudes, **losses)
+    _save_plot(values, plot, quiet=args.json)
     several = amplitudes.size > 1
     if args.json:
         out = {"amplitude_m": _json_value(amplitudes, several)}
@@ -461,7 +513,9 @@ def _run_simulate(args: argparse.Namespace) -> int:
         from clearjoint._checks import refuse_to_overwrite
 
         refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
+    plot = _plot_target(args)
     motion = run_study(study)
+    _save_plot(motion, plot, quiet=args.json)
     result = summary(study, motion)
     if args.out:
         write_netcdf(study, motion, args.out, force=args.force)
