@@ -41,7 +41,7 @@ class Joint:
         Stiffness k0 inside the gap (free-play), N/m, >= 0. Default 0 (the paper's choice).
     gap_offset : float, optional
         Position d of the gap's centre relative to x = 0 (the rest position of the
-        k0 spring), m, positive toward compression, with |d| <= c/2. Default 0.
+        k0 spring), m, positive toward compression, with abs(d) <= c/2. Default 0.
 
     Raises
     ------

@@ -67,7 +67,7 @@ class EnergyLedger:
 
     @property
     def balance_error(self) -> float:
-        """|input - losses - mechanical_energy_change| / max(|input|, losses)."""
+        """abs(input - losses - mechanical_energy_change) / max(abs(input), losses)."""
         scale = max(abs(self.input), self.losses, 1e-300)
         return abs(self.input - self.losses - self.mechanical_energy_change) / scale
 
