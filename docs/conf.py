@@ -40,7 +40,14 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext", "_templates", "**/*.ipynb", "auto_examples/*.py"]
+exclude_patterns = [
+    "_build",
+    "_ext",
+    "_templates",
+    "**/*.ipynb",
+    "auto_examples/*.py",
+    "sg_execution_times.rst",  # the gallery's timings, not a page of the guide
+]
 templates_path = ["_templates"]
 
 # ---- Markdown ------------------------------------------------------------------------------
