@@ -8,14 +8,26 @@ the free-play, compression and tension stages, and the excitation force against
 displacement.
 """
 
+import math
+
 import matplotlib.pyplot as plt
 
+from clearjoint import Friction, Joint
 from clearjoint.figures import displacement_stages_figure, force_displacement_figure
-from clearjoint.report import example_cycle
+from clearjoint.simulate import steady_state
 
 DOCS_FIGURES = {}  # figures of the docs this script draws, by file name in docs/figures/
 
-cycle = example_cycle()
+joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, tension_stiffness=5e7)
+cycle = steady_state(
+    joint,
+    1000.0,  # F0, N
+    2 * math.pi * 400.0,  # omega, rad/s
+    damping_ratio=0.01,
+    restitution=0.8,
+    friction=Friction(0.2, 300.0),
+    samples_per_period=512,
+)
 print(cycle)  # a SteadyState: its short summary
 
 stages = [(s.name, s.start, s.end) for s in cycle.stages]
