@@ -228,3 +228,14 @@ def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
     path.write_text(json.dumps({"data": [[0.0, 1.0]] * 20, "displacement units": "in"}))
     with pytest.raises(RecordError, match="must have 6 columns"):
         read_brfd(path)
+
+
+def test_metadata_takes_units_or_a_unit_named_key_never_a_bare_number(tmp_path: Path) -> None:
+    times = [i / 100 for i in range(50)]
+    good = write_csv(tmp_path, CSV_MAGIC + "\n# frequency_hz = 10\n# clearance = \"0.1mm\"\n"
+                     + csv_body(times), "good.csv")  # fmt: skip
+    record = read_record(good)
+    assert (record.frequency_hz, record.clearance) == pytest.approx((10.0, 1e-4))
+    bad = write_csv(tmp_path, CSV_MAGIC + "\n# clearance = 0.1\n" + csv_body(times))
+    with pytest.raises(RecordError, match=r"clearance = 0\.1: give a unit"):
+        read_record(bad)

@@ -124,3 +124,51 @@ def test_cli_table_and_transient(tmp_path: Path, capsys: pytest.CaptureFixture[s
 def test_cli_bad_study_exit_code_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["simulate", str(tmp_path / "missing.toml")]) == 2
     assert "no such study file" in capsys.readouterr().err
+
+
+# ---- issue 16: units by dimension, bare numbers only where the key names the unit ----------
+
+
+@pytest.mark.parametrize(
+    ("frequency", "omega"),
+    [
+        ('frequency = "2513rad/s"', 2513.0),  # was run at 2513 Hz
+        ('frequency = "400rpm"', 2.0 * math.pi * 400.0 / 60.0),  # was run at 41.89 Hz
+        ('frequency = "0.4kHz"', 2.0 * math.pi * 400.0),
+        ("frequency_hz = 400", 2.0 * math.pi * 400.0),
+    ],
+)
+def test_study_frequencies_convert_by_dimension(
+    tmp_path: Path, frequency: str, omega: float
+) -> None:
+    study = load_study(write(tmp_path, MINIMAL.replace('frequency = "400Hz"', frequency)))
+    assert study.omega == pytest.approx(omega, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "words"),
+    [
+        ('mass = "2kg"', "mass = 2", '[joint] mass = 2: give a unit, e.g. "2kg"'),
+        ('mass = "2kg"', "mass = 2", "or name the SI unit in the key (mass_kg = 2)"),
+        ('"400Hz"', '"0.4m"', "is not a frequency"),
+        ('frequency = "400Hz"', 'frequency_hz = "400Hz"', "the key names its unit"),
+        ('frequency = "400Hz"', 'frequency = "400Hz"\nfrequency_hz = 400', "given twice"),
+    ],
+)
+def test_bare_numbers_only_where_the_key_names_the_unit(
+    tmp_path: Path, old: str, new: str, words: str
+) -> None:
+    path = write(tmp_path, MINIMAL.replace(old, new))
+    with pytest.raises(StudyError) as info:
+        load_study(path)
+    assert words in str(info.value)
+    assert len(str(info.value).splitlines()) == 1
+
+
+def test_unit_named_keys_and_dimensionless_bare_numbers(tmp_path: Path) -> None:
+    text = MINIMAL.replace('mass = "2kg"', "mass_kg = 2").replace(
+        'clearance = "0.106mm"', "clearance_m = 1.06e-4"
+    )
+    study = load_study(write(tmp_path, text))
+    assert (study.joint.mass, study.joint.clearance) == (2.0, 1.06e-4)
+    assert study.damping_ratio == 0.02  # a bare number: the key is dimensionless

@@ -231,6 +231,8 @@ def _factor(where: str, channel: str, unit: str) -> float:
 _COLUMN = re.compile(r"^\s*(?P<name>[A-Za-z_]+)\s*\[(?P<unit>[^\]]+)\]\s*$")
 
 #: Metadata keys of the CSV header and sidecar, with the kind of quantity (or text).
+#: A quantity takes its unit (``clearance = "0.106mm"``), or a bare number in a key that
+#: names the SI unit (``clearance_m = 1.06e-4``, ``frequency_hz = 20``).
 _META_KINDS = {
     "joint_id": "text",
     "control": "text",
@@ -241,28 +243,24 @@ _META_KINDS = {
     "frequency": "frequency",
     "mass": "mass",
 }
+_SUFFIX = {
+    "clearance": "m",
+    "force_amplitude": "n",
+    "displacement_amplitude": "m",
+    "frequency": "hz",
+    "mass": "kg",
+}
 
 
 def _metadata_from_toml(where: str, table: dict[str, Any]) -> dict[str, Any]:
-    from clearjoint.units import parse_quantity
+    """Record metadata from a header block or sidecar, in SI (io_toml: units or unit keys)."""
+    from clearjoint.io_toml import read_table
 
-    unknown = sorted(set(table) - set(_META_KINDS))
+    unknown = sorted(set(table) - set(_META_KINDS) - {f"{k}_{_SUFFIX[k]}" for k in _SUFFIX})
     if unknown:
         raise RecordError(f"{where}: unknown metadata {unknown}; known: {sorted(_META_KINDS)}")
-    meta: dict[str, Any] = {}
-    for key, value in table.items():
-        kind = _META_KINDS[key]
-        target = "frequency_hz" if key == "frequency" else key
-        if kind == "text":
-            meta[target] = str(value)
-        elif isinstance(value, int | float) and not isinstance(value, bool):
-            meta[target] = float(value)
-        else:
-            try:
-                meta[target] = parse_quantity(str(value), kind, name=f"{where}: {key}")
-            except ClearjointError as exc:
-                raise RecordError(str(exc)) from None
-    return meta
+    values = read_table(table, _META_KINDS, where=where, section="", error=RecordError)
+    return {("frequency_hz" if key == "frequency" else key): val for key, val in values.items()}
 
 
 def _read_csv(path: Path, resample_: bool) -> Record:

@@ -1,16 +1,18 @@
 """A simulation study in one TOML file, with documented defaults, and its netCDF output.
 
-A study names the joint, the excitation and the losses; every value may carry
-a unit (``"0.106mm"``, ``"8e7N/m"``, ``"400Hz"``) or be a bare SI number.
-Anything left out takes the default in ``DEFAULT_STUDY``; an unknown key is an
-error (it is almost always a typo). The file format is documented in
-docs/simulate.md, with an example in examples/study.toml.
+A study names the joint, the excitation and the losses; every dimensional value
+carries its unit (``"0.106mm"``, ``"8e7N/m"``, ``"400Hz"``, ``"2513rad/s"``), or
+its key names the SI unit (``frequency_hz = 400``); dimensionless values
+(``damping_ratio = 0.01``) are bare numbers. The file is read by
+:mod:`clearjoint.io_toml`. Anything left out takes the default in
+``DEFAULT_STUDY``; an unknown key is an error (it is almost always a typo). The
+file format is documented in docs/simulate.md, with an example in
+examples/study.toml.
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,9 +21,9 @@ import numpy as np
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.io_toml import read_table, read_toml
 from clearjoint.joint import Friction, Joint, Pin
 from clearjoint.simulate.core import Motion, SteadyState, steady_state, time_response
-from clearjoint.units import parse_quantity
 
 #: Every key a study may give, with its default (None: required) and the kind of quantity.
 DEFAULT_STUDY: dict[str, dict[str, tuple[Any, str]]] = {
@@ -85,25 +87,6 @@ class Study:
     source: str
 
 
-def _value(section: str, key: str, raw: Any, kind: str, where: str) -> Any:
-    name = f"{where}: [{section}] {key}"
-    if kind == "text":
-        if not isinstance(raw, str):
-            raise StudyError(f"{name} must be text, got {raw!r}")
-        return raw
-    if kind == "count":
-        if isinstance(raw, bool) or not isinstance(raw, int):
-            raise StudyError(f"{name} must be a whole number, got {raw!r}")
-        return raw
-    if isinstance(raw, bool):
-        raise StudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
-    if isinstance(raw, int | float):
-        return float(raw)
-    if isinstance(raw, str):
-        return parse_quantity(raw, kind, name=name)
-    raise StudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
-
-
 def load_study(path: str | Path) -> Study:
     """Read a study TOML file, merge the defaults and validate every value.
 
@@ -113,38 +96,24 @@ def load_study(path: str | Path) -> Study:
         The file is missing or not TOML, a section or key is unknown, a required
         key is absent, or a value is invalid; the message names the file and key.
     """
-    path = Path(path)
     where = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise StudyError(f"{where}: no such study file") from None
-    except UnicodeDecodeError:
-        raise StudyError(f"{where}: not a text file; a study is a TOML file") from None
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{where}: not valid TOML ({exc})") from None
+    raw = read_toml(path, what="study", error=StudyError)
     unknown = sorted(set(raw) - set(DEFAULT_STUDY))
     if unknown:
         raise StudyError(f"{where}: unknown section(s) {unknown}; known: {sorted(DEFAULT_STUDY)}")
     values: dict[str, dict[str, Any]] = {}
     for section, spec in DEFAULT_STUDY.items():
-        given = raw.get(section, {})
-        if not isinstance(given, dict):
-            raise StudyError(f"{where}: [{section}] must be a table")
-        extra = sorted(set(given) - set(spec))
-        if extra:
-            raise StudyError(
-                f"{where}: unknown key(s) {extra} in [{section}]; known: {sorted(spec)}"
-            )
+        given = read_table(
+            raw.get(section, {}),
+            {key: kind for key, (_, kind) in spec.items()},
+            where=where,
+            section=f"[{section}]",
+            error=StudyError,
+        )
         values[section] = {}
-        for key, (default, kind) in spec.items():
+        for key, (default, _kind) in spec.items():
             if key in given:
-                try:
-                    values[section][key] = _value(section, key, given[key], kind, where)
-                except ParameterError as exc:  # a unit that does not parse: already names the key
-                    raise StudyError(str(exc)) from None
+                values[section][key] = given[key]
             elif default is None and (section != "pin" or "pin" in raw):
                 raise StudyError(f"{where}: [{section}] {key} is required")
             else:
