@@ -269,3 +269,75 @@ def test_an_overridden_clearance_reaches_the_closed_form(
     # 2 (c + A + A_t), the tension penetration A_t = A sqrt(k_c / k_t) by equal energy
     path = 2.0 * (0.196e-3 + 20e-6 * (1.0 + math.sqrt(8e7 / 5e7)))
     assert json.loads(out)["sliding_friction_j"] == pytest.approx(60.0 * path, rel=1e-9)
+
+
+# ---- issue 16: no traceback for any input ----------------------------------------------------
+
+
+def _inputs(tmp_path: Path) -> dict[str, Path]:
+    """A folder, a missing path, an empty file, a binary file and files of the wrong kind."""
+    folder = tmp_path / "a-folder"
+    folder.mkdir()
+    (tmp_path / "empty.toml").write_bytes(b"")
+    (tmp_path / "binary.toml").write_bytes(bytes(range(256)) * 4)
+    (tmp_path / "record.toml").write_text("time [s],force [N],displacement [m]\n0,0,0\n")
+    (tmp_path / "study.csv").write_text('[joint]\nmass = "2kg"\n')
+    return {
+        "folder": folder,
+        "missing": tmp_path / "no-such-file",
+        "empty": tmp_path / "empty.toml",
+        "binary": tmp_path / "binary.toml",
+        "wrong kind": tmp_path / "record.toml",
+        "wrong kind for records": tmp_path / "study.csv",
+    }
+
+
+def _command(name: str, path: Path, out: Path) -> list[str]:
+    return {
+        "simulate": ["simulate", str(path)],
+        "dissipation": ["dissipation", "--study", str(path), "--amplitude", "5um"],
+        "rig": ["rig", str(path), "--out", str(out), "--quiet"],
+        "reproduce": ["reproduce", "--campaign", str(path), "--out", str(out)],
+        "identify": ["identify", str(path), "--out", str(out / "r.csv"), "--quiet"],
+        "report": ["report", "--records", str(path), "--out", str(out)],
+    }[name]
+
+
+@pytest.mark.parametrize(
+    "command", ["simulate", "dissipation", "rig", "reproduce", "identify", "report"]
+)
+@pytest.mark.parametrize("case", ["folder", "missing", "empty", "binary", "wrong kind"])
+def test_every_command_says_what_and_where_in_one_line_for_bad_input(
+    command: str, case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    inputs = _inputs(tmp_path)
+    if command == "identify" and case == "wrong kind":
+        case = "wrong kind for records"
+    path = inputs[case]
+    # report wants a folder: the folder case is an empty one, the others are not folders
+    code, out, err = run(_command(command, path, tmp_path / "out"), capsys)
+    assert code == 2, (out, err)
+    assert "Traceback" not in err
+    lines = [line for line in err.splitlines() if line.strip() and not line.startswith("- ")]
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"clearjoint {command}: error: ")
+    assert str(path) in lines[0]
+
+
+@pytest.mark.parametrize("command", ["rig", "simulate", "identify"])
+def test_an_output_path_under_a_file_is_one_line(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("x")
+    study = str(Path(__file__).resolve().parents[1] / "examples" / "study.toml")
+    args = {
+        "rig": ["rig", "--out", str(blocker / "records"), "--quiet"],
+        "simulate": ["simulate", study, "--out", str(blocker / "x.nc")],
+        "identify": ["identify", study, "--out", str(blocker / "r.csv"), "--quiet"],
+    }[command]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1
+    assert str(blocker) in err

@@ -453,6 +453,7 @@ def _run_identify(args: argparse.Namespace) -> int:
     if not 0.0 < args.tolerance < 1.0:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
     refuse_to_overwrite([out], force=args.force)
+    out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
     if args.quiet:
         results, failures = identify_files(
             args.files, resample=args.resample, tolerance=args.tolerance
@@ -468,6 +469,8 @@ def _run_identify(args: argparse.Namespace) -> int:
                 tolerance=args.tolerance,
                 progress=lambda done, _total: bar.update(task, completed=done),
             )
+    if not results and len(failures) == 1:
+        raise ParameterError(failures[0])  # one file, one line
     for line in failures:
         print(f"not used: {line}", file=sys.stderr)
     if not results:
@@ -535,6 +538,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
         from clearjoint._checks import refuse_to_overwrite
 
         refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     motion = run_study(study)
     result = summary(study, motion)
     if args.out:
@@ -588,8 +592,14 @@ def _run_reproduce(args: argparse.Namespace) -> int:
 
 
 def _run_report(args: argparse.Namespace) -> int:
+    from clearjoint.records import RecordError
     from clearjoint.report import report_records
 
+    folder = Path(args.records)
+    if not folder.exists():
+        raise RecordError(f"{folder}: no such folder; give --records a folder of record files")
+    if not folder.is_dir():
+        raise RecordError(f"{folder}: not a folder; give --records a folder of record files")
     written = report_records(
         Path(args.records),
         Path(args.out),
@@ -618,4 +628,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return runners[args.command](args)
     except ClearjointError as exc:
         print(f"clearjoint {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except OSError as exc:  # a path the readers and writers did not check themselves
+        where = f"{exc.filename}: " if exc.filename else ""
+        reason = exc.strerror or str(exc)
+        print(
+            f"clearjoint {args.command}: error: {where}{reason.lower()}; check the path",
+            file=sys.stderr,
+        )
         return EXIT_BAD_INPUT

@@ -543,6 +543,8 @@ def sniff(path: str | Path) -> str:
         raise RecordError(f"{where}: no such file") from None
     except IsADirectoryError:
         raise RecordError(f"{where}: is a folder, not a record file") from None
+    except OSError as exc:
+        raise RecordError(f"{where}: cannot read it ({exc.strerror})") from None
     if not head:
         raise RecordError(f"{where}: empty file")
     if head.startswith(_HDF5):
