@@ -133,7 +133,9 @@ def _simulate_parser(sub: Any) -> None:
         ),
     )
     p.add_argument("study", help="study file (TOML)")
-    p.add_argument("--out", help="write the result to this netCDF file (.nc)")
+    p.add_argument(
+        "--out", help="write the motion as a test record to this netCDF file (.nc; see records)"
+    )
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
 
@@ -537,6 +539,10 @@ def _run_simulate(args: argparse.Namespace) -> int:
     if args.out:
         from clearjoint._checks import refuse_to_overwrite
 
+        if Path(args.out).suffix.lower() != ".nc":
+            raise ParameterError(
+                f"--out {args.out}: simulate writes netCDF; name the file .nc, e.g. result.nc"
+            )
         refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     motion = run_study(study)

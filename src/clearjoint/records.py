@@ -414,23 +414,50 @@ def _text(value: Any) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _write_netcdf(record: Record, path: Path) -> None:
+def record_dataset(time: ArrayLike, channels: dict[str, Any], metadata: dict[str, Any]) -> Any:
+    """Return the one netCDF layout of a time record, as an xarray Dataset (not validated).
+
+    Every time record the package writes (``write_record``, ``clearjoint simulate
+    --out``) goes through here, so that ``read_record`` and ``clearjoint identify``
+    read them all.
+
+    Parameters
+    ----------
+    time : (N,) array_like
+        Sample times, s.
+    channels : dict
+        Channel name of :data:`CHANNELS` -> (N,) array in SI (None: not measured).
+    metadata : dict
+        Record metadata by field name (``clearance``, ``mass``, ``frequency_hz``...).
+
+    Returns
+    -------
+    xarray.Dataset
+        Variables ``force``, ``displacement``... on ``time``, each with ``units``;
+        metadata as global attributes ``clearance_m``, ``mass_kg``... Callers may add
+        variables on other dimensions (a simulation adds its stages and impacts).
+    """
     import xarray as xr
 
+    unknown = sorted(set(channels) - set(CHANNELS))
+    if unknown:
+        raise RecordError(f"unknown channel(s) {unknown}; a record has {', '.join(CHANNELS)}")
     variables = {
-        name: ("time", getattr(record, name), {"units": SI[name]})
+        name: ("time", np.asarray(channels[name], dtype=np.float64), {"units": SI[name]})
         for name in CHANNELS
-        if getattr(record, name) is not None
+        if channels.get(name) is not None
     }
     attrs: dict[str, Any] = {"clearjoint_record": 1}
-    meta = record.metadata()
     for attr, key in _NC_META.items():
-        if meta.get(key) not in (None, ""):
-            attrs[attr] = meta[key]
-    data = xr.Dataset(
-        variables, coords={"time": ("time", record.time, {"units": "s"})}, attrs=attrs
-    )
-    data.to_netcdf(path, engine="h5netcdf")
+        if metadata.get(key) not in (None, ""):
+            attrs[attr] = metadata[key]
+    coords = {"time": ("time", np.asarray(time, dtype=np.float64), {"units": "s"})}
+    return xr.Dataset(variables, coords=coords, attrs=attrs)
+
+
+def _write_netcdf(record: Record, path: Path) -> None:
+    channels = {name: getattr(record, name) for name in CHANNELS}
+    record_dataset(record.time, channels, record.metadata()).to_netcdf(path, engine="h5netcdf")
 
 
 # ---- the BRFD data set --------------------------------------------------------------------

@@ -60,6 +60,7 @@ DEFAULT_STUDY: dict[str, dict[str, tuple[Any, str]]] = {
     },
     "output": {
         "samples_per_period": (256, "count"),
+        "periods": (8, "count"),  # forcing periods a steady state writes to --out
     },
 }
 
@@ -85,6 +86,7 @@ class Study:
     contact_friction_coefficient: float
     samples_per_period: int
     source: str
+    periods: int = 8
 
 
 def load_study(path: str | Path) -> Study:
@@ -167,6 +169,9 @@ def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -
             poisson_ratio=pv["poisson_ratio"],
         )
     samples = values["output"]["samples_per_period"]
+    periods = values["output"]["periods"]
+    if periods < 1:
+        raise StudyError(f"{where}: [output] periods must be >= 1, got {periods}")
     return Study(
         joint=joint,
         force_amplitude=ex["force_amplitude"],
@@ -181,6 +186,7 @@ def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -
         contact_friction_coefficient=losses["contact_friction_coefficient"],
         samples_per_period=samples,
         source=where,
+        periods=periods,
     )
 
 
@@ -228,44 +234,72 @@ def summary(study: Study, motion: Motion) -> dict[str, Any]:
 
 
 def write_netcdf(study: Study, motion: Motion, path: str | Path, *, force: bool = False) -> Path:
-    """Write the motion, its stages, impacts and ledger to netCDF (xarray, h5netcdf engine).
+    """Write the motion as a test record (the one netCDF layout of ``clearjoint.records``).
+
+    The record's ``force`` is the excitation F0 sin(w t) on the mass, its control is
+    force and its metadata (mass, clearance, force amplitude, frequency) are the
+    study's, so ``read_record`` and ``clearjoint identify`` read the file. A steady
+    state is periodic: its exact orbit is repeated to cover ``study.periods`` forcing
+    periods. Beside the record: ``restoring_force`` on ``time``, the first orbit's
+    stages on ``stage`` and impacts on ``impact``, and the study, losses and energy
+    ledger as attributes.
 
     Raises
     ------
-    FileExistsError (a ClearjointError)
+    OutputExistsError (a ClearjointError)
         ``path`` exists and ``force`` is False.
+    StudyError
+        ``path`` does not end in .nc.
     """
-    import xarray as xr
+    from clearjoint.records import record_dataset
 
     path = Path(path)
+    if path.suffix.lower() != ".nc":
+        raise StudyError(f"{path}: a simulation is written as netCDF; name the file .nc")
     refuse_to_overwrite([path], force=force)
     joint = study.joint
-    stage_names = np.array([s.name for s in motion.stages], dtype=object)
-    data = xr.Dataset(
+    time = motion.time
+    series = {
+        "displacement": motion.displacement,
+        "velocity": motion.velocity,
+        "acceleration": motion.acceleration,
+        "force": motion.excitation,
+        "restoring_force": motion.restoring_force,
+    }
+    if isinstance(motion, SteadyState):
+        orbit = motion.period  # the whole orbit: period_multiple forcing periods
+        repeats = max(1, math.ceil(study.periods / motion.period_multiple))
+        time = np.concatenate([time + k * orbit for k in range(repeats)])
+        series = {name: np.tile(values, repeats) for name, values in series.items()}
+    restoring = series.pop("restoring_force")
+    data = record_dataset(
+        time,
+        series,
         {
-            "displacement": ("time", motion.displacement, {"units": "m"}),
-            "velocity": ("time", motion.velocity, {"units": "m/s"}),
-            "acceleration": ("time", motion.acceleration, {"units": "m/s^2"}),
-            "excitation_force": ("time", motion.excitation, {"units": "N"}),
-            "restoring_force": ("time", motion.restoring_force, {"units": "N"}),
-            "stage_name": ("stage", stage_names.astype(str)),
-            "stage_start": ("stage", np.array([s.start for s in motion.stages]), {"units": "s"}),
-            "stage_end": ("stage", np.array([s.end for s in motion.stages]), {"units": "s"}),
-            "impact_time": ("impact", motion.impact_times, {"units": "s"}),
-            "impact_velocity": ("impact", motion.impact_velocities, {"units": "m/s"}),
+            "joint_id": "simulation",
+            "control": "force",
+            "notes": f"clearjoint simulate {study.source} ({study.mode})",
+            "clearance": joint.clearance,
+            "force_amplitude": study.force_amplitude,
+            "frequency_hz": study.omega / (2.0 * math.pi),
+            "mass": joint.mass,
         },
-        coords={"time": ("time", motion.time, {"units": "s"})},
-        attrs={
+    )
+    stage_names = np.array([s.name for s in motion.stages], dtype=object)
+    data["restoring_force"] = ("time", restoring, {"units": "N"})
+    data["stage_name"] = ("stage", stage_names.astype(str))
+    data["stage_start"] = ("stage", np.array([s.start for s in motion.stages]), {"units": "s"})
+    data["stage_end"] = ("stage", np.array([s.end for s in motion.stages]), {"units": "s"})
+    data["impact_time"] = ("impact", motion.impact_times, {"units": "s"})
+    data["impact_velocity"] = ("impact", motion.impact_velocities, {"units": "m/s"})
+    data.attrs.update(
+        {
             "title": "clearjoint simulation",
             "study": study.source,
-            "mass_kg": joint.mass,
-            "clearance_m": joint.clearance,
             "compression_stiffness_n_per_m": joint.compression_stiffness,
             "tension_stiffness_n_per_m": joint.tension_stiffness,
             "gap_stiffness_n_per_m": joint.gap_stiffness,
             "gap_offset_m": joint.gap_offset,
-            "force_amplitude_n": study.force_amplitude,
-            "frequency_hz": study.omega / (2.0 * math.pi),
             "damping_ratio": study.damping_ratio,
             "restitution": study.restitution,
             "friction_force_n": study.friction.force if study.friction else 0.0,
@@ -275,7 +309,7 @@ def write_netcdf(study: Study, motion: Motion, path: str | Path, *, force: bool 
                 for key, val in summary(study, motion).items()
                 if isinstance(val, int | float) and not isinstance(val, bool)
             },
-        },
+        }
     )
     path.parent.mkdir(parents=True, exist_ok=True)
     data.to_netcdf(path, engine="h5netcdf")
