@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 import math
 import re
-import tomllib
+import tokenize
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -220,7 +220,7 @@ def _factor(where: str, channel: str, unit: str) -> float:
             f"{where}: {channel} is in {unit!r}, which is not a unit of {target}; "
             "fix the unit in the file"
         ) from None
-    except (pint.errors.PintError, ValueError, AttributeError, TypeError):
+    except (pint.errors.PintError, ValueError, AttributeError, TypeError, tokenize.TokenError):
         raise RecordError(
             f"{where}: unknown unit {unit!r} for {channel}; write a unit such as {target}"
         ) from None
@@ -263,59 +263,261 @@ def _metadata_from_toml(where: str, table: dict[str, Any]) -> dict[str, Any]:
     return {("frequency_hz" if key == "frequency" else key): val for key, val in values.items()}
 
 
-def _read_csv(path: Path, resample_: bool) -> Record:
-    import pandas as pd
+_DELIMITERS = ("\t", ";", ",")
+_COMMENT = re.compile(r"^\s*(#|//|;|%|!)")
+_KEY_VALUE = re.compile(r"^\s*(?P<key>[^:=,;\t]+?)\s*[:=,;\t]\s*(?P<value>.*)$")
+_NAME_UNIT = re.compile(
+    r"^\s*(?P<name>[A-Za-z][A-Za-z _]*?)\s*(?:[\[(](?P<unit>[^\])]*)[\])])?\s*$"
+)
+#: Rows a block must hold to count as the data (and not a preamble line of numbers).
+_DATA_ROWS = 4
+#: The data must start within this many lines (a DAQ preamble is a few dozen).
+_PREAMBLE_LINES = 1000
 
-    where = str(path)
-    header: list[str] = []
-    with path.open(encoding="utf-8") as handle:
-        first = handle.readline()
-        if first.strip() == CSV_MAGIC:
-            for line in handle:
-                if not line.startswith("#"):
-                    break
-                header.append(line[1:].strip())
-    skip = len(header) + 1 if header else 0
-    if header:
+
+def _decode(where: str, data: bytes) -> str:
+    """A lab file's text: UTF-8 (with or without a BOM), else Latin-1 (Windows DAQ software)."""
+    if b"\x00" in data[:4096]:
+        raise RecordError(f"{where}: a binary file of unknown format; not a record")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
+def _fields(line: str, delimiter: str) -> list[str]:
+    return [field.strip().strip('"').strip() for field in line.rstrip("\r\n").split(delimiter)]
+
+
+def _numbers(fields: list[str], decimal_comma: bool) -> bool:
+    try:
+        for field in fields:
+            float(field.replace(",", ".") if decimal_comma else field)
+    except ValueError:
+        return False
+    return True
+
+
+def _data_start(lines: list[str], delimiter: str) -> tuple[int, int] | None:
+    """Index of the first line of the numeric block under ``delimiter`` and its width."""
+    comma = delimiter != ","
+    for i, line in enumerate(lines[:_PREAMBLE_LINES]):
+        if delimiter not in line:
+            continue
+        fields = _fields(line, delimiter)
+        if len(fields) < 2 or not _numbers(fields, comma):
+            continue
+        following = [x for x in lines[i : i + 3 * _DATA_ROWS] if x.strip()][:_DATA_ROWS]
+        rows = [_fields(x, delimiter) for x in following]
+        if all(len(r) == len(fields) and _numbers(r, comma) for r in rows):
+            return i, len(fields)
+    return None
+
+
+def _units_row(fields: list[str]) -> bool:
+    """True when every field reads as a unit and none as a channel name."""
+    import pint
+
+    ureg = registry()
+    for cell in fields:
+        text = cell.strip("[]() ")
+        if text.lower() in SI:
+            return False
         try:
-            meta = _metadata_from_toml(where, tomllib.loads("\n".join(header)))
-        except tomllib.TOMLDecodeError as exc:
-            raise RecordError(
-                f"{where}: the header block is not key = value lines ({exc})"
-            ) from None
+            ureg.Unit(text)
+        except (pint.errors.PintError, ValueError, AttributeError, TypeError, SyntaxError):
+            return False
+        except tokenize.TokenError:  # unbalanced brackets: a name such as "force (N"
+            return False
+    return True
+
+
+def _resolution(texts: list[str]) -> float:
+    """The clock's resolution implied by how time stamps are written: 10^-decimals."""
+    decimals = 0
+    for text in texts:
+        mantissa, _, exponent = text.lower().replace(",", ".").partition("e")
+        places = len(mantissa.partition(".")[2]) - (int(exponent) if exponent else 0)
+        decimals = max(decimals, places)
+    return 10.0 ** (-decimals)
+
+
+def regular_time(time: FloatArray, resolution: float) -> tuple[FloatArray, float]:
+    """A uniform clock t0 + i dt fitted to time stamps rounded to ``resolution``.
+
+    Stamps of a uniform clock rounded to its resolution (12 kHz written to 1 us)
+    have steps that differ by up to the resolution: that is rounding, not uneven
+    sampling. Returns the fitted uniform times and the largest distance of a stamp
+    from them; the caller accepts the fit only when that distance is within the
+    resolution.
+    """
+    index = np.arange(time.size, dtype=np.float64)
+    slope, intercept = np.polyfit(index, time, 1)
+    uniform = intercept + slope * index
+    return uniform, float(np.max(np.abs(time - uniform)))
+
+
+def _read_csv(path: Path, resample_: bool) -> Record:
+    """Read a CSV record: clearjoint's own layout or a lab file (docs/records.md).
+
+    Tolerated: the delimiter (comma, semicolon, tab; sniffed), a decimal comma (with a
+    semicolon or tab delimiter), a preamble of comment or key-value lines above the
+    column names, units in the names (``time [s]``, ``Force (kN)``) or in a row under
+    them, and time stamps rounded to the clock's resolution.
+    """
+    where = str(path)
+    lines = _decode(where, path.read_bytes()).splitlines()
+    meta: dict[str, Any] = {}
+    body = 0
+    if lines and lines[0].strip() == CSV_MAGIC:
+        body = 1
+        while body < len(lines) and lines[body].startswith("#"):
+            body += 1
+        block = [line[1:].strip() for line in lines[1:body]]
+        from clearjoint.io_toml import parse_toml
+
+        table = parse_toml("\n".join(block), where=where, what="record header", error=RecordError)
+        meta = _metadata_from_toml(where, table)
     else:
         sidecar = path.with_suffix(".toml")
-        if not sidecar.exists():
-            meta = {}
-        else:
-            try:
-                table = tomllib.loads(sidecar.read_text(encoding="utf-8"))
-            except tomllib.TOMLDecodeError as exc:
-                raise RecordError(f"{sidecar}: not valid TOML ({exc})") from None
+        if sidecar.exists():
+            from clearjoint.io_toml import read_toml
+
+            table = read_toml(sidecar, what="record metadata", error=RecordError)
             meta = _metadata_from_toml(str(sidecar), table.get("record", table))
-    try:
-        frame = pd.read_csv(path, skiprows=skip, skipinitialspace=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise RecordError(f"{where}: not a readable CSV file ({exc})") from None
-    columns: dict[str, FloatArray] = {}
-    units: dict[str, str] = {}
-    for column in frame.columns:
-        match = _COLUMN.match(str(column))
-        if not match:
+    found = {d: _data_start(lines[body:], d) for d in _DELIMITERS}
+    candidates = [(hit[1], d) for d, hit in found.items() if hit is not None]
+    if not candidates:
+        _no_numbers(where, lines[body:], body)
+        raise RecordError(
+            f"{where}: no block of numbers found; a CSV record has columns time, force and "
+            "displacement separated by commas, semicolons or tabs"
+        )
+    _, delimiter = max(candidates)
+    start, width = found[delimiter]  # type: ignore[misc]
+    start += body
+    above = [i for i in range(body, start) if lines[i].strip()]
+    if not above:
+        raise RecordError(
+            f"{where}: no column names above the numbers; name them like "
+            "'time [s]', 'force [N]', 'displacement [mm]'"
+        )
+    header_at = above.pop()
+    unit_fields: list[str] | None = None
+    if _units_row(_fields(lines[header_at], delimiter)) and above:
+        unit_fields = _fields(lines[header_at], delimiter)
+        header_at = above.pop()
+    names = _fields(lines[header_at], delimiter)
+    if len(names) != width or (unit_fields is not None and len(unit_fields) != width):
+        raise RecordError(
+            f"{where}: line {header_at + 1} names {len(names)} columns but the numbers under "
+            f"it have {width}; check the delimiter {delimiter!r} and the column names"
+        )
+    notes = []
+    for i in above:
+        line = lines[i]
+        if _COMMENT.match(line):
+            continue
+        pair = _KEY_VALUE.match(line)
+        if not pair or not pair["value"].strip():
             raise RecordError(
-                f"{where}: column {column!r} has no unit; name columns like "
-                "'time [s]', 'force [N]', 'displacement [mm]'"
+                f"{where}: line {i + 1} ({line.strip()[:40]!r}) above the column names is "
+                "neither a comment (#, //) nor a key and value; remove it or comment it out"
             )
-        name, unit = match["name"].lower(), match["unit"]
+        notes.append(f"{pair['key'].strip()}: {pair['value'].strip().strip(chr(34))}")
+    if notes:
+        preamble = "; ".join(notes)
+        meta["notes"] = f"{meta['notes']}; {preamble}" if meta.get("notes") else preamble
+    channels: list[tuple[str, str]] = []
+    for k, name_text in enumerate(names):
+        match = _NAME_UNIT.match(name_text)
+        if not match:
+            raise RecordError(f"{where}: cannot read the column name {name_text!r}")
+        name = match["name"].strip().lower().replace(" ", "_")
+        unit = (match["unit"] or "").strip()
+        if unit_fields is not None and not unit:
+            unit = unit_fields[k].strip("[]() ")
         if name not in SI:
             raise RecordError(f"{where}: unknown column {name!r}; known: {', '.join(SI)}")
-        try:
-            values = frame[column].to_numpy(dtype=np.float64)
-        except (TypeError, ValueError):
-            raise RecordError(f"{where}: column {column!r} is not numeric") from None
-        columns[name] = values * _factor(where, name, unit)
+        if not unit:
+            raise RecordError(
+                f"{where}: column {name_text!r} has no unit; name columns like "
+                "'time [s]', 'force [N]', 'displacement [mm]', or put a row of units under them"
+            )
+        channels.append((name, unit))
+    import io
+
+    import pandas as pd
+
+    rows = lines[start:]
+    try:
+        frame = pd.read_csv(
+            io.StringIO("\n".join(rows)),
+            sep=delimiter,
+            header=None,
+            decimal="," if delimiter != "," and "," in lines[start] else ".",
+            skipinitialspace=True,
+            dtype=np.float64,
+        )
+    except (ValueError, pd.errors.ParserError) as exc:
+        raise RecordError(f"{where}: a column is not numeric ({exc})") from None
+    table_ = frame.to_numpy(dtype=np.float64)
+    if table_.shape[1] != width:
+        raise RecordError(f"{where}: rows of {table_.shape[1]} values under {width} column names")
+    columns: dict[str, FloatArray] = {}
+    units: dict[str, str] = {}
+    for k, (name, unit) in enumerate(channels):
+        columns[name] = table_[:, k] * _factor(where, name, unit)
         units[name] = unit
+    if "time" in columns:
+        columns["time"] = _clock(where, columns["time"], rows, delimiter, channels, resample_)
     return _assemble(where, columns, units, meta, resample_)
+
+
+def _no_numbers(where: str, lines: list[str], offset: int) -> None:
+    """Raise the error for column names over rows that are not all numbers, if so."""
+    for delimiter in _DELIMITERS:
+        for i, line in enumerate(lines[:_PREAMBLE_LINES]):
+            fields = _fields(line, delimiter)
+            matches = [_NAME_UNIT.match(f) for f in fields]
+            if len(fields) >= 2 and all(m and m["name"].strip().lower() in SI for m in matches):
+                below = [(j, x) for j, x in enumerate(lines[i + 1 :], start=i + 1) if x.strip()]
+                if below:
+                    j, row = below[0]
+                    if _units_row(_fields(row, delimiter)) and len(below) > 1:
+                        j, row = below[1]
+                    raise RecordError(
+                        f"{where}: the rows under the column names are not numeric "
+                        f"(line {offset + j + 1}: {row.strip()[:40]!r})"
+                    )
+
+
+def _clock(
+    where: str,
+    time: FloatArray,
+    rows: list[str],
+    delimiter: str,
+    channels: list[tuple[str, str]],
+    resample_: bool,
+) -> FloatArray:
+    """The time column, made uniform when its steps differ only by the stamps' rounding."""
+    step = np.diff(time)
+    if step.size == 0 or np.any(step <= 0.0) or resample_:
+        return time
+    if np.ptp(step) <= UNIFORM_TOLERANCE * np.mean(step):
+        return time
+    k = [name for name, _ in channels].index("time")
+    factor = _factor(where, "time", channels[k][1])
+    stamps = [_fields(row, delimiter)[k] for row in rows if row.strip()]
+    resolution = _resolution(stamps) * factor
+    uniform, stray = regular_time(time, resolution)
+    if stray <= resolution:
+        return uniform
+    raise RecordError(
+        f"{where}: not uniformly sampled: time stamps stray up to {stray:.3g} s from a uniform "
+        f"clock, beyond their resolution {resolution:.3g} s; read it with resample=True "
+        "(--resample) to interpolate onto a uniform grid"
+    )
 
 
 def _assemble(
