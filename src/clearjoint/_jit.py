@@ -15,21 +15,32 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
-from typing import Any
+from typing import Any, TypeVar, overload
 
 from numba import njit as _njit
 
 _warned = False
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 
 class CacheWarning(UserWarning):
     """numba found nowhere writable for its cache: the kernels compile on every run."""
 
 
+@overload
+def njit(function: F, /) -> F: ...
+
+
+@overload
+def njit(*, cache: bool = False, **options: Any) -> Callable[[F], F]: ...
+
+
 def njit(*args: Any, cache: bool = False, **options: Any) -> Any:
     """``numba.njit``, with ``cache=True`` falling back to no disk cache where none is writable.
 
-    Used exactly as ``numba.njit``: ``@njit``, ``@njit(cache=True)``.
+    Used exactly as ``numba.njit``: ``@njit``, ``@njit(cache=True)``. For type checkers
+    the compiled function keeps the Python function's signature.
     """
 
     def decorate(function: Callable[..., Any]) -> Any:
