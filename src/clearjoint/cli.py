@@ -472,7 +472,7 @@ def _run_identify(args: argparse.Namespace) -> int:
                 progress=lambda done, _total: bar.update(task, completed=done),
             )
     if not results and len(failures) == 1:
-        raise ParameterError(failures[0])  # one file, one line
+        raise ParameterError(f"no record could be used: {failures[0]}")  # one file, one line
     for line in failures:
         print(f"not used: {line}", file=sys.stderr)
     if not results:
