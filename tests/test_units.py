@@ -110,3 +110,20 @@ def test_the_simulator_takes_a_frequency_in_hz_for_omega() -> None:
     si = steady_state(joint, 1000.0, 2.0 * math.pi * 400.0, damping_ratio=0.02)
     united = steady_state(joint, "1kN", "400Hz", damping_ratio=0.02)
     assert united.amplitude == pytest.approx(si.amplitude, rel=1e-12)
+
+
+def test_sweeps_and_records_take_units_too() -> None:
+    from clearjoint.records import Record
+    from clearjoint.simulate import frequency_sweep
+
+    joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    hz = registry().Quantity(np.array([390.0, 400.0]), "Hz")
+    united = frequency_sweep(joint, "1kN", hz, damping_ratio=0.02, direction="up")
+    si = frequency_sweep(
+        joint, 1000.0, 2 * math.pi * np.array([390.0, 400.0]), damping_ratio=0.02, direction="up"
+    )
+    np.testing.assert_allclose(united.omega, si.omega, rtol=1e-12)
+    np.testing.assert_allclose(united.amplitude_up, si.amplitude_up, rtol=1e-12)
+    t = np.arange(100) / 100.0
+    record = Record(time=t, force=t, displacement=t, clearance="0.1mm", mass="1500g")
+    assert (record.clearance, record.mass) == pytest.approx((1e-4, 1.5))

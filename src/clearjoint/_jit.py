@@ -56,7 +56,7 @@ def njit(*args: Any, cache: bool = False, **options: Any) -> Any:
                 _warned = True
                 warnings.warn(
                     "clearjoint: numba has no writable cache folder, so the simulation kernels "
-                    "compile on every run (about 10 s); set NUMBA_CACHE_DIR to a writable folder",
+                    "compile on every run; set NUMBA_CACHE_DIR to a writable folder",
                     CacheWarning,
                     stacklevel=2,
                 )

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError
-from clearjoint.units import SI_UNITS, registry
+from clearjoint.units import SI_UNITS, registry, to_si
 
 FloatArray = NDArray[np.float64]
 
@@ -43,6 +43,14 @@ UNIFORM_TOLERANCE = 1e-4
 #: Cycles a record must span when its frequency is known.
 MIN_CYCLES = 3
 MIN_SAMPLES = 16
+#: The SI unit of each metadata quantity (a pint Quantity or "0.1mm" is converted to it).
+_META_SI = {
+    "clearance": "m",
+    "force_amplitude": "N",
+    "displacement_amplitude": "m",
+    "frequency_hz": "Hz",
+    "mass": "kg",
+}
 
 
 class RecordError(ClearjointError, ValueError):
@@ -142,7 +150,10 @@ class Record:
             value = getattr(self, name)
             if value is None:
                 continue
-            number = float(value)
+            try:
+                number = float(to_si(value, _META_SI[name], name=f"{where}: {name}"))
+            except (TypeError, ValueError) as exc:
+                raise RecordError(f"{where}: {name} must be a number, got {value!r}") from exc
             if not math.isfinite(number) or number < 0.0:
                 raise RecordError(f"{where}: {name} must be finite and >= 0, got {value!r}")
             set_(self, name, number)
