@@ -466,7 +466,7 @@ def _read_csv(path: Path, resample_: bool) -> Record:
             io.StringIO("\n".join(rows)),
             sep=delimiter,
             header=None,
-            decimal="," if delimiter != "," and "," in lines[start] else ".",
+            decimal="," if delimiter != "," and any("," in r for r in rows[:100]) else ".",
             skipinitialspace=True,
             dtype=np.float64,
         )
