@@ -24,11 +24,17 @@ from clearjoint.units import parse_quantity, parse_quantity_list, registry, to_s
         ("80 kN/mm", "stiffness", 8e7),
         ("1.5kg", "mass", 1.5),
         ("20Hz", "frequency", 20.0),
-        ("3", "length", 3.0),
+        ("0", "length", 0.0),  # zero needs no unit
     ],
 )
 def test_parses_to_si(text: str, kind: str, si: float) -> None:
     assert parse_quantity(text, kind, name="--x") == pytest.approx(si, rel=1e-12)
+
+
+def test_bare_numbers_are_si_only_when_asked() -> None:
+    assert parse_quantity("3", "length", name="x", bare="si") == 3.0
+    with pytest.raises(ParameterError, match="give a unit"):
+        parse_quantity("3", "length", name="x")
 
 
 def test_wrong_dimension_names_the_option() -> None:

@@ -119,7 +119,7 @@ def _convert(quantity: Any, kind: str, name: str, raw: str) -> Any:
         ) from None
 
 
-def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "si") -> float:
+def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "refuse") -> float:
     """Return ``text`` (e.g. ``"0.106mm"``) as a float in the SI unit of ``kind``.
 
     Parameters
@@ -130,10 +130,10 @@ def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "si") -> flo
         A key of :data:`SI_UNITS`.
     name : str
         The option or key the text came from, for error messages.
-    bare : {"si", "refuse"}
-        What a number without a unit means: SI, or an error that shows how to
-        write it (``--clearance 0.106: give a unit, e.g. 0.106mm``). Dimensionless
-        kinds, and zero, always take bare numbers.
+    bare : {"refuse", "si"}
+        What a number without a unit means: by default an error that shows how to
+        write it (``--clearance 0.106: give a unit, e.g. 0.106mm``), or SI.
+        Dimensionless kinds, and zero, always take bare numbers.
 
     Returns
     -------
@@ -167,7 +167,7 @@ def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "si") -> flo
     return float(_convert(quantity, kind, name, raw))
 
 
-def parse_quantity_list(text: str, kind: str, *, name: str, bare: Bare = "si") -> list[float]:
+def parse_quantity_list(text: str, kind: str, *, name: str, bare: Bare = "refuse") -> list[float]:
     """Return a comma-separated list such as ``"1um,5um,20um"`` as SI floats."""
     parts = [part for part in text.split(",")]
     if not parts or any(not part.strip() for part in parts):
