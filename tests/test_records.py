@@ -300,11 +300,11 @@ def test_lab_csv_comma_with_a_bom_and_the_issue_rounding(tmp_path: Path) -> None
     check_lab_record(read_record(path))
 
 
-def test_lab_csv_tab_decimal_comma(tmp_path: Path) -> None:
-    lines = ["time [s]\tforce [kN]\tdisplacement [mm]"]
+def test_lab_csv_tab_decimal_comma_trailing_delimiter(tmp_path: Path) -> None:
+    lines = ["time [s]\tforce [kN]\tdisplacement [mm]\t"]
     for i in range(N_LAB):
         t, f, x = lab_signals(i)
-        lines.append(f"{t:.6f}\t{f:.6f}\t{x:.7f}".replace(".", ","))
+        lines.append(f"{t:.6f}\t{f:.6f}\t{x:.7f}\t".replace(".", ","))
     path = tmp_path / "lab.csv"
     path.write_text("\n".join(lines) + "\n")
     check_lab_record(read_record(path))

@@ -297,7 +297,9 @@ def _decode(where: str, data: bytes) -> str:
 
 
 def _fields(line: str, delimiter: str) -> list[str]:
-    return [field.strip().strip('"').strip() for field in line.rstrip("\r\n").split(delimiter)]
+    """The cells of one line, unquoted; a trailing delimiter (common in DAQ exports) ignored."""
+    cells = [cell.strip().strip('"').strip() for cell in line.rstrip("\r\n").split(delimiter)]
+    return cells[:-1] if len(cells) > 1 and not cells[-1] else cells
 
 
 def _numbers(fields: list[str], decimal_comma: bool) -> bool:
@@ -472,6 +474,8 @@ def _read_csv(path: Path, resample_: bool) -> Record:
         )
     except (ValueError, pd.errors.ParserError) as exc:
         raise RecordError(f"{where}: a column is not numeric ({exc})") from None
+    if frame.shape[1] == width + 1 and frame.iloc[:, -1].isna().all():
+        frame = frame.iloc[:, :-1]  # the empty cell after a trailing delimiter
     table_ = frame.to_numpy(dtype=np.float64)
     if table_.shape[1] != width:
         raise RecordError(f"{where}: rows of {table_.shape[1]} values under {width} column names")
@@ -816,11 +820,14 @@ def read_record(path: str | Path, *, resample: bool = False) -> Record:
     """
     path = Path(path)
     kind = sniff(path)
-    if kind == "netcdf":
-        return _read_netcdf(path, resample)
-    if kind == "json":
-        return read_brfd(path, resample=resample)
-    return _read_csv(path, resample)
+    try:
+        if kind == "netcdf":
+            return _read_netcdf(path, resample)
+        if kind == "json":
+            return read_brfd(path, resample=resample)
+        return _read_csv(path, resample)
+    except OSError as exc:  # truncated, or gone or locked between the sniff and the read
+        raise RecordError(f"{path}: cannot read it ({exc.strerror or exc})") from None
 
 
 def write_record(record: Record, path: str | Path, *, force: bool = False) -> Path:
