@@ -327,6 +327,7 @@ def test_uneven_beyond_the_clock_resolution_is_still_refused(tmp_path: Path) -> 
         ("Device;Rig A\nthis line is junk\ntime;force;displacement\ns;N;m\n", "line 2"),
         ("time;force;displacement\n", "has no unit"),
         ("time [s];force [N];displacement [m];velocity [m/s]\n", "names 4 columns"),
+        ("time [s];force [(];displacement [m]\n", "unknown unit '('"),  # pint asserted here
     ],
 )
 def test_lab_csv_problems_are_named(tmp_path: Path, text: str, words: str) -> None:
