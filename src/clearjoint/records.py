@@ -513,7 +513,7 @@ def _clock(
 ) -> FloatArray:
     """The time column, made uniform when its steps differ only by the stamps' rounding."""
     step = np.diff(time)
-    if step.size == 0 or np.any(step <= 0.0) or resample_:
+    if step.size == 0 or np.any(step <= 0.0):
         return time
     if np.ptp(step) <= UNIFORM_TOLERANCE * np.mean(step):
         return time
@@ -524,6 +524,8 @@ def _clock(
     uniform, stray = regular_time(time, resolution)
     if stray <= resolution:
         return uniform
+    if resample_:
+        return time  # uneven beyond the rounding: _assemble interpolates it
     raise RecordError(
         f"{where}: not uniformly sampled: time stamps stray up to {stray:.3g} s from a uniform "
         f"clock, beyond their resolution {resolution:.3g} s; read it with resample=True "
