@@ -22,7 +22,6 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 
 from clearjoint import _checks
 from clearjoint.errors import ParameterError
@@ -469,6 +468,8 @@ def equivalent_linear_response(
     grid = s_low + offsets
     values = residual(grid)
     signs = np.sign(values)
+    from scipy.optimize import brentq  # here, not at the top: it costs most of the start-up
+
     for i in np.nonzero(signs[:-1] * signs[1:] < 0.0)[0]:
         a, b = float(grid[i]), float(grid[i + 1])
         root = brentq(lambda s: float(residual(np.array([s]))[0]), a, b, xtol=1e-300, rtol=1e-15)

@@ -27,6 +27,7 @@ from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.joint import Friction, Joint, Pin
 from clearjoint.simulate import _kernel as kn
 from clearjoint.stiffness import viscous_coefficient
+from clearjoint.units import to_si
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -742,7 +743,7 @@ def frequency_sweep(
     ``omegas`` (rad/s) are sorted ascending; the down sweep visits them in reverse.
     A step with no steady state gives NaN rather than stopping the sweep.
     """
-    w = np.sort(np.atleast_1d(np.asarray(omegas, dtype=np.float64)))
+    w = np.sort(np.atleast_1d(np.asarray(to_si(omegas, "rad/s", name="omegas"), dtype=float)))
     if w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0.0):
         raise ParameterError("omegas must be a non-empty array of finite values > 0 (rad/s)")
     if direction not in ("up", "down", "both"):
