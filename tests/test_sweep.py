@@ -278,7 +278,7 @@ def test_a_stopped_sweep_resumes_with_only_the_missing_chunks(tmp_path: Path) ->
         (
             'base = "study.toml"\n[task]\nname = "energies"\namplitude = "1um"\n'
             "[axes.joint]\nclearance = [0.1]",
-            "needs a unit",
+            "give a unit",
         ),
         ('base = "study.toml"\n[task]\nname = "energies"\n[axes.joint]\nmass = ["1kg"]', "needs"),
         (

@@ -2,5 +2,5 @@
 
 from clearjoint.cli import main
 
-if __name__ == "__main__":  # not when a spawned worker (a Dask LocalCluster's) re-imports it
+if __name__ == "__main__":  # not when a tool or a spawned Dask worker merely imports it
     raise SystemExit(main())

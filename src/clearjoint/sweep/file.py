@@ -23,8 +23,9 @@ The format (docs/sweep.md; an example in examples/sweep.toml)::
     std = "0.02mm"
     lower = "0mm"                # truncate below (and/or upper = ...)
 
-Dimensional values need a unit (``"0.1mm"``); unknown keys are refused, as in study
-files. A normal draw that falls outside a parameter's range (a negative clearance)
+Dimensional values need a unit (``"0.1mm"``; a bare number only for zero or a
+dimensionless key), read by clearjoint.io_toml as in study files; unknown keys are
+refused. A normal draw that falls outside a parameter's range (a negative clearance)
 is refused unless the distribution is truncated there with ``lower``/``upper``: the
 truncated normal is then drawn exactly (by its inverse CDF), never clipped.
 """
@@ -42,9 +43,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import special
 
-from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.errors import ClearjointError
 from clearjoint.sweep.tasks import TASKS, Parameter, Task
-from clearjoint.units import parse_quantity
 
 FloatArray = NDArray[np.float64]
 
@@ -190,20 +190,10 @@ class Sweep:
 
 
 def _quantity(where: str, key: str, raw: Any, parameter: Parameter) -> float:
-    if parameter.kind == "dimensionless":
-        if isinstance(raw, bool) or not isinstance(raw, int | float | str):
-            raise SweepError(f"{where}: {key} must be a number, got {raw!r}")
-        return float(parse_quantity(str(raw), "dimensionless", name=f"{where}: {key}"))
-    if isinstance(raw, int | float):  # bool included
-        raise SweepError(
-            f'{where}: {key} = {raw!r} needs a unit; write it like "{raw}{parameter.unit}"'
-        )
-    if not isinstance(raw, str):
-        raise SweepError(f"{where}: {key} must be a quantity with a unit, got {raw!r}")
-    try:
-        return parse_quantity(raw, parameter.kind, name=f"{where}: {key}")
-    except ParameterError as exc:
-        raise SweepError(str(exc)) from None
+    """One value in SI, read as every clearjoint file reads it (clearjoint.io_toml)."""
+    from clearjoint.io_toml import quantity
+
+    return float(quantity(raw, parameter.kind, name=f"{where}: {key}", error=SweepError))
 
 
 def _check_range(where: str, key: str, values: FloatArray, p: Parameter, hint: str) -> None:
