@@ -36,6 +36,23 @@ from clearjoint.errors import ClearjointError, OutputExistsError, ParameterError
 if TYPE_CHECKING:
     from distributed import Client
 
+__all__ = [
+    "CONNECT_TIMEOUT_S",
+    "ChunkFailedError",
+    "Finished",
+    "ResultStore",
+    "Runner",
+    "SchedulerError",
+    "StoreError",
+    "Variable",
+    "chunk_bounds",
+    "dask_client",
+    "point_seed",
+    "process_pool",
+    "run_ordered",
+    "run_unordered",
+]
+
 A = TypeVar("A")
 R = TypeVar("R")
 

@@ -46,6 +46,13 @@ from scipy import special
 from clearjoint.errors import ClearjointError
 from clearjoint.sweep.tasks import TASKS, Parameter, Task
 
+__all__ = [
+    "Axis",
+    "Draw",
+    "Sweep",
+    "SweepError",
+]
+
 FloatArray = NDArray[np.float64]
 
 _TOP_KEYS = ("base", "seed", "samples", "chunk_size", "task", "axes", "draws")

@@ -14,6 +14,10 @@ import numpy as np
 
 from clearjoint.errors import ParameterError
 
+__all__ = [
+    "plot_sweep",
+]
+
 #: Display units for SI lengths and energies: (largest magnitude below which, unit, scale).
 _SCALES = {
     "m": [(1e-3, "um", 1e6), (1.0, "mm", 1e3)],

@@ -34,6 +34,12 @@ from clearjoint.parallel import (
 from clearjoint.sweep.file import Sweep
 from clearjoint.sweep.tasks import Task
 
+__all__ = [
+    "SERIAL",
+    "open_sweep",
+    "run_sweep",
+]
+
 #: Pass as ``client`` to run every chunk in this process, one after the other.
 SERIAL = "serial"
 

@@ -34,6 +34,17 @@ import numpy as np
 
 from clearjoint.errors import ParameterError
 
+__all__ = [
+    "FORCING_PARAMETERS",
+    "JOINT_PARAMETERS",
+    "TASKS",
+    "Parameter",
+    "RecordSet",
+    "Task",
+    "register_task",
+    "study_at",
+]
+
 
 @dataclass(frozen=True)
 class Parameter:
