@@ -80,33 +80,41 @@ def spin_sweep(points: int, cost_s: float, chunk_size: int) -> Sweep:
     )
 
 
+def _rate(sweep: Sweep, client: object) -> tuple[float, object]:
+    t0 = time.perf_counter()
+    result = run_sweep(sweep, client=client)
+    return sweep.n_points / (time.perf_counter() - t0), result.value.values
+
+
 def throughput() -> None:
-    cases = [(0.001, 2000, 100), (0.050, 120, 2)]
+    # chunks of 0.25-0.4 s of work: as docs/sweep.md advises, so that scheduling is amortised
+    cases = [(0.001, 4000, 250), (0.050, 160, 8)]
+    sweeps = [spin_sweep(points, cost, chunk) for cost, points, chunk in cases]
+    rates: dict[tuple[int, str], float] = {}
+    values: dict[tuple[int, str], object] = {}
+    for k, sweep in enumerate(sweeps):
+        rates[k, "serial"], values[k, "serial"] = _rate(sweep, SERIAL)
+    started = {}
+    for workers in (1, 2):  # one cluster at a time: an idle one would take CPU too
+        t0 = time.perf_counter()
+        with dask_client(workers=workers) as client:
+            started[workers] = time.perf_counter() - t0
+            for k, sweep in enumerate(sweeps):
+                rates[k, str(workers)], values[k, str(workers)] = _rate(sweep, client)
     print("points per second (higher is better); tasks spin on CPU time")
-    print(f"{'task':>8} {'serial':>10} {'1 worker':>10} {'2 workers':>10} {'2w/serial':>10}")
-    start = time.perf_counter()
-    with dask_client(workers=1) as one:
-        one_start = time.perf_counter() - start
-        start = time.perf_counter()
-        with dask_client(workers=2) as two:
-            two_start = time.perf_counter() - start
-            for cost, points, chunk in cases:
-                sweep = spin_sweep(points, cost, chunk)
-                rates = []
-                reference = None
-                for client in (SERIAL, one, two):
-                    t0 = time.perf_counter()
-                    result = run_sweep(sweep, client=client)
-                    rates.append(points / (time.perf_counter() - t0))
-                    if reference is None:
-                        reference = result.value.values
-                    # the same seeded numbers wherever they ran
-                    np.testing.assert_array_equal(result.value.values, reference)
-                print(
-                    f"{cost * 1e3:6.0f}ms {rates[0]:10.1f} {rates[1]:10.1f} {rates[2]:10.1f} "
-                    f"{rates[2] / rates[0]:9.2f}x"
-                )
-    print(f"cluster start-up: 1 worker {one_start:.1f} s, 2 workers {two_start:.1f} s")
+    print(
+        f"{'task':>8} {'chunk':>6} {'serial':>10} {'1 worker':>10} {'2 workers':>10} "
+        f"{'2w/serial':>10}"
+    )
+    for k, (cost, _, chunk) in enumerate(cases):
+        for where in ("1", "2"):  # the same seeded numbers wherever they ran
+            np.testing.assert_array_equal(values[k, where], values[k, "serial"])
+        serial, one, two = rates[k, "serial"], rates[k, "1"], rates[k, "2"]
+        print(
+            f"{cost * 1e3:6.0f}ms {chunk:6d} {serial:10.1f} {one:10.1f} {two:10.1f} "
+            f"{two / serial:9.2f}x"
+        )
+    print(f"cluster start-up: 1 worker {started[1]:.1f} s, 2 workers {started[2]:.1f} s")
     # the control: what two plain processes gain over one on this machine right now
     points = 60
     t0 = time.perf_counter()
@@ -123,6 +131,9 @@ def throughput() -> None:
         f"ProcessPoolExecutor(2) {points / two:.1f}/s, {serial / two:.2f}x"
     )
     print(f"load average while measuring: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    autogroup = Path("/proc/sys/kernel/sched_autogroup_enabled")
+    if autogroup.exists() and autogroup.read_text().strip() == "1":
+        print("kernel autogroup on: this session's processes share one session's CPU")
 
 
 RESTART_SWEEP = """
