@@ -1,6 +1,6 @@
 """Sweep throughput serial and on a Dask LocalCluster, and a SIGKILL-midway restart.
 
-Run on demand: ``python benchmarks/bench_sweep.py`` (about two minutes on 2 cores).
+Run on demand: ``python benchmarks/bench_sweep.py`` (3.5 minutes on 2 busy cores).
 Targets (issue 13): a LocalCluster of 2 workers at least 1.8x serial for tasks of
 about 50 ms; a sweep killed midway and resumed equal, bit for bit, to one run whole.
 
