@@ -19,8 +19,8 @@ from clearjoint.figures import (
     force_displacement_figure,
     stiffness_coefficient_figure,
 )
-from clearjoint.report import example_cycle, stiffness_study
 from clearjoint.simulate import SimulationError
+from clearjoint.verification import example_cycle, stiffness_study
 
 HERE = Path(__file__).parent / "figures"
 

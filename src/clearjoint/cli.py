@@ -497,7 +497,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
 def _run_reproduce(args: argparse.Namespace) -> int:
     import time
 
-    from clearjoint.report import reproduce
+    from clearjoint.reproduction import reproduce
 
     start = time.perf_counter()
     written = reproduce(
@@ -514,7 +514,7 @@ def _run_reproduce(args: argparse.Namespace) -> int:
 
 
 def _run_report(args: argparse.Namespace) -> int:
-    from clearjoint.report import report_records
+    from clearjoint.reproduction import report_records
 
     written = report_records(
         Path(args.records),

@@ -9,11 +9,15 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
+
+from clearjoint import fit
+from clearjoint.analysis import Analysis, tests_of
 
 #: Line styles that stay apart in grey print, cycled per curve.
 _STYLES: tuple[tuple[Any, str], ...] = (
@@ -451,3 +455,108 @@ def law_versus_measured_figure(
     ax.set_ylabel("predicted energy per cycle (J)")
     ax.legend(frameon=False, fontsize="small")
     return fig
+
+
+# ---- the report's figures from an analysis ------------------------------------------------
+
+
+def report_figures(
+    analysis: Analysis,
+    model_energy: Sequence[float] | None,
+    stiffness_curves: Sequence[Curve],
+) -> dict[str, Figure]:
+    """Return the report's figures (paper Figs. 7-13) by caption, from an analysis.
+
+    Parameters
+    ----------
+    analysis : Analysis
+        The identified tests and their fitted laws.
+    model_energy : sequence of float, optional
+        Section 2's energy at each jointed test (J), drawn in Fig. 13 when given.
+    stiffness_curves : sequence of Curve
+        Fig. 12's c_d curves.
+    """
+    rows = analysis.rows
+    out: dict[str, Figure] = {}
+    # Fig. 7: the first jointed record with its stages
+    for record, ident in analysis.identifications:
+        if ident.model != "line":
+            first = ident.cycles[-3] if len(ident.cycles) >= 3 else ident.cycles[0]
+            span = slice(first.start, ident.cycles[-1].stop)
+            runs = [
+                r
+                for r in ident.stage_runs(record.time)
+                if r[2] >= record.time[span.start] and r[1] <= record.time[span.stop - 1]
+            ]
+            out[f"Fig. 7: stages of {Path(ident.source).name}"] = displacement_stages_figure(
+                record.time[span], record.displacement[span], runs
+            )
+            break
+    panels = []
+    for label, law in analysis.stiffness_laws.items():
+        name, side = label.rsplit(", ", 1)
+        sel = tests_of(rows, name)
+        key_a = f"{side}_penetration_m" if sel and sel[0]["jointed"] else "amplitude_m"
+        freq = np.array([r["test_frequency_hz"] for r in sel])
+        amp = np.array([r[key_a] for r in sel])
+        k = np.array([r[f"{side}_stiffness_n_per_m"] for r in sel])
+        grid = np.linspace(amp.min(), amp.max(), 20)
+        lines = {
+            f: (grid, fit.evaluate_stiffness_law(law, 2 * math.pi * f * np.ones_like(grid), grid))
+            for f in sorted(set(freq.tolist()))
+        }
+        panels.append(StiffnessPanel(label, freq, amp, k, lines))
+    if panels:
+        out["Fig. 8: stiffness with the eq 19 planes"] = stiffness_panels_figure(
+            panels, ylabel="stiffness (MN/m)"
+        )
+    if analysis.normalised:
+        labels = list(analysis.normalised)
+        out["Fig. 9: normalised eq 19 coefficients"] = coefficient_bars_figure(
+            labels,
+            [v[0] for v in analysis.normalised.values()],
+            [v[1] for v in analysis.normalised.values()],
+        )
+    panels = []
+    for label, js in analysis.joint_stiffness.items():
+        freq = js.omega / (2 * math.pi)
+        panels.append(StiffnessPanel(label, freq, js.amplitude, js.value, {}, js.error))
+    if panels:
+        out["Fig. 10: the joint's own stiffness, eq 20"] = stiffness_panels_figure(
+            panels, ylabel="joint stiffness k_dj (MN/m)"
+        )
+    energy_panels = []
+    for name in sorted({r["structure"] for r in rows if r["jointed"]}):
+        sel = tests_of(rows, name)
+        freq = np.array([r["test_frequency_hz"] for r in sel])
+        amp = np.array([r["mean_amplitude_m"] for r in sel])
+        energy = np.array([r["energy_per_cycle_j"] for r in sel])
+        curves = {}
+        for f in sorted(set(freq.tolist())):
+            exponential = analysis.exponential_laws.get(f"{name}, {f:g} Hz")
+            if exponential is not None:
+                grid = np.linspace(amp[freq == f].min(), amp[freq == f].max(), 20)
+                curves[f] = (grid, fit.evaluate_exponential_law(exponential, grid))
+        energy_panels.append(EnergyLawPanel(name, freq, amp, energy, curves))
+    if energy_panels:
+        out["Fig. 11: energy per cycle with the eq 21 laws"] = energy_law_figure(energy_panels)
+    out["Fig. 12: stiffness coefficient c_d against amplitude"] = stiffness_coefficient_figure(
+        stiffness_curves
+    )
+    general = analysis.dissipation_law
+    if general is not None:
+        jointed = [r for r in rows if r["jointed"]]
+        measured = np.array([r["energy_per_cycle_j"] for r in jointed])
+        predicted = fit.evaluate_dissipation_law(
+            general,
+            [r["omega"] for r in jointed],
+            [r["nominal_clearance_m"] for r in jointed],
+            [r["mean_amplitude_m"] for r in jointed],
+        )
+        model = np.array(model_energy) if model_energy is not None else None
+        out["Fig. 13: eq 22 and the section-2 model against the measured energy"] = (
+            law_versus_measured_figure(
+                measured, predicted, model, np.array([r["structure"] for r in jointed])
+            )
+        )
+    return out
