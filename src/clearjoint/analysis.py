@@ -1,11 +1,15 @@
 """The analysis of a record set: one row per identified test and the fitted laws (eq 19-22).
 
 MODEL.md section 3. :func:`analyse` takes identified records and returns an
-:class:`Analysis`: the tests as rows (SI, units in the column names), eq 19 for each
-structure and side, Fig. 9's normalised coefficients, eq 20 for each jointed structure
-against the structure without clearance, eq 21 for each joint and frequency and eq 22
-over all jointed tests (with the power-law alternative). A law that cannot be fitted
-says why in ``not_fitted``. No rendering here: report.py draws and writes.
+:class:`Analysis`: the tests as rows (SI, units in the column names), each with the
+per-side dynamic stiffness k_d,s of MODEL.md section 3 (:func:`side_dynamic_stiffness`,
+from the identified contact slopes, penetrations and clearance with section 1's exact
+times); eq 19 on k_d,s for each structure and side (and, apart, on the contact slopes),
+Fig. 9's normalised coefficients, eq 20 for each jointed structure against the
+structure without clearance, eq 21 for each joint and frequency, and eq 22 over all
+jointed tests twice: with A = Abar = X - c/2 and with A = X (with the power-law
+alternative). A law that cannot be fitted says why in ``not_fitted``. No rendering
+here: report.py draws and writes.
 """
 
 from __future__ import annotations
@@ -16,10 +20,19 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from clearjoint import fit
+from clearjoint.errors import ParameterError
 from clearjoint.identify import Identification
+from clearjoint.joint import Joint
 from clearjoint.records import Record
+from clearjoint.stiffness import free_orbit
+
+FloatArray = NDArray[np.float64]
+
+#: The two sides of a joint and the row keys of their contact slope and penetration.
+SIDES = ("compression", "tension")
 
 
 @dataclass
@@ -32,10 +45,78 @@ class Analysis:
     stiffness_laws: dict[str, fit.LinearFit] = field(default_factory=dict)
     normalised: dict[str, tuple[float, float]] = field(default_factory=dict)
     joint_stiffness: dict[str, fit.JointStiffness] = field(default_factory=dict)
+    contact_laws: dict[str, fit.LinearFit] = field(default_factory=dict)
+    contact_joint_stiffness: dict[str, fit.JointStiffness] = field(default_factory=dict)
     exponential_laws: dict[str, fit.LinearFit] = field(default_factory=dict)
     dissipation_law: fit.LinearFit | None = None
+    dissipation_law_total: fit.LinearFit | None = None
     alternative_law: fit.LinearFit | None = None
     not_fitted: list[str] = field(default_factory=list)
+
+
+def side_dynamic_stiffness(
+    mass: float | None,
+    clearance: float,
+    compression_slope: float,
+    tension_slope: float,
+    gap_stiffness: float,
+    compression_penetration: float,
+    tension_penetration: float,
+) -> tuple[float, float]:
+    """Return the per-side dynamic stiffness (k_d,c, k_d,t), N/m (MODEL.md section 3).
+
+    k_d,s = m (pi / tau_s)^2 with tau_s = t_contact,s + t_cross: side s's contact time
+    and one free-play crossing of the free orbit whose penetration on side s is A_s
+    (section 1's exact times; for k0 = 0, k_d,s = k_s (pi A_s / (pi A_s + c))^2). The
+    gap is taken as centred on the k0 spring's rest position. The mass cancels (every
+    time scales as sqrt(m)), so a record without it is computed with m = 1 kg.
+
+    Parameters
+    ----------
+    mass : float or None
+        Moving mass, kg.
+    clearance : float
+        Identified clearance c, m (0 for a structure without clearance).
+    compression_slope, tension_slope : float
+        The measured contact slopes k0 + k_c and k0 + k_t, N/m.
+    gap_stiffness : float
+        k0, N/m.
+    compression_penetration, tension_penetration : float
+        A_c and A_t, m.
+
+    Returns
+    -------
+    (float, float)
+        k_d,c and k_d,t; NaN for a side whose slope is not above k0 or whose
+        penetration is not positive.
+    """
+    m = mass if mass else 1.0
+    c = max(clearance, 0.0)
+    k0 = max(gap_stiffness, 0.0)
+    out = []
+    for own, other, a in (
+        (compression_slope, tension_slope, compression_penetration),
+        (tension_slope, compression_slope, tension_penetration),
+    ):
+        if not (math.isfinite(a) and a > 0.0 and own > k0 and other > k0):
+            out.append(math.nan)
+            continue
+        try:
+            # side s as the compression side of a mirrored joint: its orbit at A = A_s
+            joint = Joint(
+                mass=m,
+                clearance=c,
+                compression_stiffness=own - k0,
+                tension_stiffness=other - k0,
+                gap_stiffness=k0,
+            )
+        except ParameterError:
+            out.append(math.nan)
+            continue
+        orbit = free_orbit(joint, np.array([a]))
+        tau = float(orbit.compression_time[0]) + 0.5 * float(orbit.free_play_time[0])
+        out.append(m * (math.pi / tau) ** 2)
+    return out[0], out[1]
 
 
 def _group(record: Record, ident: Identification) -> str:
@@ -60,6 +141,19 @@ def _study_rows(results: list[tuple[Record, Identification]]) -> list[dict[str, 
             mean_amplitude_m=row["amplitude_m"] - 0.5 * row["clearance_m"],
             force_amplitude_n=record.force_amplitude,
         )
+        jointed = row["jointed"]
+        k_dc, k_dt = side_dynamic_stiffness(
+            record.mass,
+            row["clearance_m"] if jointed else 0.0,
+            row["compression_stiffness_n_per_m"],
+            row["tension_stiffness_n_per_m"],
+            row["gap_stiffness_n_per_m"],
+            row["compression_penetration_m"] if jointed else row["amplitude_m"],
+            row["tension_penetration_m"] if jointed else row["amplitude_m"],
+        )
+        for side, value in zip(SIDES, (k_dc, k_dt), strict=True):
+            row[f"{side}_dynamic_stiffness_n_per_m"] = value
+            row[f"{side}_stiffness_coefficient"] = value / row[f"{side}_stiffness_n_per_m"]
         rows.append(row)
     return rows
 
@@ -73,6 +167,25 @@ def tests_of(rows: list[dict[str, Any]], name: str) -> list[dict[str, Any]]:
     tests = [r for r in rows if r["structure"] == name]
     jointed = [r for r in tests if r["jointed"]]
     return jointed or tests
+
+
+def side_data(
+    tests: list[dict[str, Any]], side: str, column: str = "dynamic_stiffness_n_per_m"
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Return (w rad/s, A_s m, k N/m) of one side over ``tests``, where k is finite.
+
+    ``column`` is ``"dynamic_stiffness_n_per_m"`` (k_d,s) or ``"stiffness_n_per_m"``
+    (the contact slope); A_s is the penetration on that side, or X for a structure
+    without clearance.
+    """
+    w = np.array([r["omega"] for r in tests], dtype=np.float64)
+    a = np.array(
+        [r[f"{side}_penetration_m"] if r["jointed"] else r["amplitude_m"] for r in tests],
+        dtype=np.float64,
+    )
+    k = np.array([r[f"{side}_{column}"] for r in tests], dtype=np.float64)
+    keep = np.isfinite(k)
+    return w[keep], a[keep], k[keep]
 
 
 def _attempt(
@@ -93,41 +206,34 @@ def analyse(results: list[tuple[Record, Identification]], failures: list[str]) -
     analysis = Analysis(rows=rows, identifications=results, failures=failures)
     structures = sorted({r["structure"] for r in rows})
     beams = [s for s in structures if not any(r["jointed"] for r in rows if r["structure"] == s)]
-    for name in structures:
-        sel = tests_of(rows, name)
-        for side, key_a in (
-            ("compression", "compression_penetration_m"),
-            ("tension", "tension_penetration_m"),
-        ):
-            w = np.array([r["omega"] for r in sel])
-            a = np.array([r[key_a] if r["jointed"] else r["amplitude_m"] for r in sel])
-            k = np.array([r[f"{side}_stiffness_n_per_m"] for r in sel])
-            label = f"{name}, {side}"
-            law = _attempt(
-                analysis, f"eq 19 {label}", fit.stiffness_law, w, a, k, what=f"eq 19 {label}"
-            )
-            if law is not None:
-                analysis.stiffness_laws[label] = law
-                analysis.normalised[label] = fit.normalised_coefficients(law, w, a, k)
-    for name in structures:
-        if name in beams:
-            continue
-        for side in ("compression", "tension"):
-            label = f"{name}, {side}"
-            beam_label = f"{beams[0]}, {side}" if beams else None
-            if label not in analysis.stiffness_laws or beam_label not in analysis.stiffness_laws:
-                analysis.not_fitted.append(
-                    f"eq 20 {label}: needs eq 19 for it and for a structure without clearance"
-                )
+    for column, laws, joint, tag in (
+        ("dynamic_stiffness_n_per_m", analysis.stiffness_laws, analysis.joint_stiffness, ""),
+        ("stiffness_n_per_m", analysis.contact_laws, analysis.contact_joint_stiffness, " slopes"),
+    ):
+        for name in structures:
+            for side in SIDES:
+                w, a, k = side_data(tests_of(rows, name), side, column)
+                label = f"{name}, {side}"
+                what = f"eq 19{tag} {label}"
+                law = _attempt(analysis, what, fit.stiffness_law, w, a, k, what=what)
+                if law is not None:
+                    laws[label] = law
+                    if not tag:
+                        analysis.normalised[label] = fit.normalised_coefficients(law, w, a, k)
+        for name in structures:
+            if name in beams:
                 continue
-            sel = tests_of(rows, name)
-            key_a = f"{side}_penetration_m"
-            analysis.joint_stiffness[label] = fit.joint_stiffness(
-                analysis.stiffness_laws[label],
-                analysis.stiffness_laws[beam_label],
-                [r["omega"] for r in sel],
-                [r[key_a] for r in sel],
-            )
+            for side in SIDES:
+                label = f"{name}, {side}"
+                beam_label = f"{beams[0]}, {side}" if beams else ""
+                if label not in laws or beam_label not in laws:
+                    analysis.not_fitted.append(
+                        f"eq 20{tag} {label}: needs eq 19 for it and for a structure without "
+                        "clearance"
+                    )
+                    continue
+                w, a, _ = side_data(tests_of(rows, name), side, column)
+                joint[label] = fit.joint_stiffness(laws[label], laws[beam_label], w, a)
     jointed = [r for r in rows if r["jointed"]]
     for name in sorted({r["structure"] for r in jointed}):
         for f in sorted({r["test_frequency_hz"] for r in jointed if r["structure"] == name}):
@@ -152,4 +258,13 @@ def analyse(results: list[tuple[Record, Identification]], failures: list[str]) -
         )
         analysis.dissipation_law = _attempt(analysis, "eq 22", fit.dissipation_law, *args)
         analysis.alternative_law = _attempt(analysis, "power law", fit.power_law, *args)
+        analysis.dissipation_law_total = _attempt(
+            analysis,
+            "eq 22 (A = X)",
+            fit.dissipation_law,
+            *args[:2],
+            [r["amplitude_m"] for r in jointed],
+            args[3],
+            what="eq 22 (A = X)",
+        )
     return analysis

@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from clearjoint import fit
-from clearjoint.analysis import Analysis, tests_of
+from clearjoint.analysis import Analysis, side_data, tests_of
 
 #: Line styles that stay apart in grey print, cycled per curve.
 _STYLES: tuple[tuple[Any, str], ...] = (
@@ -492,24 +492,36 @@ def report_figures(
                 record.time[span], record.displacement[span], runs
             )
             break
-    panels = []
-    for label, law in analysis.stiffness_laws.items():
-        name, side = label.rsplit(", ", 1)
-        sel = tests_of(rows, name)
-        key_a = f"{side}_penetration_m" if sel and sel[0]["jointed"] else "amplitude_m"
-        freq = np.array([r["test_frequency_hz"] for r in sel])
-        amp = np.array([r[key_a] for r in sel])
-        k = np.array([r[f"{side}_stiffness_n_per_m"] for r in sel])
-        grid = np.linspace(amp.min(), amp.max(), 20)
-        lines = {
-            f: (grid, fit.evaluate_stiffness_law(law, 2 * math.pi * f * np.ones_like(grid), grid))
-            for f in sorted(set(freq.tolist()))
-        }
-        panels.append(StiffnessPanel(label, freq, amp, k, lines))
-    if panels:
-        out["Fig. 8: stiffness with the eq 19 planes"] = stiffness_panels_figure(
-            panels, ylabel="stiffness (MN/m)"
+    for laws, caption, ylabel in (
+        (
+            analysis.stiffness_laws,
+            "Fig. 8: per-side dynamic stiffness k_d,s with the eq 19 planes",
+            "dynamic stiffness k_d,s (MN/m)",
+        ),
+        (
+            analysis.contact_laws,
+            "Contact slopes k_s,meas with their eq 19 planes (not a paper figure)",
+            "contact slope (MN/m)",
+        ),
+    ):
+        panels = []
+        column = (
+            "dynamic_stiffness_n_per_m" if laws is analysis.stiffness_laws else "stiffness_n_per_m"
         )
+        for label, law in laws.items():
+            name, side = label.rsplit(", ", 1)
+            sel = tests_of(rows, name)
+            freq = np.array([r["test_frequency_hz"] for r in sel], dtype=np.float64)
+            _, amp, k = side_data(sel, side, column)
+            freq = freq[np.isfinite([r[f"{side}_{column}"] for r in sel])]
+            grid = np.linspace(amp.min(), amp.max(), 20)
+            lines = {
+                f: (grid, fit.evaluate_stiffness_law(law, 2 * math.pi * f, grid))
+                for f in sorted(set(freq.tolist()))
+            }
+            panels.append(StiffnessPanel(label, freq, amp, k, lines))
+        if panels:
+            out[caption] = stiffness_panels_figure(panels, ylabel=ylabel)
     if analysis.normalised:
         labels = list(analysis.normalised)
         out["Fig. 9: normalised eq 19 coefficients"] = coefficient_bars_figure(
@@ -522,8 +534,8 @@ def report_figures(
         freq = js.omega / (2 * math.pi)
         panels.append(StiffnessPanel(label, freq, js.amplitude, js.value, {}, js.error))
     if panels:
-        out["Fig. 10: the joint's own stiffness, eq 20"] = stiffness_panels_figure(
-            panels, ylabel="joint stiffness k_dj (MN/m)"
+        out["Fig. 10: the joint's own dynamic stiffness k_dj, eq 20 on k_d,s"] = (
+            stiffness_panels_figure(panels, ylabel="joint stiffness k_dj (MN/m)")
         )
     energy_panels = []
     for name in sorted({r["structure"] for r in rows if r["jointed"]}):

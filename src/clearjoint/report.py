@@ -58,10 +58,12 @@ def _fit_rows(analysis: Analysis) -> list[dict[str, Any]]:
     out: list[dict[str, Any]] = []
     groups: list[tuple[str, dict[str, fit.LinearFit]]] = [
         ("eq 19", analysis.stiffness_laws),
+        ("eq 19 slopes", analysis.contact_laws),
         ("eq 21", analysis.exponential_laws),
     ]
     for law_name, single in (
         ("eq 22", analysis.dissipation_law),
+        ("eq 22 (A = X)", analysis.dissipation_law_total),
         ("power law", analysis.alternative_law),
     ):
         if single is not None:
@@ -206,15 +208,8 @@ def write_report(
     payload = {
         "tests": analysis.rows,
         "fits": fits_rows,
-        "joint_stiffness": {
-            label: {
-                "frequency_hz": (js.omega / (2 * math.pi)).tolist(),
-                "amplitude_m": js.amplitude.tolist(),
-                "k_dj_n_per_m": js.value.tolist(),
-                "std_error": js.error.tolist(),
-            }
-            for label, js in analysis.joint_stiffness.items()
-        },
+        "joint_stiffness": _joint_json(analysis.joint_stiffness),
+        "contact_joint_stiffness": _joint_json(analysis.contact_joint_stiffness),
         "normalised_coefficients": {k: list(v) for k, v in analysis.normalised.items()},
         "not_fitted": analysis.not_fitted,
         "records_not_used": analysis.failures,
@@ -231,6 +226,18 @@ def write_report(
                 writer.writeheader()
                 writer.writerows(rows)
     return list(targets.values())
+
+
+def _joint_json(laws: dict[str, fit.JointStiffness]) -> dict[str, dict[str, list[float]]]:
+    return {
+        label: {
+            "frequency_hz": (js.omega / (2 * math.pi)).tolist(),
+            "amplitude_m": js.amplitude.tolist(),
+            "k_dj_n_per_m": js.value.tolist(),
+            "k_dj_std_error_n_per_m": js.error.tolist(),
+        }
+        for label, js in laws.items()
+    }
 
 
 def _json_default(value: Any) -> Any:
