@@ -11,26 +11,8 @@ import pytest
 
 from clearjoint.cli import main
 
-SMALL = """
-seed = 5
-periods = 12
-[grid]
-frequencies = ["20Hz", "60Hz", "100Hz"]
-force_amplitudes = ["1000N", "2000N", "3000N"]
-"""
-
 FIGURES = ("Fig. 7", "Fig. 8", "Fig. 9", "Fig. 10", "Fig. 11", "Fig. 12", "Fig. 13")
 BRFD = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
-
-
-@pytest.fixture(scope="module")
-def reproduction(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("reproduce")
-    campaign = folder / "campaign.toml"
-    campaign.write_text(SMALL)
-    out = folder / "out"
-    assert main(["reproduce", "--out", str(out), "--campaign", str(campaign), "--jobs", "2"]) == 0
-    return out
 
 
 def self_contained(page: str) -> None:

@@ -14,6 +14,7 @@ here: report.py draws and writes.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -140,22 +141,64 @@ def _study_rows(results: list[tuple[Record, Identification]]) -> list[dict[str, 
             omega=2.0 * math.pi * nominal,
             mean_amplitude_m=row["amplitude_m"] - 0.5 * row["clearance_m"],
             force_amplitude_n=record.force_amplitude,
+            mass_kg=record.mass,
         )
+        rows.append(row)
+    return rows
+
+
+def _majority_kind(
+    rows: list[dict[str, Any]],
+    results: list[tuple[Record, Identification]],
+    failures: list[str],
+) -> tuple[list[dict[str, Any]], list[tuple[Record, Identification]], list[str]]:
+    """Leave out a test identified unlike most tests of its structure (a damper loop among
+    straight lines, say): it is a failed identification, not a measurement of that
+    structure, and it would make a structure without clearance look jointed."""
+    kinds: dict[str, list[bool]] = {}
+    for row in rows:
+        kinds.setdefault(row["structure"], []).append(row["jointed"])
+    majority = {name: 2 * sum(v) > len(v) for name, v in kinds.items()}
+    keep_rows, keep_results, dropped = [], [], list(failures)
+    for row, result in zip(rows, results, strict=True):
+        if row["jointed"] == majority[row["structure"]] or len(kinds[row["structure"]]) < 3:
+            keep_rows.append(row)
+            keep_results.append(result)
+        else:
+            dropped.append(
+                f"{row['file']}: identified as a {row['model']} loop while most tests of "
+                f"{row['structure']} are {'jointed' if majority[row['structure']] else 'not'}; "
+                "left out of the laws"
+            )
+    return keep_rows, keep_results, dropped
+
+
+def _add_dynamic_stiffness(rows: list[dict[str, Any]], *, frozen_slopes: bool) -> None:
+    """Add k_d,s and c_d,s = k_d,s / k_s,meas to each row (with frozen slopes: each side's
+    slope is its structure's median, so k_d,s changes only through A_s and c)."""
+    slopes: dict[tuple[str, str], float] = {}
+    if frozen_slopes:
+        for name in {r["structure"] for r in rows}:
+            for side in SIDES:
+                values = [r[f"{side}_stiffness_n_per_m"] for r in tests_of(rows, name)]
+                slopes[name, side] = float(np.nanmedian(values))
+    for row in rows:
         jointed = row["jointed"]
+        k_c, k_t = (
+            slopes.get((row["structure"], side), row[f"{side}_stiffness_n_per_m"]) for side in SIDES
+        )
         k_dc, k_dt = side_dynamic_stiffness(
-            record.mass,
+            row["mass_kg"],
             row["clearance_m"] if jointed else 0.0,
-            row["compression_stiffness_n_per_m"],
-            row["tension_stiffness_n_per_m"],
+            k_c,
+            k_t,
             row["gap_stiffness_n_per_m"],
             row["compression_penetration_m"] if jointed else row["amplitude_m"],
             row["tension_penetration_m"] if jointed else row["amplitude_m"],
         )
-        for side, value in zip(SIDES, (k_dc, k_dt), strict=True):
+        for side, value, slope in zip(SIDES, (k_dc, k_dt), (k_c, k_t), strict=True):
             row[f"{side}_dynamic_stiffness_n_per_m"] = value
-            row[f"{side}_stiffness_coefficient"] = value / row[f"{side}_stiffness_n_per_m"]
-        rows.append(row)
-    return rows
+            row[f"{side}_stiffness_coefficient"] = value / slope
 
 
 def tests_of(rows: list[dict[str, Any]], name: str) -> list[dict[str, Any]]:
@@ -200,9 +243,21 @@ def _attempt(
         return None
 
 
-def analyse(results: list[tuple[Record, Identification]], failures: list[str]) -> Analysis:
-    """Fit eq 19-22 to identified tests (each law that cannot be fitted says why)."""
+def analyse(
+    results: list[tuple[Record, Identification]],
+    failures: list[str],
+    *,
+    frozen_slopes: bool = False,
+) -> Analysis:
+    """Return eq 19-22 fitted to identified tests (each law that cannot be fitted says why).
+
+    With ``frozen_slopes``, k_d,s is computed with each side's contact slope held at
+    its structure's median: what the clearance alone makes of the stiffness, the
+    control used on records where no rig can be re-run without its installation effects.
+    """
     rows = _study_rows(results)
+    rows, results, failures = _majority_kind(rows, results, failures)
+    _add_dynamic_stiffness(rows, frozen_slopes=frozen_slopes)
     analysis = Analysis(rows=rows, identifications=results, failures=failures)
     structures = sorted({r["structure"] for r in rows})
     beams = [s for s in structures if not any(r["jointed"] for r in rows if r["structure"] == s)]
@@ -268,3 +323,32 @@ def analyse(results: list[tuple[Record, Identification]], failures: list[str]) -
             what="eq 22 (A = X)",
         )
     return analysis
+
+
+#: A damper's free play: where |restoring force| is below this fraction of its friction force.
+DAMPER_FREE_PLAY_FRACTION = 0.2
+
+
+def stage_runs(record: Record, ident: Identification) -> list[tuple[str, float, float]]:
+    """Return the record's stages as (name, start s, end s) runs, where they are.
+
+    A clearance joint's stages follow the displacement (inside the gap edges or
+    beyond), as ``Identification.stage_runs`` gives them. A friction damper with
+    backlash plays free after each reversal, not at the zero crossings: its stages
+    follow the restoring force, free play where |F| is below
+    ``DAMPER_FREE_PLAY_FRACTION`` of the identified friction force, compression where
+    F is above it and tension below its negative.
+    """
+    if ident.model != "damper":
+        return ident.stage_runs(record.time)
+    force = ident.restoring_force
+    level = DAMPER_FREE_PLAY_FRACTION * ident.summary["friction_force_n"]
+    stage = np.where(force > level, 1, np.where(force < -level, -1, 0))
+    names = {0: "free-play", 1: "compression", -1: "tension"}
+    change = np.nonzero(np.diff(stage))[0] + 1
+    bounds = np.concatenate(([0], change, [stage.size]))
+    t = record.time
+    return [
+        (names[int(stage[a])], float(t[a]), float(t[min(b, t.size - 1)]))
+        for a, b in itertools.pairwise(bounds)
+    ]

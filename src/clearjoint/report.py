@@ -1,11 +1,15 @@
 """Render a study to files: report.html, results.json, results.csv and fits.csv.
 
-No analysis and no physics here: :func:`write_report` takes an
-:class:`~clearjoint.analysis.Analysis`, the figures (``figures.report_figures``) and
-any extra sections, and writes one self-contained HTML file (figures embedded, no
-external resources), ``results.json`` with every number, ``results.csv`` (one row per
+No analysis and no physics here: :func:`write_report` takes a :class:`Study` (the
+analysis, the findings table, the figures, and for the virtual rig the checks against
+its truth) and writes one self-contained HTML file (figures embedded, no external
+resources), ``results.json`` with every number, ``results.csv`` (one row per
 identified record) and ``fits.csv`` (every fitted coefficient with its standard error).
-Files keep SI with the unit in each column's name. MODEL.md section 4.
+The page opens with a summary: what was run, the findings table, the identification
+against the truth, and what to distrust; long tables fold away in ``<details>`` and
+speak engineering units (um, MN/m, mJ) with the unit in the header. Files keep SI with
+the unit in each column's name. Record paths are relative to the records folder.
+MODEL.md section 4.
 """
 
 from __future__ import annotations
@@ -16,7 +20,9 @@ import html
 import io
 import json
 import math
+import os
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +32,7 @@ from matplotlib.figure import Figure
 from clearjoint import fit
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.analysis import Analysis
+from clearjoint.findings import Finding, Timing
 
 #: What the study assumes, stated in every report.
 ASSUMPTIONS: tuple[str, ...] = (
@@ -37,12 +44,41 @@ ASSUMPTIONS: tuple[str, ...] = (
     " a1 mean(w)/mean(k) and a2 mean(A)/mean(k).",
     "Eq 20 puts the non-jointed structure and the joint in series, k_dj = k_d k_dn/(k_dn - k_d),"
     " with k_dn from the non-jointed eq 19 law at the same w and A.",
-    "Eq 21 and 22 use Abar = X - c/2 and are fitted on ln E; eq 22 is compared with a power law"
-    " by AIC. With only two clearances the law's linearity in c cannot be tested.",
+    "Figs. 8-10 and eq 19-20 use the per-side dynamic stiffness k_d,s = m (pi / tau_s)^2 of"
+    " MODEL.md section 3 (contact time of side s plus one free-play crossing, section 1's exact"
+    " times from the identified slopes, A_s and c; gap centred); the contact slopes have their"
+    " own eq 19 and figure.",
+    "Eq 21 and 22 are fitted on ln E with A = Abar = X - c/2; eq 22 also with A = X, and is"
+    " compared with a power law by AIC. With only two clearances the law's linearity in c"
+    " cannot be tested.",
     "Sliding friction acts over the whole path; contact friction on the pin is evaluated along"
     " the motion without feedback on it.",
     "The virtual rig's dimensions (the paper's Fig. 6 was lost) are in docs/rig.md.",
 )
+
+
+@dataclass
+class Study:
+    """What a report shows: the analysis, its findings and figures, and the rig's checks.
+
+    ``accuracy``, ``worst`` and ``comparisons`` are the identification against the
+    virtual rig's truth and section 2's closed form against the exact cycle (None for
+    a user's records); ``truth_figures`` are drawn in the summary.
+    """
+
+    title: str
+    what_was_run: list[str]
+    analysis: Analysis
+    findings: list[Finding]
+    figures: dict[str, Figure]
+    records_folder: Path
+    truth_figures: dict[str, Figure] = field(default_factory=dict)
+    accuracy: list[dict[str, Any]] | None = None
+    worst: dict[str, float] | None = None
+    comparisons: list[dict[str, Any]] | None = None
+    control: str = ""
+    control_analysis: Analysis | None = None
+    timing: Timing | None = None
 
 
 def _png(fig: Figure) -> bytes:
@@ -51,7 +87,7 @@ def _png(fig: Figure) -> bytes:
     return buffer.getvalue()
 
 
-# ---- writing ------------------------------------------------------------------------------
+# ---- tables -----------------------------------------------------------------------------------
 
 
 def _fit_rows(analysis: Analysis) -> list[dict[str, Any]]:
@@ -84,13 +120,45 @@ def _fit_rows(analysis: Analysis) -> list[dict[str, Any]]:
     return out
 
 
-def html_table(rows: list[dict[str, Any]], columns: Sequence[str]) -> str:
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
+#: The identified tests as the page shows them: (header with unit, row key, scale).
+TEST_COLUMNS: tuple[tuple[str, str, float], ...] = (
+    ("file", "file", 1.0),
+    ("structure", "structure", 1.0),
+    ("f (Hz)", "frequency_hz", 1.0),
+    ("X (µm)", "amplitude_m", 1e6),
+    ("c (µm)", "clearance_m", 1e6),
+    ("A_c (µm)", "compression_penetration_m", 1e6),
+    ("A_t (µm)", "tension_penetration_m", 1e6),
+    ("k_c,meas (MN/m)", "compression_stiffness_n_per_m", 1e-6),
+    ("k_t,meas (MN/m)", "tension_stiffness_n_per_m", 1e-6),
+    ("k_d,c (MN/m)", "compression_dynamic_stiffness_n_per_m", 1e-6),
+    ("k_d,t (MN/m)", "tension_dynamic_stiffness_n_per_m", 1e-6),
+    ("friction (N)", "friction_force_n", 1.0),
+    ("E per cycle (mJ)", "energy_per_cycle_j", 1e3),
+    ("cycles used", "cycles_used", 1.0),
+    ("model", "model", 1.0),
+)
+
+
+def html_table(
+    rows: Sequence[dict[str, Any]], columns: Sequence[str | tuple[str, str, float]]
+) -> str:
+    """An HTML table; a column is a row key, or (header, row key, scale to the header's unit)."""
+    spec = [(c, c, 1.0) if isinstance(c, str) else c for c in columns]
+    head = "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in spec)
     body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(_fmt(row.get(c)))}</td>" for c in columns) + "</tr>"
+        "<tr>"
+        + "".join(f"<td>{html.escape(_fmt(_scaled(row.get(k), f)))}</td>" for _, k, f in spec)
+        + "</tr>"
         for row in rows
     )
     return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _scaled(value: Any, factor: float) -> Any:
+    if factor != 1.0 and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value) * factor
+    return value
 
 
 def _items(values: Sequence[str]) -> str:
@@ -103,34 +171,98 @@ def _fmt(value: Any) -> str:
     return "" if value is None else str(value)
 
 
-def _html(analysis: Analysis, figures: dict[str, bytes], extra: dict[str, str], title: str) -> str:
-    images = "".join(
-        f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,'
-        f'{base64.b64encode(data).decode("ascii")}"><figcaption>{html.escape(name)}'
+def _details(summary: str, content: str, *, open_: bool = False) -> str:
+    flag = " open" if open_ else ""
+    return f"<details{flag}><summary>{html.escape(summary)}</summary>{content}</details>"
+
+
+def _figure(caption: str, data: bytes) -> str:
+    return (
+        f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,'
+        f'{base64.b64encode(data).decode("ascii")}"><figcaption>{html.escape(caption)}'
         "</figcaption></figure>"
-        for name, data in figures.items()
     )
+
+
+def _relative(path: str, folder: Path) -> str:
+    try:
+        return os.path.relpath(path, folder)
+    except ValueError:  # another drive
+        return Path(path).name
+
+
+# ---- the page ---------------------------------------------------------------------------------
+
+
+def findings_html(findings: Sequence[Finding]) -> str:
+    """The findings table: one row per paper finding, reproduced and source first."""
+    head = "<tr><th>paper finding</th><th>reproduced</th><th>source</th><th>evidence</th></tr>"
+    body = "".join(
+        f'<tr class="{"yes" if f.reproduced else "no"}"><td><b>{html.escape(f.finding)}</b><br>'
+        f"<small>{html.escape(f.paper)}</small></td>"
+        f"<td>{'yes' if f.reproduced else 'NO'}</td><td>{html.escape(f.source)}</td>"
+        f"<td><small>{html.escape(f.evidence)}</small><br><i>{html.escape(f.why)}</i></td></tr>"
+        for f in findings
+    )
+    return f'<table id="findings">{head}{body}</table>'
+
+
+def distrust(study: Study) -> list[str]:
+    """What a reader should not take at face value, from the study's own numbers."""
+    out = []
+    analysis = study.analysis
+    given = [f.finding for f in study.findings if f.reproduced and f.source == "rig input"]
+    if given:
+        out.append(
+            "Reproduced only because the test article was given it (rig input): "
+            + "; ".join(given)
+            + "."
+        )
+    missing = [f.finding for f in study.findings if not f.reproduced]
+    if missing:
+        out.append("Not reproduced (see the evidence): " + "; ".join(missing) + ".")
+    poor = sorted(
+        {
+            f"{r['law']} {r['group']} (R^2 = {r['r_squared']:.2f})"
+            for r in _fit_rows(analysis)
+            if r["r_squared"] < 0.5
+        }
+    )
+    if poor:
+        out.append("Laws with R^2 below 0.5, which do not describe their data: " + "; ".join(poor))
+    if analysis.not_fitted:
+        out.append(f"{len(analysis.not_fitted)} law(s) could not be fitted (listed below).")
+    if analysis.failures:
+        out.append(f"{len(analysis.failures)} record(s) were not used (listed below).")
+    if study.comparisons:
+        gaps = [abs(c["gap"]) for c in study.comparisons if math.isfinite(c["gap"])]
+        if gaps and max(gaps) > 0.1:
+            out.append(
+                f"Section 2's closed form is up to {max(gaps):.0%} off the exact cycle on these"
+                " forced tests (Fig. 13's grey points): use it for trends, not for numbers."
+            )
+    out.append("With two clearances eq 22's dependence on c is a straight line through two points.")
+    return out
+
+
+def _html(study: Study) -> str:
+    analysis = study.analysis
+    rows = _display_rows(analysis.rows, study.records_folder)
+    figures = "".join(_figure(c, _png(f)) for c, f in study.figures.items())
+    truth = ""
+    if study.worst is not None:
+        truth = (
+            "<h3>Identification against the virtual rig's truth</h3><p>Largest relative errors "
+            "over all tests: "
+            + html.escape(
+                ", ".join(f"{k.replace('_', ' ')} {v:.2%}" for k, v in study.worst.items())
+            )
+            + ". Contact stiffness is compared with k0 + k_s, the slope a record shows.</p>"
+            + "".join(_figure(c, _png(f)) for c, f in study.truth_figures.items())
+        )
     fits = html_table(
         _fit_rows(analysis),
         ("law", "group", "name", "value", "std_error", "unit", "r_squared", "n"),
-    )
-    tests = html_table(
-        analysis.rows,
-        (
-            "file",
-            "structure",
-            "frequency_hz",
-            "amplitude_m",
-            "clearance_m",
-            "clearance_m_std",
-            "compression_stiffness_n_per_m",
-            "tension_stiffness_n_per_m",
-            "friction_force_n",
-            "energy_per_cycle_j",
-            "energy_per_cycle_j_std",
-            "cycles_used",
-            "model",
-        ),
     )
     comparison = ""
     if analysis.dissipation_law is not None and analysis.alternative_law is not None:
@@ -146,85 +278,173 @@ def _html(analysis: Analysis, figures: dict[str, bytes], extra: dict[str, str], 
             f"(R<sup>2</sup> {analysis.alternative_law.r_squared:.4f}). {better} is preferred."
             "</p>"
         )
-    joint_rows = []
-    for label, js in analysis.joint_stiffness.items():
+    joint_rows = _joint_rows(analysis.joint_stiffness)
+    joint = html_table(
+        joint_rows,
+        (
+            "group",
+            ("f (Hz)", "frequency_hz", 1.0),
+            ("A_s (µm)", "amplitude_m", 1e6),
+            ("k_dj (MN/m)", "k_dj_n_per_m", 1e-6),
+            ("std error (MN/m)", "k_dj_std_error_n_per_m", 1e-6),
+        ),
+    )
+    sections = [
+        _details(
+            f"Fitted coefficients (eq 19, 21, 22), SI units as listed ({len(_fit_rows(analysis))}"
+            " rows)",
+            fits + comparison,
+        ),
+        _details(f"The joint's own dynamic stiffness, eq 20 ({len(joint_rows)} rows)", joint),
+        _details(f"Identified tests ({len(rows)})", html_table(rows, TEST_COLUMNS)),
+    ]
+    if study.comparisons:
+        sections.append(
+            _details(
+                f"Dissipation: closed form (section 2) against the exact cycle "
+                f"({len(study.comparisons)} tests)",
+                "<p>The closed forms on the free cycle at each test's penetration, against the "
+                "energy integrated over the exact steady cycle (the simulator's ledger); "
+                "see docs/dissipation.md for where the closed form holds.</p>"
+                + html_table(
+                    study.comparisons,
+                    (
+                        "file",
+                        ("A (µm)", "penetration_m", 1e6),
+                        ("closed form (mJ)", "closed_total_j", 1e3),
+                        ("exact cycle (mJ)", "exact_total_j", 1e3),
+                        ("relative gap", "gap", 1.0),
+                        ("integration (ms)", "integration_s", 1e3),
+                    ),
+                ),
+            )
+        )
+    sections += [
+        _details(
+            f"Laws not fitted ({len(analysis.not_fitted)})",
+            f"<ul>{_items(analysis.not_fitted) or '<li>none</li>'}</ul>",
+        ),
+        _details(
+            f"Records not used ({len(analysis.failures)})",
+            "<ul>"
+            + (
+                _items(
+                    [f.replace(f"{study.records_folder}{os.sep}", "") for f in analysis.failures]
+                )
+                or "<li>none</li>"
+            )
+            + "</ul>",
+        ),
+        _details("What was assumed", f"<ul>{_items(ASSUMPTIONS)}</ul>"),
+    ]
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{html.escape(study.title)}</title>
+<style>body{{font-family:sans-serif;max-width:72em;margin:1em auto;line-height:1.35}}
+h1{{font-size:1.4em;margin:0.3em 0}}
+table{{border-collapse:collapse;font-size:0.85em;margin:0.5em 0;display:block;overflow-x:auto}}
+td,th{{border:1px solid #999;padding:0.15em 0.4em;vertical-align:top}}img{{max-width:100%}}
+#findings{{font-size:0.8em}}#findings tr.no td:nth-child(2){{font-weight:bold}}
+details{{margin:0.4em 0}}summary{{cursor:pointer;font-weight:bold}}</style>
+</head><body>
+<h1>{html.escape(study.title)}</h1>
+<p>{_items_inline(study.what_was_run)} Paper: Li et al., Shock and Vibration (2013),
+doi:10.1155/2013/583030; equations as rebuilt in MODEL.md.</p>
+<h2>Findings of the paper, against these data</h2>
+{findings_html(study.findings)}
+<p><small>Reproduced: the fitted slope has the paper's sign by more than two standard errors
+for every joint and side. Source "model": it also holds in the control ({
+        html.escape(study.control)
+    }); "rig input": it was given to the test article. Every number is in
+results.json (key <code>findings</code>).</small></p>
+<h2>What to distrust</h2><ul>{_items(distrust(study))}</ul>
+{truth}
+<h2>Figures</h2>{figures}
+<h2>Tables</h2>{"".join(sections)}
+</body></html>
+"""
+
+
+def _items_inline(values: Sequence[str]) -> str:
+    return " ".join(html.escape(v) for v in values)
+
+
+def _display_rows(rows: Sequence[dict[str, Any]], folder: Path) -> list[dict[str, Any]]:
+    return [{**row, "file": _relative(row["file"], folder)} for row in rows]
+
+
+def _joint_rows(laws: dict[str, fit.JointStiffness]) -> list[dict[str, Any]]:
+    out = []
+    for label, js in laws.items():
         for w, a, v, e in zip(js.omega, js.amplitude, js.value, js.error, strict=True):
-            joint_rows.append(
+            out.append(
                 {
                     "group": label,
                     "frequency_hz": w / (2 * math.pi),
                     "amplitude_m": a,
                     "k_dj_n_per_m": v,
-                    "std_error": e,
+                    "k_dj_std_error_n_per_m": e,
                 }
             )
-    joint = html_table(
-        joint_rows, ("group", "frequency_hz", "amplitude_m", "k_dj_n_per_m", "std_error")
-    )
-    sections = "".join(f"<h2>{html.escape(k)}</h2>{v}" for k, v in extra.items())
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
-<style>body{{font-family:sans-serif;max-width:70em;margin:2em auto;line-height:1.4}}
-table{{border-collapse:collapse;font-size:0.85em;margin:1em 0;display:block;overflow-x:auto}}
-td,th{{border:1px solid #999;padding:0.15em 0.4em}}img{{max-width:100%}}</style>
-</head><body>
-<h1>{html.escape(title)}</h1>
-<p>Li et al., Shock and Vibration (2013), doi:10.1155/2013/583030, reproduced with clearjoint;
-equations as rebuilt in MODEL.md.</p>
-<h2>Figures</h2>{images}
-<h2>Fitted coefficients (eq 19, 21, 22) with standard errors</h2>{fits}{comparison}
-<h2>The joint's own stiffness (eq 20)</h2>{joint}
-<h2>Laws not fitted</h2><ul>{_items(analysis.not_fitted) or "<li>none</li>"}</ul>
-{sections}
-<h2>Identified tests</h2>{tests}
-<h2>Records not used</h2><ul>{_items(analysis.failures) or "<li>none</li>"}</ul>
-<h2>What was assumed</h2><ul>{_items(ASSUMPTIONS)}</ul>
-</body></html>
-"""
+    return out
 
 
-def write_report(
-    out_dir: Path,
-    analysis: Analysis,
-    figures: dict[str, Figure],
-    extra_html: dict[str, str],
-    extra_json: dict[str, Any],
-    title: str,
-    force: bool,
-) -> list[Path]:
+# ---- writing ------------------------------------------------------------------------------
+
+
+def write_report(out_dir: Path, study: Study, *, force: bool = False) -> list[Path]:
     """Write report.html, results.json, results.csv and fits.csv into ``out_dir``; return them.
 
-    ``extra_html`` maps a section title to its HTML, ``extra_json`` adds keys to
-    results.json. Nothing is overwritten unless ``force``.
+    Nothing is overwritten unless ``force``.
     """
+    analysis = study.analysis
     targets = {
         name: out_dir / name for name in ("report.html", "results.json", "results.csv", "fits.csv")
     }
     refuse_to_overwrite(targets.values(), force=force)
     out_dir.mkdir(parents=True, exist_ok=True)
-    images = {caption: _png(fig) for caption, fig in figures.items()}
-    targets["report.html"].write_text(_html(analysis, images, extra_html, title), encoding="utf-8")
+    targets["report.html"].write_text(_html(study), encoding="utf-8")
     fits_rows = _fit_rows(analysis)
-    payload = {
-        "tests": analysis.rows,
+    rows = _display_rows(analysis.rows, study.records_folder)
+    folder = f"{study.records_folder}{os.sep}"
+    failures = [line.replace(folder, "") for line in analysis.failures]
+    payload: dict[str, Any] = {
+        "what_was_run": study.what_was_run,
+        "findings": [f.as_dict() for f in study.findings],
+        "control": study.control,
+        "tests": rows,
         "fits": fits_rows,
         "joint_stiffness": _joint_json(analysis.joint_stiffness),
         "contact_joint_stiffness": _joint_json(analysis.contact_joint_stiffness),
         "normalised_coefficients": {k: list(v) for k, v in analysis.normalised.items()},
         "not_fitted": analysis.not_fitted,
-        "records_not_used": analysis.failures,
+        "records_not_used": failures,
         "assumptions": list(ASSUMPTIONS),
-        **extra_json,
+        "distrust": distrust(study),
     }
+    if study.control_analysis is not None:
+        control = study.control_analysis
+        payload["control_tests"] = _display_rows(control.rows, study.records_folder)
+        payload["control_fits"] = _fit_rows(control)
+        payload["control_joint_stiffness"] = _joint_json(control.joint_stiffness)
+    if study.timing is not None:
+        payload["timing"] = {
+            "law_s_per_test": study.timing.law_s,
+            "integration_s_per_test": study.timing.integration_s,
+            "law_median_error": study.timing.median_error,
+        }
+    if study.accuracy is not None:
+        payload["identification_accuracy"] = study.accuracy
+        payload["worst_errors"] = study.worst
+        payload["model_comparison"] = study.comparisons
     targets["results.json"].write_text(
         json.dumps(payload, indent=1, default=_json_default), encoding="utf-8"
     )
-    for name, rows in (("results.csv", analysis.rows), ("fits.csv", fits_rows)):
+    for name, table in (("results.csv", rows), ("fits.csv", fits_rows)):
         with targets[name].open("w", newline="", encoding="utf-8") as handle:
-            if rows:
-                writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+            if table:
+                writer = csv.DictWriter(handle, fieldnames=list(table[0]))
                 writer.writeheader()
-                writer.writerows(rows)
+                writer.writerows(table)
     return list(targets.values())
 
 
