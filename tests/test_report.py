@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import json
+import os
 import re
 import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -96,3 +98,87 @@ def test_report_on_real_brfd_records_says_what_it_cannot_fit(tmp_path: Path) -> 
 def test_report_needs_records(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["report", "--records", str(tmp_path), "--out", str(tmp_path / "o")]) == 2
     assert "no record files" in capsys.readouterr().err
+
+
+# ---- the report in a real browser (headless Chromium; CI installs it, see .ci/run) ----------
+
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--window-size=1280,900",
+)
+
+
+def _browser(user_data: Path) -> Any:
+    """A headless Chromium driven by Debian's chromedriver, or skip (fail in CI) without it."""
+    reasons = [
+        f"{name} not found" for name in ("chromium", "chromedriver") if not shutil.which(name)
+    ]
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.service import Service
+    except ImportError:
+        reasons.append("selenium is not installed (pip install -e '.[test]')")
+    if reasons:
+        message = (
+            "the browser test needs Debian's chromium and chromium-driver "
+            f"(apt-get install -y chromium chromium-driver): {'; '.join(reasons)}"
+        )
+        if os.environ.get("CLEARJOINT_REQUIRE_BROWSER") == "1":
+            pytest.fail(message)
+        pytest.skip(message)
+    os.environ.setdefault("SE_OFFLINE", "true")  # never let Selenium Manager download
+    options = webdriver.ChromeOptions()
+    options.binary_location = str(shutil.which("chromium"))
+    for flag in (*CHROMIUM_FLAGS, f"--user-data-dir={user_data}"):
+        options.add_argument(flag)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    return webdriver.Chrome(options=options, service=Service(str(shutil.which("chromedriver"))))
+
+
+def _problems(driver: Any, page: Path) -> list[str]:
+    """What is wrong with a page in the browser: console errors, images that do not decode,
+    a findings table not visible in the first screen."""
+    driver.get(page.resolve().as_uri())
+    problems = [
+        f"console: {e['message']}" for e in driver.get_log("browser") if e["level"] == "SEVERE"
+    ]
+    images = driver.execute_script(
+        "return Array.from(document.images).map(i => [i.alt, i.complete, i.naturalWidth]);"
+    )
+    problems += [f"image {alt!r} did not decode" for alt, ok, width in images if not (ok and width)]
+    box = driver.execute_script(
+        "const t = document.getElementById('findings');"
+        "if (!t) return null;"
+        "const r = t.querySelectorAll('tr')[1].getBoundingClientRect();"
+        "return [r.top, r.bottom, window.innerHeight];"
+    )
+    if box is None or not (box[0] >= 0 and box[1] <= box[2]):
+        problems.append(f"the findings table is not in the first screen: {box}")
+    return problems
+
+
+def test_report_in_a_real_browser(reproduction: Path, tmp_path: Path) -> None:
+    driver = _browser(tmp_path / "chromium-profile")
+    try:
+        assert _problems(driver, reproduction / "report.html") == []
+        assert len(driver.execute_script("return document.images;")) >= 8
+        # the same checks see each fault on a page made to have them
+        bad = tmp_path / "bad.html"
+        bad.write_text(
+            '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>bad</title>'
+            '</head><body><div style="height:3000px"></div>'
+            '<img alt="broken" src="data:image/png;base64,AAAA">'
+            '<table id="findings"><tr><th>h</th></tr><tr><td>row</td></tr></table>'
+            "<script>undefinedFunction();</script></body></html>"
+        )
+        found = _problems(driver, bad)
+        assert len(found) == 3, found
+    finally:
+        driver.quit()
