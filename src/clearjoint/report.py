@@ -241,7 +241,12 @@ def distrust(study: Study) -> list[str]:
                 f"Section 2's closed form is up to {max(gaps):.0%} off the exact cycle on these"
                 " forced tests (Fig. 13's grey points): use it for trends, not for numbers."
             )
-    out.append("With two clearances eq 22's dependence on c is a straight line through two points.")
+    clearances = {r["nominal_clearance_m"] for r in analysis.rows if r["jointed"]}
+    if len(clearances) == 2:
+        out.append(
+            "With two clearances eq 22's dependence on c is a straight line through two points:"
+            " its linearity in c cannot be tested."
+        )
     return out
 
 
@@ -358,7 +363,12 @@ for every joint and side. Source "model": it also holds in the control ({
 results.json (key <code>findings</code>).</small></p>
 <h2>What to distrust</h2><ul>{_items(distrust(study))}</ul>
 {truth}
-<h2>Figures</h2>{figures}
+<h2>Figures</h2>
+<p>Figs. 8-10 and eq 19-20 show the per-side dynamic stiffness k_d,s of MODEL.md section 3
+(contact time plus one free-play crossing, from the identified slopes, A_s and c), which
+includes the clearance's softening; the contact slopes, which earlier reports showed there,
+have their own figure and their own eq 19 and 20 (law "eq 19 slopes", key
+<code>contact_joint_stiffness</code>).</p>{figures}
 <h2>Tables</h2>{"".join(sections)}
 </body></html>
 """
