@@ -68,3 +68,42 @@ def test_no_clearance_gives_the_slope_and_bad_sides_give_nan() -> None:
     kdc, kdt = side_dynamic_stiffness(1.5, 1e-4, 7e7, 6e7, 0.0, -1e-6, math.nan)
     assert math.isnan(kdc)
     assert math.isnan(kdt)
+
+
+def test_damper_stages_follow_the_force_after_each_reversal() -> None:
+    from clearjoint.analysis import stage_runs
+    from clearjoint.identify import CycleResult, Identification
+    from clearjoint.records import Record
+
+    t = np.linspace(0.0, 2.0, 2001)
+    x = np.sin(2 * np.pi * t)  # reversals at t = 0.25, 0.75, ...
+    # friction 100 N while sliding; after each reversal the force falls through zero
+    # (backlash, 0.05 s at zero force) before it reaches -100 N
+    force = np.zeros_like(t)
+    for k, start in enumerate(np.arange(-0.25, 2.0, 0.5)):
+        sign = 1.0 if k % 2 == 0 else -1.0
+        span = (t >= start) & (t < start + 0.5)
+        since = t[span] - start
+        force[span] = np.where(since < 0.1, sign * 100 * (1 - since / 0.1), 0.0)
+        force[span] = np.where(since >= 0.15, -sign * 100.0, force[span])
+    force = -force  # compression (+) while x rises toward its maximum
+    record = Record(time=t, force=force, displacement=x, control="displacement")
+    cycle = CycleResult(0, t.size, {}, 0.0, 0.0, "damper")
+    ident = Identification(
+        source="synthetic",
+        frequency_hz=1.0,
+        cycles_total=2,
+        cycles=(cycle,),
+        summary={"friction_force_n": 100.0},
+        spread={},
+        control="displacement",
+        restoring_force=force,
+        stage=np.zeros(t.size, dtype=np.int8),
+    )
+    free = [(a, b) for name, a, b in stage_runs(record, ident) if name == "free-play"]
+    assert len(free) >= 3
+    for a, b in free:
+        # each free play sits just after a reversal (x at a turning point, 0.25 + k/2 s)
+        since_reversal = (a - 0.25) % 0.5
+        assert 0.05 < since_reversal < 0.12, (a, b)
+        assert b - a == pytest.approx(0.07, abs=0.01)
