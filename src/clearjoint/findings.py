@@ -31,6 +31,7 @@ import numpy as np
 
 from clearjoint import fit
 from clearjoint.analysis import SIDES, Analysis, side_data, tests_of
+from clearjoint.errors import ParameterError
 
 #: How many standard errors make a sign.
 Z = 2.0
@@ -53,7 +54,7 @@ class Finding:
 
     def __post_init__(self) -> None:
         if self.source not in ("model", "rig input"):
-            raise ValueError(f"source must be 'model' or 'rig input', got {self.source!r}")
+            raise ParameterError(f"source must be 'model' or 'rig input', got {self.source!r}")
 
     def as_dict(self) -> dict[str, Any]:
         """The row as results.json writes it (keys exactly the field names)."""
@@ -488,9 +489,10 @@ def law_timing(
     files: Sequence[str],
 ) -> Timing | None:
     """Return eq 22's time per test (best of 5 repeats over the jointed tests) beside the
-    integration's, and eq 22's median error against the exact cycles' energies.
+    integration's, and eq 22's median error against the integrated energies.
 
-    ``integration_s``, ``exact_j`` and ``files`` describe the tests integrated
+    ``integration_s``, ``exact_j`` (the energy per cycle integrated over the exact
+    steady cycle with the rig's losses) and ``files`` describe the tests integrated
     (``verification.model_checks``).
     """
     import time

@@ -156,7 +156,7 @@ def reproduce(
     timing = law_timing(
         analysis,
         [c["integration_s"] for c in comparisons],
-        [c["exact_total_j"] for c in comparisons],
+        [c["integrated_j"] for c in comparisons],
         [c["file"] for c in comparisons],
     )
     findings = findings_table(analysis, control, control_name="control run", timing=timing)
