@@ -92,7 +92,12 @@ def test_report_on_real_brfd_records_says_what_it_cannot_fit(tmp_path: Path) -> 
     results = json.loads((out / "results.json").read_text())
     assert any("eq 20" in line for line in results["not_fitted"])  # no structure without play
     assert any("2Hz0lbtension1amplitude" in line for line in results["records_not_used"])
-    self_contained((out / "report.html").read_text())
+    assert len(results["findings"]) == 10  # the same table, its control the frozen slopes
+    assert all(not line.startswith("/") for line in results["records_not_used"])
+    page = (out / "report.html").read_text()
+    self_contained(page)
+    assert page.index('<table id="findings">') < page.index("<h2>Figures</h2>")
+    assert "Fig. 12: stiffness coefficient c_d against amplitude, for c = " in page
 
 
 def test_report_needs_records(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
