@@ -211,7 +211,10 @@ def _joint_first_falls_with_frequency(analysis: Analysis) -> _Check:
 
 def _no_eq20(analysis: Analysis) -> str:
     reasons = [line for line in analysis.not_fitted if line.startswith("eq 20 ")]
-    return "eq 20 not fitted: " + ("; ".join(reasons) if reasons else "no jointed structure")
+    if not reasons:
+        return "eq 20 not fitted: no jointed structure"
+    more = f" (and {len(reasons) - 1} more)" if len(reasons) > 1 else ""
+    return f"eq 20 not fitted: {reasons[0]}{more}"
 
 
 # ---- the dissipation findings ---------------------------------------------------------------
@@ -301,7 +304,8 @@ def _row(
     if input_check is not None:
         evidence += f". Contact slopes: {input_check.evidence}"
     if not ours.holds:
-        return Finding(finding, paper, False, "model", evidence, why_model)
+        why = f"Not shown by these data at {Z:g} standard errors. The model: {why_model}"
+        return Finding(finding, paper, False, "model", evidence, why)
     if input_check is not None and input_check.holds:
         return Finding(finding, paper, True, "rig input", evidence, given)
     if not survives:
@@ -346,10 +350,15 @@ def findings_table(
     elif falls_abar:
         which = "It falls at equal penetration Abar, the model's own amplitude."
     else:
+        clearances = {r["nominal_clearance_m"] for r in analysis.rows if r["jointed"]}
         which = (
             "Neither fit gives a significant fall"
             + (" (with A = Abar it rises: more free play, faster impacts)" if rises_abar else "")
-            + "; with only two clearances eq 22's linearity in c cannot be tested."
+            + (
+                "; with only two clearances eq 22's linearity in c cannot be tested."
+                if len(clearances) == 2
+                else "."
+            )
         )
     rows = [
         _row(

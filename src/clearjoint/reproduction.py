@@ -85,7 +85,7 @@ def report_records(
         title=f"clearjoint report: {folder.name}",
         what_was_run=[
             f"clearjoint report --records {folder.name}: {len(files)} record files, "
-            f"{len(analysis.rows)} identified, {len(failures)} not used.",
+            f"{len(analysis.rows)} identified and used, {len(analysis.failures)} not used.",
         ],
         analysis=analysis,
         findings=findings,
