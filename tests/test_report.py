@@ -187,3 +187,14 @@ def test_report_in_a_real_browser(reproduction: Path, tmp_path: Path) -> None:
         assert len(found) == 3, found
     finally:
         driver.quit()
+
+
+def test_names_moved_out_of_report_still_import() -> None:
+    from clearjoint import analysis, reproduction, verification
+    from clearjoint.report import analyse, example_cycle, reproduce
+
+    assert reproduce is reproduction.reproduce
+    assert analyse is analysis.analyse
+    assert example_cycle is verification.example_cycle
+    with pytest.raises(ImportError, match="no_such_name"):
+        from clearjoint.report import no_such_name  # noqa: F401

@@ -474,3 +474,23 @@ def _json_default(value: Any) -> Any:
     if isinstance(value, np.generic):
         return value.item()
     raise TypeError(f"not JSON: {value!r}")
+
+
+#: Names that lived here before report.py was split, and where they live now.
+_MOVED = {
+    "reproduce": "clearjoint.reproduction",
+    "report_records": "clearjoint.reproduction",
+    "analyse": "clearjoint.analysis",
+    "stiffness_study": "clearjoint.verification",
+    "example_cycle": "clearjoint.verification",
+    "PAPER_CLEARANCES": "clearjoint.verification",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Keep ``from clearjoint.report import reproduce`` (and the other moved names) working."""
+    if name in _MOVED:
+        import importlib
+
+        return getattr(importlib.import_module(_MOVED[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
