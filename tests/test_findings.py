@@ -205,12 +205,23 @@ def test_the_report_opens_with_the_findings_table(reproduction: Path) -> None:
         assert name.replace(">", "&gt;") in page
 
 
-def test_the_same_table_for_a_folder_of_records(reproduction: Path, tmp_path: Path) -> None:
+def test_the_same_table_for_a_folder_of_records(
+    reproduction: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     from clearjoint.cli import main
 
     out = tmp_path / "report"
     assert main(["report", "--records", str(reproduction / "records"), "--out", str(out)]) == 0
     results = json.loads((out / "results.json").read_text())
+    printed = capsys.readouterr().out.splitlines()
+    for row in results["findings"]:  # the command prints the same table
+        mark = "yes" if row["reproduced"] else "NO"
+        assert any(
+            line.split()[:1] == [mark]
+            and line.rstrip().endswith(row["finding"])
+            and row["source"] in line
+            for line in printed
+        ), row["finding"]
     check_table(results)  # its control: the contact slopes frozen at their medians
     assert "frozen" in results["control"]
     assert results["findings"][-1]["reproduced"] is False  # no exact cycles to time here

@@ -511,8 +511,20 @@ def _run_reproduce(args: argparse.Namespace) -> int:
     )
     for path in written:
         print(f"wrote {path}")
+    _print_findings(Path(args.out) / "results.json")
     print(f"done in {time.perf_counter() - start:.0f} s")
     return 0
+
+
+def _print_findings(results: Path) -> None:
+    """Print the findings table of a written report, one row per paper finding."""
+    import json
+
+    rows = json.loads(results.read_text(encoding="utf-8"))["findings"]
+    print("the paper's findings (reproduced, source): see report.html for the evidence")
+    for row in rows:
+        mark = "yes" if row["reproduced"] else "NO "
+        print(f"  {mark}  {row['source']:<9}  {row['finding']}")
 
 
 def _run_report(args: argparse.Namespace) -> int:
@@ -526,6 +538,7 @@ def _run_report(args: argparse.Namespace) -> int:
     )
     for path in written:
         print(f"wrote {path}")
+    _print_findings(Path(args.out) / "results.json")
     return 0
 
 
