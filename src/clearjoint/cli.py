@@ -13,8 +13,10 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -671,6 +673,15 @@ def _run_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def _warning_printer(command: str) -> Callable[..., None]:
+    """A warnings.showwarning that prints one line, without the source file and line."""
+
+    def show(message: Warning | str, category: type[Warning], *_: Any, **__: Any) -> None:
+        print(f"clearjoint {command}: warning: {message}", file=sys.stderr)
+
+    return show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
@@ -685,7 +696,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         "report": _run_report,
     }
     try:
-        return runners[args.command](args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _warning_printer(args.command)
+            return runners[args.command](args)
+    except BrokenPipeError:  # the reader stopped early (| head): not an error of ours
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so the exit's flush does not raise again
+        return 0
     except ClearjointError as exc:
         print(f"clearjoint {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
