@@ -19,14 +19,14 @@ HERE = Path(__file__).parent / "figures"
 
 
 def _name(alt: str) -> str | None:
-    """A figure's file name from its caption: figN, contact (slopes) or truth."""
+    """A figure's file name from its caption: figN, fig8_contact (slopes) or fig_truth."""
     number = re.match(r"Fig\. (\d+)", alt)
     if number:
         return f"fig{number.group(1)}"
     if alt.startswith("Contact slopes"):
-        return "contact"
+        return "fig8_contact"
     if alt.startswith("Identification against"):
-        return "truth"
+        return "fig_truth"
     return None
 
 
