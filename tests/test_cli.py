@@ -341,3 +341,31 @@ def test_an_output_path_under_a_file_is_one_line(
     assert "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
     assert str(blocker) in err
+
+
+def test_a_reader_that_stops_early_gets_no_traceback_and_no_error() -> None:
+    """`clearjoint dissipation ... | head -2`: a broken pipe is the reader's choice."""
+    amplitudes = ",".join(f"{i}um" for i in range(1, 3000))  # far more than a pipe buffers
+    command = [sys.executable, "-m", "clearjoint", "dissipation", "--mass", "2kg", "--stiffness",
+               "8e7N/m", "--clearance", "0.106mm", "--amplitude", amplitudes]  # fmt: skip
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE) as proc:
+        assert proc.stdout is not None
+        assert proc.stderr is not None
+        proc.stdout.readline()
+        proc.stdout.close()  # as head does after its lines
+        err = proc.stderr.read().decode()
+        assert proc.wait(timeout=120) == 0
+    assert err == ""
+
+
+@pytest.mark.filterwarnings("default::clearjoint.contact.HertzValidityWarning")
+def test_a_warning_is_one_line_naming_the_command(capsys: pytest.CaptureFixture[str]) -> None:
+    # a 1 kN-class contact force on a short pin: Hertz's half-angle is far past 0.2 rad
+    code = main(["dissipation", "--mass", "2kg", "--stiffness", "8e7N/m", "--clearance", "0.106mm",
+                 "--amplitude", "300um", "--pin-radius", "5mm", "--pin-length", "5mm",
+                 "--contact-friction-coefficient", "0.15"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 0
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("clearjoint dissipation: warning: Hertz contact half-angle")
