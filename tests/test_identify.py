@@ -14,8 +14,11 @@ from clearjoint.cli import main
 from clearjoint.identify import IdentificationError, identify
 from clearjoint.records import Record, read_record
 from clearjoint.rig import load_campaign, run_campaign
+from independent_joint import TrueJoint, steady_truth, write_record
 
 BRFD = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
+#: Three real BRFD records shipped with the tests (2 Hz, 0.5 in; 0, 30 and 36 lb; CC BY-SA 4.0).
+SHIPPED = Path(__file__).resolve().parent / "data" / "brfd"
 
 REDUCED = """
 seed = 11
@@ -222,3 +225,56 @@ def test_cli_refuses_when_nothing_is_usable(
     junk.write_text(json.dumps({"a": 1}))
     assert main(["identify", str(junk), "--out", str(tmp_path / "r.csv"), "--quiet"]) == 2
     assert "no record could be used" in capsys.readouterr().err
+
+
+# ---- records from an independent simulator (tests/independent_joint.py, not the rig) -------
+
+
+@pytest.fixture(scope="module")
+def independent() -> dict[float, tuple[TrueJoint, dict[str, float]]]:
+    joints = {f: TrueJoint(frequency_hz=f) for f in (40.0, 100.0)}
+    return {f: (j, steady_truth(j)) for f, j in joints.items()}
+
+
+def test_the_independent_simulator_balances_its_energy(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]],
+) -> None:
+    for _, truth in independent.values():
+        # the exciter's work over a steady cycle is what friction and drag dissipate
+        assert truth["external_work_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=1e-6)
+        assert truth["amplitude_m"] > 0.5 * TrueJoint().clearance  # the contacts are reached
+
+
+def test_noise_free_independent_records_with_acceleration(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path
+) -> None:
+    for f, (joint, truth) in independent.items():
+        path = write_record(joint, tmp_path / f"{f}.csv", noise=0.0, cycles=12)
+        s = identify(read_record(path)).summary
+        for key in ("clearance_m", "compression_stiffness_n_per_m", "tension_stiffness_n_per_m"):
+            assert s[key] == pytest.approx(truth[key], rel=0.01), (f, key)
+        assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.05)
+        assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+# ---- real records shipped with the tests ------------------------------------------------
+
+
+def elastic_plastic_energy(s: dict[str, float]) -> float:
+    """Loop area of an elastic-plastic friction loop with a gap: 2 F_f (2X - b - 2 F_f / k)."""
+    k = 0.5 * (s["compression_stiffness_n_per_m"] + s["tension_stiffness_n_per_m"])
+    f_f, x, b = s["friction_force_n"], s["amplitude_m"], s["clearance_m"]
+    return 2 * f_f * (2 * x - b - 2 * f_f / k)
+
+
+@pytest.mark.parametrize("tension", [30, 36])
+def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
+    record = read_record(SHIPPED / f"2Hz{tension}lbtension0.5amplitude.json")
+    assert "band tension" in record.notes
+    result = identify(record)
+    s = result.summary
+    assert result.model == "damper"
+    assert result.cycles_used >= 3
+    # the device's backlash is a few millimetres (the data set's figures: about 5 mm)
+    assert 3e-3 < s["clearance_m"] < 7e-3
+    assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
