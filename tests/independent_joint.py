@@ -20,6 +20,7 @@ dissipated per cycle, integral of (c_v x'^2 + F_f tanh(x'/v_s) x') dt over the c
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -63,6 +64,7 @@ class TrueJoint:
         )
 
 
+@functools.lru_cache(maxsize=8)
 def _periodic_cycle(joint: TrueJoint, settle: int = 80) -> tuple[Callable[[Array], Array], float]:
     """Dense output (x, x') of one steady cycle starting at the returned time t0.
 

@@ -142,22 +142,19 @@ def test_real_brfd_records() -> None:
     identified = 0
     for path in sorted(BRFD.glob("*.json")):
         if path.name == "2Hz0lbtension1amplitude.json":  # two steady cycles only (docs)
-            with pytest.raises(IdentificationError, match="steady cycles"):
+            with pytest.raises(IdentificationError, match="2 steady cycles"):
                 identify(read_record(path))
             continue
         result = identify(read_record(path))
         identified += 1
         s = result.summary
-        assert result.cycles_used >= 2
-        assert s["energy_per_cycle_j"] > 0
-        # the 0 lb band-tension tests have little friction and, per the data set's own
-        # notes, possibly a wrong tension: their loops are not rigid-plastic (docs)
-        if "0lbtension" not in path.name:
-            assert result.model == "damper", path.name
-            # independent route: a rigid-plastic friction loop with backlash b
-            estimate = 2 * s["friction_force_n"] * (2 * s["amplitude_m"] - s["clearance_m"])
-            assert 0.7 < s["energy_per_cycle_j"] / estimate < 1.25, path.name
-            assert 3e-3 < s["clearance_m"] < 8e-3, path.name
+        assert result.cycles_used >= 3
+        if path.name == "1Hz0lbtension1.5amplitude.json":
+            continue  # not yet recognised as a damper (docs/identify.md)
+        assert result.model == "damper", path.name
+        # independent route: an elastic-plastic friction loop with a gap b
+        assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
+        assert 2e-3 < s["clearance_m"] < 6e-3, path.name
     assert identified == 30
 
 
@@ -257,6 +254,58 @@ def test_noise_free_independent_records_with_acceleration(
         assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
 
 
+KEYS = ("clearance_m", "compression_stiffness_n_per_m", "tension_stiffness_n_per_m")
+
+
+@pytest.mark.parametrize("frequency", [40.0, 100.0])
+def test_one_percent_noise_on_every_channel_with_acceleration(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path, frequency: float
+) -> None:
+    joint, truth = independent[frequency]
+    path = write_record(joint, tmp_path / "noisy.csv", noise=0.01, acceleration=True)
+    s = identify(read_record(path)).summary
+    assert s["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01)
+    for key in KEYS[1:]:
+        assert s[key] == pytest.approx(truth[key], rel=0.02), key
+    assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10)
+    assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+@pytest.mark.parametrize("frequency", [40.0, 100.0])
+def test_one_percent_noise_without_acceleration(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path, frequency: float
+) -> None:
+    joint, truth = independent[frequency]
+    path = write_record(joint, tmp_path / "noisy.csv", noise=0.01, acceleration=False)
+    result = identify(read_record(path))
+    s = result.summary
+    for key in KEYS[1:]:
+        assert s[key] == pytest.approx(truth[key], rel=0.02), key
+    assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+    if frequency == 40.0:  # at 100 Hz the free-play crossing is too short (docs)
+        assert s["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01)
+        assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10)
+    # every value carries a standard error
+    assert all(result.stderr[k] > 0 for k in KEYS)
+
+
+def test_force_control_without_a_mass_warns_and_estimates_it(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path
+) -> None:
+    joint, truth = independent[40.0]
+    path = write_record(joint, tmp_path / "nomass.csv", noise=0.01, mass_in_metadata=False)
+    result = identify(read_record(path))
+    assert len(result.warnings) == 1
+    assert "without a mass" in result.warnings[0]
+    assert "# mass = " in result.warnings[0]  # says how to add it
+    assert result.summary["mass_kg"] == pytest.approx(joint.mass, rel=0.02)
+    assert result.summary["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01)
+    flag, reason = result.flags["clearance_m"]
+    assert flag == "doubtful"
+    assert "mass" in reason
+    assert result.row()["flag"] == "doubtful"
+
+
 # ---- real records shipped with the tests ------------------------------------------------
 
 
@@ -267,7 +316,7 @@ def elastic_plastic_energy(s: dict[str, float]) -> float:
     return 2 * f_f * (2 * x - b - 2 * f_f / k)
 
 
-@pytest.mark.parametrize("tension", [30, 36])
+@pytest.mark.parametrize("tension", [0, 30, 36])
 def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
     record = read_record(SHIPPED / f"2Hz{tension}lbtension0.5amplitude.json")
     assert "band tension" in record.notes
@@ -275,6 +324,10 @@ def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
     s = result.summary
     assert result.model == "damper"
     assert result.cycles_used >= 3
-    # the device's backlash is a few millimetres (the data set's figures: about 5 mm)
-    assert 3e-3 < s["clearance_m"] < 7e-3
+    # the device's backlash is a few millimetres (the data set's figures: about 4 mm)
+    assert 2e-3 < s["clearance_m"] < 6e-3
+    # the slip levels of both directions, with the friction force half their difference
+    up, down = s["friction_force_positive_n"], s["friction_force_negative_n"]
+    assert up > 0 > down
+    assert s["friction_force_n"] == pytest.approx(0.5 * (up - down))
     assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
