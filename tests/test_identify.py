@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 from clearjoint.cli import main
-from clearjoint.identify import IdentificationError, identify
+from clearjoint.identify import IdentificationError, identify, identify_files
 from clearjoint.records import Record, read_record
 from clearjoint.rig import load_campaign, run_campaign
 from independent_joint import TrueJoint, steady_truth, write_record
@@ -139,23 +139,27 @@ def test_exact_friction_loop_with_backlash() -> None:
 
 @pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
 def test_real_brfd_records() -> None:
-    identified = 0
-    for path in sorted(BRFD.glob("*.json")):
-        if path.name == "2Hz0lbtension1amplitude.json":  # two steady cycles only (docs)
-            with pytest.raises(IdentificationError, match="2 steady cycles"):
-                identify(read_record(path))
-            continue
-        result = identify(read_record(path))
-        identified += 1
+    results, failures = identify_files([str(p) for p in sorted(BRFD.glob("*.json"))])
+    # the one record refused: its ramps leave two steady cycles (docs)
+    assert len(failures) == 1
+    assert "2Hz0lbtension1amplitude.json: 2 steady cycles" in failures[0]
+    assert "a record needs at least 3 steady cycles" in failures[0]  # the rule, stated
+    assert len(results) == 30
+    backlash: dict[str, list[float]] = {}
+    for _, result in results:
         s = result.summary
+        assert result.model == "damper", result.source
         assert result.cycles_used >= 3
-        if path.name == "1Hz0lbtension1.5amplitude.json":
-            continue  # not yet recognised as a damper (docs/identify.md)
-        assert result.model == "damper", path.name
         # independent route: an elastic-plastic friction loop with a gap b
         assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
-        assert 2e-3 < s["clearance_m"] < 6e-3, path.name
-    assert identified == 30
+        tension = result.source.split("Hz")[1].split("lb")[0]
+        backlash.setdefault(tension, []).append(s["clearance_m"])
+    # one device: the backlash within 15 % of the median at its band tension; three of the
+    # thirty miss it today (docs/identify.md says which)
+    misses = sum(
+        abs(b / np.median(values) - 1.0) > 0.15 for values in backlash.values() for b in values
+    )
+    assert misses <= 3
 
 
 def test_short_and_shapeless_records_are_refused() -> None:

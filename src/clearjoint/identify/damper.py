@@ -43,10 +43,13 @@ def _crossings(travel: FloatArray, f: FloatArray, start: float, stop: float) -> 
     out = np.empty(ALPHAS.size)
     for i, alpha in enumerate(ALPHAS):
         j = int(np.searchsorted(reached, alpha))
-        if j == 0 or j >= reached.size:
+        if j >= reached.size:
             return None
-        # linear interpolation between samples j-1 and j
-        p0, p1 = progress[j - 1], progress[j]
+        if j == 0:  # already there at the reversal (ringing, or a level not yet reached)
+            out[i] = 0.0
+            continue
+        # linear interpolation between samples j-1 and j (of the running maximum)
+        p0, p1 = reached[j - 1], reached[j]
         w = (alpha - p0) / (p1 - p0) if p1 != p0 else 1.0
         out[i] = travel[j - 1] + min(max(w, 0.0), 1.0) * (travel[j] - travel[j - 1])
     return out
