@@ -335,3 +335,63 @@ def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
     assert up > 0 > down
     assert s["friction_force_n"] == pytest.approx(0.5 * (up - down))
     assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
+
+
+# ---- the result object and the command line ---------------------------------------------
+
+
+def test_identification_repr_tables_and_plot() -> None:
+    result = identify(read_record(SHIPPED / "2Hz36lbtension0.5amplitude.json"))
+    text = repr(result)
+    assert text.startswith("Identification(")
+    assert "model='damper'" in text
+    assert len(text) < 400
+    assert "array" not in text
+    data = result.to_xarray()
+    assert data.sizes["cycle"] == result.cycles_used
+    assert data["clearance_m"].attrs["units"] == "m"
+    assert data["clearance_m"].attrs["estimate"] == result.summary["clearance_m"]
+    assert data["clearance_m"].attrs["flag"] in ("ok", "doubtful", "rejected")
+    # the cycles' jackknife pseudo-values average to the estimate's neighbourhood and
+    # their spread over sqrt(n) is the standard error
+    values = data["clearance_m"].to_numpy()
+    n = values.size
+    assert np.std(values, ddof=1) / np.sqrt(n) == pytest.approx(result.stderr["clearance_m"])
+    table = result.to_pandas()
+    assert table.loc["friction_force_n", "unit"] == "N"
+    assert set(table["flag"]) <= {"ok", "doubtful", "rejected"}
+    import matplotlib
+
+    matplotlib.use("Agg")
+    ax = result.plot()
+    assert ax.get_xlabel() == "displacement (mm)"
+    assert len(ax.lines) >= 1
+
+
+def test_cli_plot_flags_warnings_and_jobs(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    joint, _ = independent[40.0]
+    nomass = write_record(joint, tmp_path / "nomass.csv", noise=0.01, mass_in_metadata=False)
+    files = [str(p) for p in sorted(SHIPPED.glob("*.json"))] + [str(nomass)]
+    out, plot = tmp_path / "r.csv", tmp_path / "loops.png"
+    assert main(["identify", *files, "--out", str(out), "--plot", str(plot), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: " in err
+    assert "without a mass" in err
+    assert plot.stat().st_size > 0
+    with out.open() as handle:
+        table = list(csv.DictReader(handle))
+    assert {"flag", "flag_reason", "clearance_m_se"} <= set(table[0])
+    assert table[-1]["flag"] == "doubtful"
+    assert "mass" in table[-1]["flag_reason"]
+    # an existing plot is not overwritten without --force
+    assert main(["identify", *files, "--out", str(tmp_path / "s.csv"), "--plot", str(plot)]) == 2
+    assert "will not overwrite" in capsys.readouterr().err
+    # two processes give the serial results, in file order
+    serial, _ = identify_files(files)
+    parallel, _ = identify_files(files, jobs=2)
+    for (_, a), (_, b) in zip(serial, parallel, strict=True):
+        np.testing.assert_equal(a.row(), b.row())  # NaN equals NaN here

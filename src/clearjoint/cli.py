@@ -161,6 +161,10 @@ def _identify_parser(sub: Any) -> None:
     p.add_argument("files", nargs="+", help="record files")
     p.add_argument("--out", required=True, help="results file, .csv or .nc")
     p.add_argument("--figures", help="write two figures per test into this folder")
+    p.add_argument("--plot", help="write one figure (.png) of every identified loop with its flag")
+    p.add_argument(
+        "--jobs", type=int, default=1, help="processes over the files (default 1; same results)"
+    )
     p.add_argument(
         "--resample", action="store_true", help="interpolate records that are not uniformly sampled"
     )
@@ -378,11 +382,15 @@ def _run_identify(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .csv or .nc, got {out.name!r}")
     if not 0.0 < args.tolerance < 1.0:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
-    refuse_to_overwrite([out], force=args.force)
+    if args.jobs < 1:
+        raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    plot = Path(args.plot) if args.plot else None
+    if plot is not None and plot.suffix.lower() != ".png":
+        raise ParameterError(f"--plot must end in .png, got {plot.name!r}")
+    refuse_to_overwrite([out, *([plot] if plot else [])], force=args.force)
+    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
     if args.quiet:
-        results, failures = identify_files(
-            args.files, resample=args.resample, tolerance=args.tolerance
-        )
+        results, failures = identify_files(args.files, **options)
     else:
         from rich.progress import Progress
 
@@ -390,12 +398,14 @@ def _run_identify(args: argparse.Namespace) -> int:
             task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
             results, failures = identify_files(
                 args.files,
-                resample=args.resample,
-                tolerance=args.tolerance,
+                **options,
                 progress=lambda done, _total: bar.update(task, completed=done),
             )
     for line in failures:
         print(f"not used: {line}", file=sys.stderr)
+    for _, ident in results:
+        for warning in ident.warnings:
+            print(f"warning: {warning}", file=sys.stderr)
     if not results:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -403,7 +413,16 @@ def _run_identify(args: argparse.Namespace) -> int:
     _write_rows(rows, out)
     if args.figures:
         _identify_figures(results, Path(args.figures), force=args.force)
-    print(f"identified {len(results)} of {len(args.files)} records; wrote {out}")
+    if plot is not None:
+        from clearjoint.identify import identifications_figure
+
+        identifications_figure([ident for _, ident in results]).savefig(plot, dpi=100)
+        print(f"wrote {plot}")
+    flagged = sum(ident.flag != "ok" for _, ident in results)
+    print(
+        f"identified {len(results)} of {len(args.files)} records ({flagged} flagged, see the "
+        f"flag and flag_reason columns); wrote {out}"
+    )
     return 0
 
 

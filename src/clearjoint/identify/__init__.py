@@ -24,7 +24,12 @@ from clearjoint.identify.cycles import (
     excitation_frequency,
     steady_rule,
 )
-from clearjoint.identify.result import QUANTITIES, CycleResult, Identification
+from clearjoint.identify.result import (
+    QUANTITIES,
+    CycleResult,
+    Identification,
+    identifications_figure,
+)
 from clearjoint.identify.segments import STAGE_COMPRESSION, STAGE_FREE, STAGE_TENSION
 
 __all__ = [
@@ -38,6 +43,7 @@ __all__ = [
     "IdentificationError",
     "excitation_frequency",
     "flag_outliers",
+    "identifications_figure",
     "identify",
     "identify_files",
     "restoring_force",

@@ -519,30 +519,65 @@ def flag_outliers(results: list[Identification]) -> list[Identification]:
     return out
 
 
+def _identify_path(args: tuple[str, bool, float]) -> tuple[Record, Identification] | str:
+    """Read and identify one file; its result, or the line that says why it was not used."""
+    from clearjoint.records import read_record
+
+    path, resample, tolerance = args
+    try:
+        record = read_record(path, resample=resample)
+        return record, identify(record, tolerance=tolerance)
+    except ClearjointError as exc:
+        text = str(exc)
+        return text if text.startswith(str(path)) else f"{path}: {text}"
+
+
 def identify_files(
     paths: list[str],
     *,
     resample: bool = False,
     tolerance: float = 0.03,
+    jobs: int = 1,
     progress: Callable[[int, int], Any] | None = None,
 ) -> tuple[list[tuple[Record, Identification]], list[str]]:
     """Identify every file; return the results and one line for each file not used.
 
-    ``progress(done, total)`` is called after each file. Clearances more than twice
-    the median of the other tests of the same device are flagged (:func:`flag_outliers`).
-    """
-    from clearjoint.records import read_record
+    Parameters
+    ----------
+    paths : list of str
+        Record files (any format of :mod:`clearjoint.records`).
+    resample, tolerance
+        As for :func:`~clearjoint.records.read_record` and :func:`identify`.
+    jobs : int
+        Processes over the files; the results are those of one process, in file order.
+    progress : callable, optional
+        ``progress(done, total)``, called after each file.
 
-    results: list[tuple[Record, Identification]] = []
-    failures: list[str] = []
-    for k, path in enumerate(paths, start=1):
-        try:
-            record = read_record(path, resample=resample)
-            results.append((record, identify(record, tolerance=tolerance)))
-        except ClearjointError as exc:
-            text = str(exc)
-            failures.append(text if text.startswith(str(path)) else f"{path}: {text}")
-        if progress:
-            progress(k, len(paths))
+    Returns
+    -------
+    results : list of (Record, Identification)
+    failures : list of str
+
+    Clearances more than twice the median of the other tests of the same device are
+    flagged (:func:`flag_outliers`).
+    """
+    tasks = [(str(path), resample, tolerance) for path in paths]
+    outcomes: list[tuple[Record, Identification] | str] = []
+    if jobs > 1 and len(tasks) > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            chunk = max(1, len(tasks) // (4 * jobs))
+            for k, outcome in enumerate(pool.map(_identify_path, tasks, chunksize=chunk), 1):
+                outcomes.append(outcome)
+                if progress:
+                    progress(k, len(tasks))
+    else:
+        for k, task in enumerate(tasks, start=1):
+            outcomes.append(_identify_path(task))
+            if progress:
+                progress(k, len(tasks))
+    results = [o for o in outcomes if not isinstance(o, str)]
+    failures = [o for o in outcomes if isinstance(o, str)]
     flagged = flag_outliers([ident for _, ident in results])
     return [(rec, ident) for (rec, _), ident in zip(results, flagged, strict=True)], failures

@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     import pandas as pd
     import xarray as xr
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 FloatArray = NDArray[np.float64]
 
@@ -247,3 +248,32 @@ class Identification:
             (names[int(self.stage[a])], float(time[a]), float(time[min(b, time.size - 1)]))
             for a, b in itertools.pairwise(bounds)
         ]
+
+
+def identifications_figure(results: list[Identification], columns: int = 4) -> Figure:
+    """Return one figure with every identification's loop (:meth:`Identification.plot`).
+
+    Parameters
+    ----------
+    results : list of Identification
+    columns : int
+        Panels per row.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    n = max(len(results), 1)
+    cols = min(columns, n)
+    rows = math.ceil(n / cols)
+    fig = Figure(figsize=(4.0 * cols, 3.2 * rows), layout="constrained")
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax, ident in zip(axes, results, strict=False):
+        ident.plot(ax)
+        name = ident.source.replace("\\", "/").rsplit("/", 1)[-1]
+        ax.set_title(f"{name}\n{ax.get_title()}", fontsize=8)
+    for ax in axes[len(results) :]:
+        ax.set_visible(False)
+    return fig
