@@ -352,11 +352,11 @@ def test_identification_repr_tables_and_plot() -> None:
     assert data["clearance_m"].attrs["units"] == "m"
     assert data["clearance_m"].attrs["estimate"] == result.summary["clearance_m"]
     assert data["clearance_m"].attrs["flag"] in ("ok", "doubtful", "rejected")
-    # the cycles' jackknife pseudo-values average to the estimate's neighbourhood and
-    # their spread over sqrt(n) is the standard error
+    # three cycles, three jackknife groups: the cycles' pseudo-values' spread over sqrt(3)
+    # is the standard error
     values = data["clearance_m"].to_numpy()
-    n = values.size
-    assert np.std(values, ddof=1) / np.sqrt(n) == pytest.approx(result.stderr["clearance_m"])
+    assert values.size == 3
+    assert np.std(values, ddof=1) / np.sqrt(3) == pytest.approx(result.stderr["clearance_m"])
     table = result.to_pandas()
     assert table.loc["friction_force_n", "unit"] == "N"
     assert set(table["flag"]) <= {"ok", "doubtful", "rejected"}

@@ -228,3 +228,12 @@ def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
     path.write_text(json.dumps({"data": [[0.0, 1.0]] * 20, "displacement units": "in"}))
     with pytest.raises(RecordError, match="must have 6 columns"):
         read_brfd(path)
+
+
+def test_fast_unit_factors_agree_with_pint() -> None:
+    from clearjoint.records import FAST_FACTORS, SI
+    from clearjoint.units import registry
+
+    for (channel, unit), factor in FAST_FACTORS.items():
+        exact = registry().Quantity(1.0, unit).to(SI[channel]).magnitude
+        assert factor == pytest.approx(exact, rel=1e-12), (channel, unit)

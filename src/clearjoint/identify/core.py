@@ -16,9 +16,9 @@ MODEL.md section 3. The steps:
    for test functions, by robust least squares over the average's samples (the velocity's
    sign and drag from its spectral derivative); the damper's and the line's by their
    per-sample fits;
-6. a jackknife over the cycles (the average without each cycle in turn) for every
-   standard error; the energy per cycle is each cycle's own loop area (the closed integral
-   of F dx, in which the inertia term cancels);
+6. a jackknife over the cycles (the average without each of at most eight contiguous
+   groups of cycles in turn) for every standard error; the energy per cycle is each
+   cycle's own loop area (the closed integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a fit residual above the noise floor or a force-controlled
    record without a mass (then estimated from the record, with a warning).
@@ -72,6 +72,8 @@ EDGE_MARGIN = 0.05
 #: Equations each stage needs for the weak form (else the stages are fitted sample by
 #: sample on the cycle average, as when a contact lasts only a few samples).
 MIN_EQUATIONS = 4
+#: Groups of the jackknife (contiguous blocks of cycles; one cycle each up to this many).
+JACKKNIFE_GROUPS = 8
 #: Quantities taken per cycle (the cycle's own), not from the fit.
 PER_CYCLE = ("amplitude_m", "energy_per_cycle_j", "secant_stiffness_n_per_m")
 
@@ -155,10 +157,19 @@ def _dynamic(fit: _Fit, clearance: float, a_c: float, mass: float | None) -> flo
         return math.nan
 
 
-def _leave_one_out(values: FloatArray) -> FloatArray:
-    """The averages of the (n, M) rows without each row in turn, (n, M)."""
+def _groups(n: int) -> list[NDArray[np.int64]]:
+    """The jackknife's groups of cycles: contiguous blocks, at most JACKKNIFE_GROUPS."""
+    return [
+        np.asarray(g, dtype=np.int64)
+        for g in np.array_split(np.arange(n), min(n, JACKKNIFE_GROUPS))
+    ]
+
+
+def _leave_one_out(values: FloatArray, groups: list[NDArray[np.int64]]) -> FloatArray:
+    """The averages of the (n, M) rows without each group in turn, (G, M)."""
     n = values.shape[0]
-    out: FloatArray = (values.sum(axis=0)[None, :] - values) / (n - 1)
+    total = values.sum(axis=0)
+    out: FloatArray = np.array([(total - values[g].sum(axis=0)) / (n - g.size) for g in groups])
     return out
 
 
@@ -302,10 +313,13 @@ def _identify_stack(
         model = "damper"
 
     # every replicate: row 0 the average of all cycles, then the averages without one
-    reps_x = np.vstack((x[None, :], _leave_one_out(xs)))
-    reps_f = np.vstack((f[None, :], _leave_one_out(fs)))
+    groups = _groups(n)
+    reps_x = np.vstack((x[None, :], _leave_one_out(xs, groups)))
+    reps_f = np.vstack((f[None, :], _leave_one_out(fs, groups)))
     reps_a = (
-        np.vstack((st.channels["a"].mean(axis=0)[None, :], _leave_one_out(st.channels["a"])))
+        np.vstack(
+            (st.channels["a"].mean(axis=0)[None, :], _leave_one_out(st.channels["a"], groups))
+        )
         if "a" in st.channels
         else None
     )
@@ -346,7 +360,7 @@ def _identify_stack(
                 vr = v
             rr = fr_ - m_guess * ar if force_control else fr_
             fits.append(_joint_fit(xr_, rr, vr, parts, windows, compete=False) or first_fit)
-        masses = np.full(n + 1, m_guess if force_control else math.nan)
+        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     else:
         fits = []
         for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
@@ -360,10 +374,10 @@ def _identify_stack(
             if fit is None:
                 fit = _line_fit(xr_, rr, vr)
             fits.append(fit)
-        masses = np.full(n + 1, m_guess if force_control else math.nan)
+        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     values = [
         _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
-        for i in range(n + 1)
+        for i in range(len(groups) + 1)
     ]
     for vals, fit in zip(values, fits, strict=True):
         symmetric = math.isnan(fit.level_positive)
@@ -381,18 +395,30 @@ def _identify_stack(
             xs, fs - (m_guess * st.channels["a"] if force_control and "a" in st.channels else 0.0)
         ),
     }
+    g = len(groups)
+    member = np.empty(n, dtype=np.int64)
+    for k, group in enumerate(groups):
+        member[group] = k
     for q in QUANTITIES:
         if q in own:
             cyc = own[q]
             est = float(np.mean(cyc))
+            finite = np.isfinite(cyc)
+            se = float(np.std(cyc[finite], ddof=1)) / math.sqrt(n) if finite.sum() > 1 else math.nan
         else:
             est = full.get(q, math.nan)
-            cyc = n * est - (n - 1) * np.array([vv.get(q, math.nan) for vv in loo])
+            pseudo = g * est - (g - 1) * np.array([vv.get(q, math.nan) for vv in loo])
+            cyc = pseudo[member]
+            finite = np.isfinite(pseudo)
+            se = (
+                float(np.std(pseudo[finite], ddof=1)) / math.sqrt(g)
+                if finite.sum() > 1
+                else math.nan
+            )
         per_cycle[q] = cyc
         summary[q] = est if q != "amplitude_m" else 0.5 * float(np.ptp(x))
-        finite = np.isfinite(cyc)
-        spread[q] = float(np.std(cyc[finite], ddof=1)) if finite.sum() > 1 else math.nan
-        stderr[q] = spread[q] / math.sqrt(n) if finite.sum() > 1 else math.nan
+        stderr[q] = se
+        spread[q] = se * math.sqrt(n)
     if model == "line":
         for q in ("clearance_m",):
             summary[q], spread[q], stderr[q] = 0.0, 0.0, 0.0

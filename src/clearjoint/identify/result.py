@@ -62,8 +62,10 @@ class CycleResult:
     the elastic lines (intercept, slope) of its tension, free-play and compression stages.
 
     Amplitude, energy and secant stiffness are the cycle's own; the fitted quantities are
-    the cycle's jackknife pseudo-value (n times the fit of all cycles minus n - 1 times the
-    fit without this one), whose mean is the estimate and whose spread gives its error.
+    the jackknife pseudo-value of the cycle's group (G times the fit of all cycles minus
+    G - 1 times the fit without the group; G <= 8 contiguous groups, one cycle each when
+    there are at most eight), whose mean is near the estimate and whose spread over
+    sqrt(G) is its standard error.
     """
 
     start: int
@@ -81,9 +83,9 @@ class Identification:
 
     ``summary[q]``, ``spread[q]`` and ``stderr[q]`` are, for each quantity in
     ``QUANTITIES``, the estimate (the fit of the steady cycles' average; for amplitude,
-    energy and secant stiffness the mean over the cycles), the spread over the cycles and
-    the estimate's standard error. ``flags[q]`` is (flag, reason) with flag one of
-    ``ok``, ``doubtful``, ``rejected``.
+    energy and secant stiffness the mean over the cycles), the scatter of one cycle
+    (``stderr * sqrt(cycles_used)``) and the estimate's standard error. ``flags[q]`` is
+    (flag, reason) with flag one of ``ok``, ``doubtful``, ``rejected``.
     """
 
     source: str
