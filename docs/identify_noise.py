@@ -1,0 +1,103 @@
+"""Bias of the identification against noise level, on records of an independent simulator.
+
+Run from the repository's root: ``python docs/identify_noise.py``. It writes
+docs/figures/identify_noise_bias.png and prints the table quoted in docs/identify.md.
+
+The records come from tests/independent_joint.py (a scipy solve_ivp model with a smoothed
+Coulomb friction, not the rig, not clearjoint.simulate), written in clearjoint's CSV format
+with Gaussian noise of the given fraction of each channel's standard deviation on every
+channel, with and without an acceleration channel; three noise seeds per level.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from clearjoint.identify import identify  # noqa: E402
+from clearjoint.records import read_record  # noqa: E402
+from independent_joint import TrueJoint, steady_truth, write_record  # noqa: E402
+
+KEYS = {
+    "clearance_m": "clearance",
+    "compression_stiffness_n_per_m": "k_c",
+    "tension_stiffness_n_per_m": "k_t",
+    "friction_force_n": "friction",
+    "energy_per_cycle_j": "energy",
+}
+LEVELS = (0.0, 0.0025, 0.005, 0.01, 0.02)
+SEEDS = (1, 2, 3)
+
+
+def main() -> None:
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        for frequency in (40.0, 100.0):
+            joint = TrueJoint(frequency_hz=frequency)
+            truth = steady_truth(joint)
+            for acceleration in (True, False):
+                for level in LEVELS:
+                    errors = {k: [] for k in KEYS}
+                    for seed in SEEDS:
+                        path = write_record(
+                            joint,
+                            Path(folder) / "r.csv",
+                            noise=level,
+                            acceleration=acceleration,
+                            seed=seed,
+                        )
+                        s = identify(read_record(path)).summary
+                        for k in KEYS:
+                            errors[k].append(s[k] / truth[k] - 1.0)
+                    rows.append((frequency, acceleration, level, errors))
+    print("| f (Hz) | acceleration | noise | " + " | ".join(KEYS.values()) + " |")
+    print("|---|---|---|" + "---|" * len(KEYS))
+    for frequency, acceleration, level, errors in rows:
+        cells = [
+            f"{100 * np.mean(errors[k]):+.2f} ± {100 * np.std(errors[k]):.2f}" for k in KEYS
+        ]
+        print(
+            f"| {frequency:g} | {'yes' if acceleration else 'no'} | {100 * level:g} % | "
+            + " | ".join(cells)
+            + " |"
+        )
+    fig, axes = plt.subplots(1, len(KEYS), figsize=(16, 3.4), layout="constrained")
+    for ax, (key, label) in zip(axes, KEYS.items(), strict=True):
+        for frequency, acceleration, style in (
+            (40.0, True, "C0-o"),
+            (40.0, False, "C0--s"),
+            (100.0, True, "C3-o"),
+            (100.0, False, "C3--s"),
+        ):
+            sel = [r for r in rows if r[0] == frequency and r[1] == acceleration]
+            levels = [100 * r[2] for r in sel]
+            mean = [100 * np.mean(r[3][key]) for r in sel]
+            ax.plot(
+                levels,
+                mean,
+                style,
+                ms=4,
+                label=f"{frequency:g} Hz, {'with' if acceleration else 'no'} acceleration",
+            )
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_xlabel("noise on every channel (% of its std)")
+        ax.set_title(label)
+    axes[0].set_ylabel("error, mean of 3 seeds (%)")
+    axes[-1].legend(fontsize=7)
+    out = ROOT / "docs" / "figures" / "identify_noise_bias.png"
+    fig.savefig(out, dpi=90)
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
