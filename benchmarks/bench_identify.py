@@ -6,16 +6,18 @@ Run on demand::
 
 It times the command (process start, reading, identification, writing results.csv) over
 the default rig campaign (written to a temporary folder unless ``--records`` names one)
-and over the BRFD folder, best of ``--repeats``. With ``--old-src`` (for example the
-``src`` folder of another checkout) the same command runs with that code too, in the same
-loop, and the ratio is printed: on a shared machine only ratios measured side by side
-mean anything. Target (issue 15): 1e6 samples per second.
+and over the BRFD folder, best of ``--repeats``, in wall-clock seconds and in CPU seconds
+(user + system of the command's processes, which contention inflates less). With
+``--old-src`` (for example the ``src`` folder of another checkout) the same command runs
+with that code too, in the same loop, and the ratio is printed: on a shared machine only
+ratios measured side by side mean anything. Target (issue 15): 1e6 samples per second.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -42,7 +44,8 @@ def samples(files: list[Path]) -> int:
     return total
 
 
-def run(files: list[Path], src: str | None, jobs: int, out: Path) -> float:
+def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float, float]:
+    """Wall-clock and CPU seconds (user + system, of the command's processes) of one run."""
     env = dict(os.environ)
     if src:
         env["PYTHONPATH"] = src
@@ -50,9 +53,13 @@ def run(files: list[Path], src: str | None, jobs: int, out: Path) -> float:
     command += ["--out", str(out), "--quiet", "--force"]
     if jobs > 1 and not src:
         command += ["--jobs", str(jobs)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run(command, env=env, check=True, capture_output=True)
-    return time.perf_counter() - start
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
 
 
 def main() -> None:
@@ -76,19 +83,25 @@ def main() -> None:
         out = Path(folder) / "results.csv"
         for name, files in sets.items():
             n = samples(files)
-            best = {"new": float("inf"), "old": float("inf")}
+            best = {"new": (float("inf"), 0.0), "old": (float("inf"), 0.0)}
             for _ in range(args.repeats):
                 best["new"] = min(best["new"], run(files, None, args.jobs, out))
                 if args.old_src:
                     best["old"] = min(best["old"], run(files, args.old_src, 1, out))
-            rate = n / best["new"]
+            wall, cpu = best["new"]
+            rate = n / wall
             verdict = "meets" if rate >= TARGET else "below"
             line = (
-                f"{name:22s} {len(files):3d} files {n:8d} samples: {best['new']:6.2f} s, "
-                f"{rate:.3g} samples/s ({verdict} {TARGET:.0e}; jobs={args.jobs})"
+                f"{name:22s} {len(files):3d} files {n:8d} samples: {wall:6.2f} s wall, "
+                f"{rate:.3g} samples/s ({verdict} {TARGET:.0e}; jobs={args.jobs}); "
+                f"{cpu:6.2f} CPU s, {n / cpu:.3g} samples per CPU s"
             )
             if args.old_src:
-                line += f"; old code {best['old']:6.2f} s, ratio {best['old'] / best['new']:.2f}x"
+                old_wall, old_cpu = best["old"]
+                line += (
+                    f"; old code {old_wall:6.2f} s wall, {old_cpu:6.2f} CPU s: ratio "
+                    f"{old_wall / wall:.2f}x wall, {old_cpu / cpu:.2f}x CPU"
+                )
             print(line)
 
 

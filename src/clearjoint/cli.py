@@ -459,7 +459,8 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
         first = ident.cycles[0]
         span = slice(first.start, ident.cycles[-1].stop)
         runs = ident.stage_runs(record.time)
-        fig = displacement_stages_figure(record.time, record.displacement, runs, title=stem)
+        title = f"{stem} [{ident.flag}]"  # the credibility flag on every figure
+        fig = displacement_stages_figure(record.time, record.displacement, runs, title=title)
         fig.savefig(targets[0], dpi=100)
         fig = identified_loop_figure(
             record.displacement[span],
@@ -467,7 +468,7 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
             ident.stage[span],
             (first.upper_edge, first.lower_edge),
             first.lines,
-            title=stem,
+            title=title,
         )
         fig.savefig(targets[1], dpi=100)
 

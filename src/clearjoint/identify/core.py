@@ -20,7 +20,8 @@ MODEL.md section 3. The steps:
    groups of cycles in turn) for every standard error; the energy per cycle is each
    cycle's own loop area (the closed integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
-   spans zero, ``doubtful`` for a fit residual above the noise floor or a force-controlled
+   spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
+   exceeds a quarter of it, a fit residual above the noise floor, or a force-controlled
    record without a mass (then estimated from the record, with a warning).
 """
 
@@ -64,6 +65,9 @@ from clearjoint.records import Record
 
 FloatArray = NDArray[np.float64]
 
+#: The noise floor is at least this part of the force's standard deviation (the resolution
+#: of a record's digits and ADC): a noise-free record is not held to zero residual.
+RESOLUTION = 1e-3
 #: A fit residual this many times the noise floor of the cycle average makes a value doubtful.
 RESIDUAL_FACTOR = 3.0
 #: Samples this close to a gap edge (a fraction of the clearance) belong to no stage's
@@ -72,6 +76,14 @@ EDGE_MARGIN = 0.05
 #: Equations each stage needs for the weak form (else the stages are fitted sample by
 #: sample on the cycle average, as when a contact lasts only a few samples).
 MIN_EQUATIONS = 4
+#: A value whose standard error exceeds this part of it is doubtful (for these quantities).
+RELATIVE_ERROR = 0.25
+CREDIBLE = (
+    "compression_stiffness_n_per_m",
+    "tension_stiffness_n_per_m",
+    "friction_force_n",
+    "energy_per_cycle_j",
+)
 #: Groups of the jackknife (contiguous blocks of cycles; one cycle each up to this many).
 JACKKNIFE_GROUPS = 8
 #: Quantities taken per cycle (the cycle's own), not from the fit.
@@ -299,12 +311,11 @@ def _identify_stack(
     if first_fit is not None:
         edges = (first_fit.lower_edge, first_fit.upper_edge)
         margin = EDGE_MARGIN * (edges[1] - edges[0])
-        system = weak_system(x, v, st.step, stage_runs(x, edges, margin))
         model = "joint"
+        if "a" not in st.channels:  # with a measured acceleration: fit the samples
+            system = weak_system(x, v, st.step, stage_runs(x, edges, margin))
         if system is not None and np.bincount(system.stage).min() < MIN_EQUATIONS:
             system = None  # a contact too short for the weak form: fit sample by sample
-        if "a" in st.channels:
-            system = None  # a measured acceleration: no derivative to avoid, fit the samples
     if (
         model == "line"
         and record.control == "displacement"
@@ -424,7 +435,13 @@ def _identify_stack(
             summary[q], spread[q], stderr[q] = 0.0, 0.0, 0.0
             per_cycle[q] = np.zeros(n)
     flags = _flags(
-        model, summary, stderr, residual, _noise_floor(fs), mass_missing, summary["mass_kg"]
+        model,
+        summary,
+        stderr,
+        residual,
+        max(_noise_floor(fs), RESOLUTION * float(np.std(f))),
+        mass_missing,
+        summary["mass_kg"],
     )
     if mass_missing:
         warnings.append(
@@ -499,6 +516,13 @@ def _flags(
             flags["clearance_m"] = (
                 "rejected",
                 f"clearance {c * 1e3:.3g} ± {se * 1e3:.2g} mm: its interval spans zero",
+            )
+    for q in CREDIBLE:
+        value, se = summary[q], stderr[q]
+        if flags[q][0] == "ok" and value and abs(se / value) > RELATIVE_ERROR:
+            flags[q] = (
+                "doubtful",
+                f"{q} has a standard error of {abs(se / value):.0%} of its value",
             )
     if math.isfinite(residual) and residual > RESIDUAL_FACTOR * noise:
         reason = (

@@ -52,9 +52,12 @@ class IdentificationError(ClearjointError, ValueError):
 
 def excitation_frequency(record: Record) -> float:
     """Return the excitation frequency in Hz: the displacement spectrum's peak, interpolated."""
+    from scipy.fft import next_fast_len, rfft
+
     x = record.displacement - record.displacement.mean()
     n = x.size
-    spectrum = np.abs(np.fft.rfft(x * np.hanning(n), n=4 * n))
+    padded = next_fast_len(4 * n, real=True)  # a length the FFT factors fast
+    spectrum = np.abs(rfft(x * np.hanning(n), n=padded))
     spectrum[0] = 0.0
     k = float(np.argmax(spectrum))
     i = int(k)
@@ -62,7 +65,7 @@ def excitation_frequency(record: Record) -> float:
         a, b, c = np.log(spectrum[i - 1 : i + 2] + 1e-300)
         if (a - 2 * b + c) != 0:
             k = i + 0.5 * (a - c) / (a - 2 * b + c)
-    return float(k * record.sampling_rate / (4 * n))
+    return float(k * record.sampling_rate / padded)
 
 
 def cycle_bounds(record: Record, frequency: float) -> list[tuple[int, int]]:
@@ -84,12 +87,22 @@ def steady(x: FloatArray, bounds: list[tuple[int, int]], tolerance: float) -> li
     """Indices (into ``bounds``) of the steady cycles, by :func:`steady_rule`."""
     if not bounds:
         return []
-    amp = np.array([0.5 * np.ptp(x[i:j]) for i, j in bounds])
-    mid = np.array([0.5 * (x[i:j].max() + x[i:j].min()) for i, j in bounds])
+    starts = np.array([i for i, _ in bounds])
+    stops = np.array([j for _, j in bounds])
+    # bounds are contiguous ranges of x; reduceat over their starts (the last one ends at
+    # its own stop, so the tail after it is cut off first)
+    span = x[: stops[-1]]
+    high = np.maximum.reduceat(span, starts)
+    low = np.minimum.reduceat(span, starts)
+    if np.any(starts[1:] != stops[:-1]):  # not contiguous: one cycle at a time
+        high = np.array([x[i:j].max() for i, j in bounds])
+        low = np.array([x[i:j].min() for i, j in bounds])
+    amp = 0.5 * (high - low)
+    mid = 0.5 * (high + low)
     top = amp >= 0.9 * amp.max()
     reference = float(np.median(amp[top]))
     centre = float(np.median(mid[top]))
-    closure = np.array([abs(x[i] - x[j - 1]) for i, j in bounds])
+    closure = np.abs(x[starts] - x[stops - 1])
     keep = (
         (np.abs(amp - reference) <= tolerance * reference)
         & (np.abs(mid - centre) <= tolerance * reference)
