@@ -395,3 +395,43 @@ def test_cli_plot_flags_warnings_and_jobs(
     parallel, _ = identify_files(files, jobs=2)
     for (_, a), (_, b) in zip(serial, parallel, strict=True):
         np.testing.assert_equal(a.row(), b.row())  # NaN equals NaN here
+
+
+def test_a_clearance_twice_the_median_of_the_device_is_flagged() -> None:
+    from dataclasses import replace
+
+    from clearjoint.identify import flag_outliers
+
+    base = identify(read_record(SHIPPED / "2Hz36lbtension0.5amplitude.json"))
+    assert base.joint_id == "BRFD"
+    c = base.summary["clearance_m"]
+    tests = [
+        replace(base, source=f"t{k}", summary={**base.summary, "clearance_m": c * factor})
+        for k, factor in enumerate((1.0, 1.1, 0.9, 2.5))
+    ]
+    flagged = flag_outliers(tests)
+    assert [t.flags["clearance_m"][0] for t in flagged[:3]] == [base.flags["clearance_m"][0]] * 3
+    flag, reason = flagged[3].flags["clearance_m"]
+    assert flag == "doubtful"
+    assert "more than twice the median" in reason
+    assert "BRFD" in reason
+    # another device's tests are not compared with these
+    other = replace(tests[3], joint_id="other")
+    assert flag_outliers([*tests[:3], other])[3].flags == other.flags
+
+
+def test_the_steady_cycle_rule_is_stated_where_a_record_is_refused() -> None:
+    from clearjoint.identify import steady_rule
+
+    t = np.arange(300) / 100.0
+    short = Record(
+        time=t,
+        force=np.sin(2 * np.pi * t),
+        displacement=np.sin(2 * np.pi * t),
+        control="displacement",
+        source="short",
+    )
+    with pytest.raises(IdentificationError) as refused:
+        identify(short, tolerance=0.05)
+    assert steady_rule(0.05) in str(refused.value)
+    assert "5%" in steady_rule(0.05)
