@@ -34,7 +34,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.signal import savgol_filter
 
 from clearjoint import stiffness
 from clearjoint.errors import ClearjointError, ParameterError
@@ -486,16 +485,18 @@ def _identify_stack(
 
 
 def _record_acceleration(record: Record, frequency: float) -> FloatArray:
-    """The record's acceleration (measured, or a local cubic's): for the figures only."""
+    """The record's acceleration for the figures only: measured, or the second difference of
+    the displacement smoothed over a fortieth of a period (a moving average)."""
     if record.acceleration is not None or record.control == "displacement":
         return (
             record.acceleration if record.acceleration is not None else np.zeros_like(record.time)
         )
-    window = max(5, int(record.sampling_rate / frequency / 40) | 1)
-    window = min(window, (record.time.size // 2) * 2 - 1)
-    return np.asarray(
-        savgol_filter(record.displacement, window, 3, deriv=2, delta=1.0 / record.sampling_rate)
-    )
+    window = max(1, int(record.sampling_rate / frequency / 40))
+    kernel = np.ones(window) / window
+    smooth = np.convolve(record.displacement, kernel, mode="same")
+    step = 1.0 / record.sampling_rate
+    out: FloatArray = np.gradient(np.gradient(smooth, step), step)
+    return out
 
 
 def _flags(
