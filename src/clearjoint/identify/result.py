@@ -205,7 +205,8 @@ class Identification:
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """Plot the steady cycles' average loop (restoring force against displacement), the
-        gap edges and the fitted stage lines; return the Axes."""
+        gap edges, the fitted stage lines (a joint) or the two slip levels (a damper), with
+        the clearance, its standard error and the flag in the title; return the Axes."""
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -216,6 +217,9 @@ class Identification:
         if self.model != "line":
             for edge in (first.upper_edge, first.lower_edge):
                 ax.axvline(edge * 1e3, color="C3", lw=0.8, ls="--")
+        if self.model == "damper":  # the two slip levels
+            for key in ("friction_force_positive_n", "friction_force_negative_n"):
+                ax.axhline(self.summary[key], color="C0", lw=1.0, ls=":")
         for (a, k), (lo, hi) in zip(
             first.lines,
             (
