@@ -1,4 +1,7 @@
-"""identify.py: accuracy against the rig's truth, an exact friction loop, and the real BRFD data."""
+"""clearjoint.identify: against the rig's truth, an exact friction loop, an independent
+solve_ivp simulator with 1 % noise on every channel (tests/independent_joint.py), real BRFD
+records shipped in tests/data/brfd (and all 31 when ../shared is beside the clone), flags,
+the result object and the command line."""
 
 from __future__ import annotations
 
