@@ -382,7 +382,7 @@ def test_cli_plot_flags_warnings_and_jobs(
     out, plot = tmp_path / "r.csv", tmp_path / "loops.png"
     assert main(["identify", *files, "--out", str(out), "--plot", str(plot), "--quiet"]) == 0
     err = capsys.readouterr().err
-    assert "warning: " in err
+    assert "clearjoint identify: warning: " in err
     assert "without a mass" in err
     assert plot.stat().st_size > 0
     with out.open() as handle:

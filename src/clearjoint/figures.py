@@ -200,7 +200,7 @@ def agreement_map_figure(
     tolerance: float = 0.05,
     title: str | None = None,
 ) -> Figure:
-    """Return the map of where |closed / exact - 1| <= tolerance over frequency (Hz) and force.
+    """Return the map of where abs(closed / exact - 1) <= tolerance over frequency (Hz) and force.
 
     Grey: within tolerance; white: outside; hatched: no periodic orbit. Contours
     give the exact cycle's penetration A in um.
