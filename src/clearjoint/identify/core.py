@@ -7,9 +7,10 @@ MODEL.md section 3. The steps:
    rule of :func:`clearjoint.identify.cycles.steady_rule`;
 3. the steady cycles stacked on one phase grid and averaged: the average is the latent
    periodic signal, with 1/sqrt(n) of one cycle's noise in every channel;
-4. the model, chosen on that average (so on all the steady cycles): a clearance joint
-   (steep, flat, steep stages on both branches, better than a straight line by BIC), a
-   friction damper with backlash, or a straight line;
+4. the model, chosen on that average (so on all the steady cycles): a friction damper
+   with backlash when a displacement-controlled loop's branches end on slip plateaus;
+   else a clearance joint (steep, flat, steep stages, found on both branches or lent by
+   one to the other, better than a straight line by BIC); else a straight line;
 5. the joint's parameters: without an acceleration channel by the weak form
    (:mod:`clearjoint.identify.weak`: no derivative of the displacement, test functions
    that stop at the contact instants); with one, or when a contact lasts too few samples
@@ -300,14 +301,24 @@ def _identify_stack(
         _windows(x[parts[0]], r[parts[0]], 3),
         _windows(x[parts[1]], r[parts[1]], 3),
     )
+    if _is_joint(windows[0]) != _is_joint(windows[1]):
+        # a stage too short to be found on one branch (e.g. a brief contact at a low
+        # force): the stages are places in x, the same on both branches, so the branch
+        # that shows all three lends them to the other
+        shown = windows[0] if _is_joint(windows[0]) else windows[1]
+        windows = (shown, shown)
     model = "line"
     system = None
+    # a displacement-controlled loop whose branches end on slip plateaus is a damper
+    damper = record.control == "displacement" and _damper_fit(x, f, parts) is not None
     first_fit = (
         _joint_fit(x, r, v, parts, windows)
-        if _is_joint(windows[0]) and _is_joint(windows[1])
+        if not damper and _is_joint(windows[0]) and _is_joint(windows[1])
         else None
     )
-    if first_fit is not None:
+    if damper:
+        model = "damper"
+    elif first_fit is not None:
         edges = (first_fit.lower_edge, first_fit.upper_edge)
         margin = EDGE_MARGIN * (edges[1] - edges[0])
         model = "joint"
@@ -315,12 +326,6 @@ def _identify_stack(
             system = weak_system(x, v, st.step, stage_runs(x, edges, margin))
         if system is not None and np.bincount(system.stage).min() < MIN_EQUATIONS:
             system = None  # a contact too short for the weak form: fit sample by sample
-    if (
-        model == "line"
-        and record.control == "displacement"
-        and _damper_fit(x, f, parts) is not None
-    ):
-        model = "damper"
 
     # every replicate: row 0 the average of all cycles, then the averages without one
     groups = _groups(n)
