@@ -178,6 +178,14 @@ def _identify_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="results file, .csv or .nc")
     p.add_argument("--figures", help="write two figures per test into this folder")
     p.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="draw every identified loop with its flag into one figure (.png, .pdf or .svg)",
+    )
+    p.add_argument(
+        "--jobs", type=int, default=1, help="processes over the files (default 1; same results)"
+    )
+    p.add_argument(
         "--resample", action="store_true", help="interpolate records that are not uniformly sampled"
     )
     p.add_argument(
@@ -186,7 +194,7 @@ def _identify_parser(sub: Any) -> None:
         default=0.03,
         help="steady-cycle amplitude tolerance (default 0.03)",
     )
-    p.add_argument("--force", action="store_true", help="overwrite existing output")
+    p.add_argument("--force", action="store_true", help="overwrite existing output and --plot")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -532,12 +540,14 @@ def _run_identify(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .csv or .nc, got {out.name!r}")
     if not 0.0 < args.tolerance < 1.0:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
+    if args.jobs < 1:
+        raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    plot = _plot_target(args)  # a figure suffix, not overwritten unless --force
     refuse_to_overwrite([out], force=args.force)
     out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
+    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
     if args.quiet:
-        results, failures = identify_files(
-            args.files, resample=args.resample, tolerance=args.tolerance
-        )
+        results, failures = identify_files(args.files, **options)
     else:
         from rich.progress import Progress
 
@@ -545,14 +555,16 @@ def _run_identify(args: argparse.Namespace) -> int:
             task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
             results, failures = identify_files(
                 args.files,
-                resample=args.resample,
-                tolerance=args.tolerance,
+                **options,
                 progress=lambda done, _total: bar.update(task, completed=done),
             )
     if not results and len(failures) == 1:
         raise ParameterError(f"no record could be used: {failures[0]}")  # one file, one line
     for line in failures:
         print(f"not used: {line}", file=sys.stderr)
+    for _, ident in results:
+        for warning in ident.warnings:
+            print(f"clearjoint identify: warning: {warning}", file=sys.stderr)
     if not results:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -560,7 +572,17 @@ def _run_identify(args: argparse.Namespace) -> int:
     _write_rows(rows, out)
     if args.figures:
         _identify_figures(results, Path(args.figures), force=args.force)
-    print(f"identified {len(results)} of {len(args.files)} records; wrote {out}")
+    if plot is not None:
+        from clearjoint.identify import identifications_figure
+
+        plot.parent.mkdir(parents=True, exist_ok=True)
+        identifications_figure([ident for _, ident in results]).savefig(plot, dpi=100)
+        print(f"wrote {plot}")
+    flagged = sum(ident.flag != "ok" for _, ident in results)
+    print(
+        f"identified {len(results)} of {len(args.files)} records ({flagged} flagged, see the "
+        f"flag and flag_reason columns); wrote {out}"
+    )
     return 0
 
 
@@ -597,7 +619,8 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
         first = ident.cycles[0]
         span = slice(first.start, ident.cycles[-1].stop)
         runs = ident.stage_runs(record.time)
-        fig = displacement_stages_figure(record.time, record.displacement, runs, title=stem)
+        title = f"{stem} [{ident.flag}]"  # the credibility flag on every figure
+        fig = displacement_stages_figure(record.time, record.displacement, runs, title=title)
         fig.savefig(targets[0], dpi=100)
         fig = identified_loop_figure(
             record.displacement[span],
@@ -605,7 +628,7 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
             ident.stage[span],
             (first.upper_edge, first.lower_edge),
             first.lines,
-            title=stem,
+            title=title,
         )
         fig.savefig(targets[1], dpi=100)
 
