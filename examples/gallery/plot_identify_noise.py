@@ -24,7 +24,10 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
+try:
+    ROOT = Path(__file__).resolve().parents[2]
+except NameError:  # sphinx-gallery runs the script from its own folder, without __file__
+    ROOT = Path.cwd().resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the independent simulator lives with the tests
 
 from clearjoint.identify import identify  # noqa: E402

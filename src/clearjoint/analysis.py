@@ -325,7 +325,7 @@ def analyse(
     return analysis
 
 
-#: A damper's free play: where |restoring force| is below this fraction of its friction force.
+#: A damper's free play: where the restoring force's magnitude is below this fraction of its friction force.
 DAMPER_FREE_PLAY_FRACTION = 0.2
 
 
@@ -335,7 +335,7 @@ def stage_runs(record: Record, ident: Identification) -> list[tuple[str, float, 
     A clearance joint's stages follow the displacement (inside the gap edges or
     beyond), as ``Identification.stage_runs`` gives them. A friction damper with
     backlash plays free after each reversal, not at the zero crossings: its stages
-    follow the restoring force, free play where |F| is below
+    follow the restoring force, free play where abs(F) is below
     ``DAMPER_FREE_PLAY_FRACTION`` of the identified friction force, compression where
     F is above it and tension below its negative.
     """
