@@ -18,6 +18,10 @@ from numpy.typing import NDArray
 
 from clearjoint.identify.segments import STAGE_COMPRESSION, STAGE_FREE, STAGE_TENSION
 
+#: A damper's free play: where the restoring force's magnitude is below this fraction of
+#: its friction force (:meth:`Identification.stage_runs`).
+DAMPER_FREE_PLAY_FRACTION = 0.2
+
 if TYPE_CHECKING:
     import pandas as pd
     import xarray as xr
@@ -242,16 +246,29 @@ class Identification:
         return ax
 
     def stage_runs(self, time: FloatArray) -> list[tuple[str, float, float]]:
-        """The stages as (name, start, end) runs over the record's time, for figures."""
+        """The stages as (name, start, end) runs over the record's time, for figures.
+
+        A clearance joint's stages follow the displacement (inside the gap edges or
+        beyond). A friction damper with backlash plays free after each reversal, not at
+        the zero crossings: its stages follow the restoring force, free play where
+        abs(F) is below ``DAMPER_FREE_PLAY_FRACTION`` of the identified friction force,
+        compression where F is above it and tension below its negative.
+        """
+        stage = self.stage
+        if self.model == "damper":
+            force = self.restoring_force
+            level = DAMPER_FREE_PLAY_FRACTION * self.summary["friction_force_n"]
+            beyond = np.where(force < -level, STAGE_TENSION, STAGE_FREE)
+            stage = np.where(force > level, STAGE_COMPRESSION, beyond)
         names = {
             STAGE_FREE: "free-play",
             STAGE_COMPRESSION: "compression",
             STAGE_TENSION: "tension",
         }
-        change = np.nonzero(np.diff(self.stage))[0] + 1
-        bounds = np.concatenate(([0], change, [self.stage.size]))
+        change = np.nonzero(np.diff(stage))[0] + 1
+        bounds = np.concatenate(([0], change, [stage.size]))
         return [
-            (names[int(self.stage[a])], float(time[a]), float(time[min(b, time.size - 1)]))
+            (names[int(stage[a])], float(time[a]), float(time[min(b, time.size - 1)]))
             for a, b in itertools.pairwise(bounds)
         ]
 
