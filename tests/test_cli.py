@@ -369,3 +369,50 @@ def test_a_warning_is_one_line_naming_the_command(capsys: pytest.CaptureFixture[
     lines = err.splitlines()
     assert len(lines) == 1, err
     assert lines[0].startswith("clearjoint dissipation: warning: Hertz contact half-angle")
+
+
+# ---- review: a loss given without what it needs is an error, not a silent zero ----------------
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["--friction-coefficient", "0.2"], "--friction-coefficient needs --lateral-load too"),
+        (["--lateral-load", "300N"], "--lateral-load needs --friction-coefficient too"),
+        (
+            ["--friction-coefficient=-0.2", "--lateral-load", "300N"],
+            "friction coefficient must be >= 0",
+        ),
+        (["--friction-coefficient", "0.2", "--lateral-load=-300N"], "lateral_load must be >= 0"),
+        (["--friction-region", "free-play"], "--friction-region needs sliding friction"),
+        (["--contact-friction-coefficient", "0.2"], "acts on the pin: give --pin-radius"),
+        (["--damping-ratio", "0,02"], "write the decimal point as '.'"),
+    ],
+)
+def test_a_loss_without_what_it_needs_is_one_line(
+    extra: list[str], words: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, err = run([*DISSIPATION, "--amplitude", "5um", *extra], capsys)
+    assert (code, out) == (2, "")
+    assert words in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_friction_can_still_be_switched_off_over_a_study(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    study = str(Path(__file__).resolve().parents[1] / "examples" / "study.toml")
+    code, out, err = run(
+        ["dissipation", "--study", study, "--amplitude", "5um", "--json", "--lateral-load", "0N"],
+        capsys,
+    )
+    assert code == 0, err
+    assert json.loads(out)["sliding_friction_j"] == 0.0
+
+
+def test_a_damping_ratio_in_percent_is_a_hundredth(capsys: pytest.CaptureFixture[str]) -> None:
+    # "1%" is 0.01 (pint gives it as a unitless 1, which was taken as zeta = 1)
+    args = [*DISSIPATION, "--amplitude", "5um", "--json", "--damping-ratio"]
+    _, percent, _ = run([*args, "1%"], capsys)
+    _, plain, _ = run([*args, "0.01"], capsys)
+    assert json.loads(percent)["viscous_j"] == pytest.approx(json.loads(plain)["viscous_j"])

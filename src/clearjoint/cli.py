@@ -439,18 +439,43 @@ def _losses_from(args: argparse.Namespace, base: Any | None, joint: Any) -> dict
     load = number("lateral-load", "force", friction.lateral_load if friction else 0.0)
     region = args.friction_region or (friction.region if friction else "everywhere")
     pin = _pin_from(args, base, joint.clearance)
+    sliding = None
+    if friction is None:  # neither the study nor the options gave both: one alone is no force
+        for given, option, other, example in (
+            (mu_s, "friction-coefficient", "lateral-load", "300N"),
+            (load, "lateral-load", "friction-coefficient", "0.2"),
+        ):
+            if given != 0.0 and getattr(args, other.replace("-", "_")) is None:
+                raise ParameterError(
+                    f"--{option} needs --{other} too (e.g. --{other} {example}): without it "
+                    "there is no sliding friction"
+                )
+    if mu_s != 0.0 or load != 0.0:
+        sliding = Friction(mu_s, load, region)  # validates the signs
+        sliding = sliding if sliding.force > 0.0 else None
+    if args.friction_region and sliding is None:
+        raise ParameterError(
+            "--friction-region needs sliding friction: give --friction-coefficient and "
+            "--lateral-load (or put them in the study file)"
+        )
+    mu_c = number(
+        "contact-friction-coefficient",
+        "dimensionless",
+        base.contact_friction_coefficient if base else 0.0,
+    )
+    if mu_c > 0.0 and pin is None:
+        raise ParameterError(
+            "--contact-friction-coefficient acts on the pin: give --pin-radius and --pin-length "
+            "(or a [pin] table in the study file)"
+        )
     return {
-        "friction": Friction(mu_s, load, region) if mu_s > 0 and load > 0 else None,
+        "friction": sliding,
         "restitution": number("restitution", "dimensionless", base.restitution if base else 1.0),
         "damping_ratio": number(
             "damping-ratio", "dimensionless", base.damping_ratio if base else 0.0
         ),
         "pin": pin,
-        "contact_friction_coefficient": number(
-            "contact-friction-coefficient",
-            "dimensionless",
-            base.contact_friction_coefficient if base else 0.0,
-        ),
+        "contact_friction_coefficient": mu_c,
     }
 
 
