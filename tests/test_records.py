@@ -330,6 +330,25 @@ def test_uneven_beyond_the_clock_resolution_is_still_refused(tmp_path: Path) -> 
         read_record(path)
 
 
+@pytest.mark.parametrize("stamp", ["{:.6e}", "{:.9e}", "{:g}"])
+def test_lab_csv_time_stamps_in_scientific_notation(tmp_path: Path, stamp: str) -> None:
+    """%.6e stamps are rounded to 1e-11 s near 0 but 1e-7 s near 0.1 s: still a uniform clock."""
+    body = "time [s],force [kN],displacement [mm]\n" + "".join(
+        (stamp + ",{:.6f},{:.7f}\n").format(*lab_signals(i)) for i in range(N_LAB)
+    )
+    check_lab_record(read_record(write_csv(tmp_path, body)))
+
+
+def test_uneven_scientific_stamps_are_still_refused(tmp_path: Path) -> None:
+    jitter = [0.0, 3e-6, -2e-6, 1e-6]  # 3 us on stamps written to 1e-7 s or finer
+    body = "time [s],force [kN],displacement [mm]\n" + "".join(
+        "{:.6e},{:.6f},{:.7f}\n".format(lab_signals(i)[0] + jitter[i % 4], *lab_signals(i)[1:])
+        for i in range(N_LAB)
+    )
+    with pytest.raises(RecordError, match="not uniformly sampled"):
+        read_record(write_csv(tmp_path, body))
+
+
 @pytest.mark.parametrize(
     ("text", "words"),
     [

@@ -361,29 +361,35 @@ def _units_row(fields: list[str]) -> bool:
     return True
 
 
-def _resolution(texts: list[str]) -> float:
-    """The clock's resolution implied by how time stamps are written: 10^-decimals."""
-    decimals = 0
+def _resolution(texts: list[str]) -> FloatArray:
+    """The resolution each time stamp is written to: 10^-decimals, less its exponent.
+
+    Per stamp, since in scientific notation ("8.333333e-05", "1.999167e-01") the
+    resolution grows with the stamp: one figure for the whole column, the finest,
+    would call a uniform clock written with ``%.6e`` uneven.
+    """
+    places = []
     for text in texts:
         mantissa, _, exponent = text.lower().replace(",", ".").partition("e")
-        places = len(mantissa.partition(".")[2]) - (int(exponent) if exponent else 0)
-        decimals = max(decimals, places)
-    return 10.0 ** (-decimals)
+        places.append(len(mantissa.partition(".")[2]) - (int(exponent) if exponent else 0))
+    return np.power(10.0, -np.asarray(places, dtype=np.float64))
 
 
-def regular_time(time: FloatArray, resolution: float) -> tuple[FloatArray, float]:
+def regular_time(time: FloatArray, resolution: float | FloatArray) -> tuple[FloatArray, float]:
     """A uniform clock t0 + i dt fitted to time stamps rounded to ``resolution``.
 
     Stamps of a uniform clock rounded to its resolution (12 kHz written to 1 us)
     have steps that differ by up to the resolution: that is rounding, not uneven
-    sampling. Returns the fitted uniform times and the largest distance of a stamp
-    from them; the caller accepts the fit only when that distance is within the
-    resolution.
+    sampling. ``resolution`` may differ from stamp to stamp (scientific notation):
+    each stamp then weighs in by 1 / its resolution. Returns the fitted uniform
+    times and the largest distance of a stamp from them, in units of its own
+    resolution; the caller accepts the fit only when that is at most 1.
     """
     index = np.arange(time.size, dtype=np.float64)
-    slope, intercept = np.polyfit(index, time, 1)
+    scale = np.broadcast_to(np.asarray(resolution, dtype=np.float64), time.shape)
+    slope, intercept = np.polyfit(index, time, 1, w=1.0 / scale)
     uniform = intercept + slope * index
-    return uniform, float(np.max(np.abs(time - uniform)))
+    return uniform, float(np.max(np.abs(time - uniform) / scale))
 
 
 def _read_csv(path: Path, resample_: bool) -> Record:
@@ -541,14 +547,16 @@ def _clock(
     factor = _factor(where, "time", channels[k][1])
     stamps = [_fields(row, delimiter)[k] for row in rows if row.strip()]
     resolution = _resolution(stamps) * factor
-    uniform, stray = regular_time(time, resolution)
-    if stray <= resolution:
+    uniform, ratio = regular_time(time, resolution)
+    if ratio <= 1.0:  # every stamp within its own resolution of the fitted clock
         return uniform
+    worst = int(np.argmax(np.abs(time - uniform) / resolution))
+    stray, resolution_at = float(abs(time[worst] - uniform[worst])), float(resolution[worst])
     if resample_:
         return time  # uneven beyond the rounding: _assemble interpolates it
     raise RecordError(
         f"{where}: not uniformly sampled: time stamps stray up to {stray:.3g} s from a uniform "
-        f"clock, beyond their resolution {resolution:.3g} s; read it with resample=True "
+        f"clock, beyond their resolution {resolution_at:.3g} s; read it with resample=True "
         "(--resample) to interpolate onto a uniform grid"
     )
 
