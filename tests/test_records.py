@@ -364,3 +364,12 @@ def test_lab_csv_problems_are_named(tmp_path: Path, text: str, words: str) -> No
         read_record(path)
     assert words in str(info.value)
     assert str(path) in str(info.value)
+
+
+def test_lab_csv_in_utf16_as_excel_saves_unicode_text(tmp_path: Path) -> None:
+    """Excel's "Unicode text" is UTF-16 with a BOM, tab-separated: text, not a binary file."""
+    lines = ["time (s)\tforce (kN)\tdisplacement (mm)"]
+    lines += ["{:.6f}\t{:.6f}\t{:.7f}".format(*lab_signals(i)) for i in range(N_LAB)]
+    path = tmp_path / "lab.txt"
+    path.write_bytes("\r\n".join(lines).encode("utf-16"))  # BOM first, then UTF-16-LE
+    check_lab_record(read_record(path))

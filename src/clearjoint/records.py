@@ -294,6 +294,7 @@ def _metadata_from_toml(where: str, table: dict[str, Any]) -> dict[str, Any]:
 
 
 _DELIMITERS = ("\t", ";", ",")
+_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 _COMMENT = re.compile(r"^\s*(#|//|;|%|!)")
 _KEY_VALUE = re.compile(r"^\s*(?P<key>[^:=,;\t]+?)\s*[:=,;\t]\s*(?P<value>.*)$")
 _NAME_UNIT = re.compile(
@@ -306,7 +307,13 @@ _PREAMBLE_LINES = 1000
 
 
 def _decode(where: str, data: bytes) -> str:
-    """A lab file's text: UTF-8 (with or without a BOM), else Latin-1 (Windows DAQ software)."""
+    """A lab file's text: UTF-8 (with or without a BOM), UTF-16 with its BOM (Excel's
+    "Unicode text"), else Latin-1 (Windows DAQ software)."""
+    if data.startswith(_UTF16_BOMS):
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError:
+            raise RecordError(f"{where}: starts as UTF-16 text but does not decode as it") from None
     if b"\x00" in data[:4096]:
         raise RecordError(f"{where}: a binary file of unknown format; not a record")
     try:
@@ -823,7 +830,7 @@ def sniff(path: str | Path) -> str:
         raise RecordError(f"{where}: a classic (netCDF-3) file; save it as netCDF-4 / HDF5")
     elif head.lstrip().startswith(b"{"):
         kind = "json"
-    elif b"\x00" in head:
+    elif b"\x00" in head and not head.startswith(_UTF16_BOMS):  # UTF-16 text has NULs
         raise RecordError(f"{where}: a binary file of unknown format; not a record")
     else:
         kind = "csv"
