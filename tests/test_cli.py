@@ -416,3 +416,13 @@ def test_a_damping_ratio_in_percent_is_a_hundredth(capsys: pytest.CaptureFixture
     _, percent, _ = run([*args, "1%"], capsys)
     _, plain, _ = run([*args, "0.01"], capsys)
     assert json.loads(percent)["viscous_j"] == pytest.approx(json.loads(plain)["viscous_j"])
+
+
+def test_a_negative_value_after_a_space_says_how_to_write_it(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, _, err = run([*BASE, "--amplitude", "5um", "--gap-offset", "-0.01mm"], capsys)
+    assert code == 2
+    assert "for a negative value write --gap-offset=-0.01mm" in err
+    code, _, err = run([*BASE, "--amplitude", "5um", "--gap-offset=-0.01mm", "--json"], capsys)
+    assert code == 0, err

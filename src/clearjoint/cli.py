@@ -32,6 +32,9 @@ class _Parser(argparse.ArgumentParser):
     """An ArgumentParser whose errors are one line and exit code 2."""
 
     def error(self, message: str) -> NoReturn:
+        if message.endswith("expected one argument"):  # also "--gap-offset -0.01mm"
+            option = message.removeprefix("argument ").split(":")[0].split("/")[-1]
+            message += f"; for a negative value write {option}=-0.01mm"
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
 
 
