@@ -426,3 +426,28 @@ def test_a_negative_value_after_a_space_says_how_to_write_it(
     assert "for a negative value write --gap-offset=-0.01mm" in err
     code, _, err = run([*BASE, "--amplitude", "5um", "--gap-offset=-0.01mm", "--json"], capsys)
     assert code == 0, err
+
+
+@pytest.mark.parametrize("command", ["rig", "reproduce", "report", "identify --figures"])
+def test_an_output_folder_that_is_a_file_is_refused_before_the_work(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("x")
+    records = tmp_path / "records"
+    records.mkdir()
+    study = str(Path(__file__).resolve().parents[1] / "examples" / "study.toml")
+    target = str(blocker / "sub")  # a folder to make under a file
+    args = {
+        "rig": ["rig", "--out", target, "--quiet"],
+        "reproduce": ["reproduce", "--out", target],
+        "report": ["report", "--records", str(records), "--out", target],
+        "identify --figures": [
+            "identify", study, "--out", str(tmp_path / "r.csv"), "--figures", target, "--quiet",
+        ],
+    }[command]  # fmt: skip
+    code, out, err = run(args, capsys)
+    assert (code, out) == (2, "")
+    assert err.strip().endswith(f"{blocker} is a file; give a folder"), err
+    assert not any(line.startswith("- ") for line in err.splitlines())  # before any stage
+    assert not (tmp_path / "r.csv").exists()

@@ -538,6 +538,7 @@ def _run_rig(args: argparse.Namespace) -> int:
     from clearjoint.rig import load_campaign, run_campaign
 
     campaign = load_campaign(args.campaign)
+    _refuse_file_as_folder(args.out, "--out")
     jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
@@ -574,6 +575,9 @@ def _run_identify(args: argparse.Namespace) -> int:
     refuse_to_overwrite([out], force=args.force)
     out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
     options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
+
+    if args.figures:
+        _refuse_file_as_folder(args.figures, "--figures")
     if args.quiet:
         results, failures = identify_files(args.files, **options)
     else:
@@ -714,6 +718,7 @@ def _run_reproduce(args: argparse.Namespace) -> int:
 
     from clearjoint.reproduction import reproduce
 
+    _refuse_file_as_folder(args.out, "--out")
     start = time.perf_counter()
     written = reproduce(
         Path(args.out),
@@ -749,6 +754,7 @@ def _run_report(args: argparse.Namespace) -> int:
         raise RecordError(f"{folder}: no such folder; give --records a folder of record files")
     if not folder.is_dir():
         raise RecordError(f"{folder}: not a folder; give --records a folder of record files")
+    _refuse_file_as_folder(args.out, "--out")
     written = report_records(
         Path(args.records),
         Path(args.out),
@@ -855,6 +861,15 @@ def _plot_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _refuse_file_as_folder(path: str, option: str) -> None:
+    """Refuse an output folder that is (or lies under) a file, before the work, not after it."""
+    for folder in (Path(path), *Path(path).parents):
+        if folder.exists():
+            if not folder.is_dir():
+                raise ParameterError(f"{option} {path}: {folder} is a file; give a folder")
+            return
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
@@ -883,6 +898,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:  # a path the readers and writers did not check themselves
         where = f"{exc.filename}: " if exc.filename else ""
         reason = exc.strerror or str(exc)
+        if isinstance(exc, FileExistsError | NotADirectoryError):  # mkdir met a file
+            reason = "a file stands where a folder is needed"
         print(
             f"clearjoint {args.command}: error: {where}{reason.lower()}; check the path",
             file=sys.stderr,
