@@ -356,6 +356,7 @@ def test_uneven_scientific_stamps_are_still_refused(tmp_path: Path) -> None:
         ("time;force;displacement\n", "has no unit"),
         ("time [s];force [N];displacement [m];velocity [m/s]\n", "names 4 columns"),
         ("time [s];force [(];displacement [m]\n", "unknown unit '('"),  # pint asserted here
+        ("time;force;displacement\ns;N\n", "line 2 has units for 2 columns"),
     ],
 )
 def test_lab_csv_problems_are_named(tmp_path: Path, text: str, words: str) -> None:
@@ -372,4 +373,15 @@ def test_lab_csv_in_utf16_as_excel_saves_unicode_text(tmp_path: Path) -> None:
     lines += ["{:.6f}\t{:.6f}\t{:.7f}".format(*lab_signals(i)) for i in range(N_LAB)]
     path = tmp_path / "lab.txt"
     path.write_bytes("\r\n".join(lines).encode("utf-16"))  # BOM first, then UTF-16-LE
+    check_lab_record(read_record(path))
+
+
+def test_lab_csv_a_blank_spreadsheet_row_of_delimiters(tmp_path: Path) -> None:
+    """';;' between the names and the numbers is a blank row, not a units row of blanks."""
+    lines = ["Time [s];Force [kN];Displacement [mm]", ";;"]
+    lines += [
+        "{:.6f};{:.6f};{:.7f}".format(*lab_signals(i)).replace(".", ",") for i in range(N_LAB)
+    ]
+    path = tmp_path / "lab.csv"
+    path.write_text("\n".join(lines) + "\n")
     check_lab_record(read_record(path))

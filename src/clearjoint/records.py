@@ -438,23 +438,28 @@ def _read_csv(path: Path, resample_: bool) -> Record:
     _, delimiter = max(candidates)
     start, width = found[delimiter]  # type: ignore[misc]
     start += body
-    above = [i for i in range(body, start) if lines[i].strip()]
+    # a row of delimiters alone (";;", a blank spreadsheet row) is a blank line
+    above = [i for i in range(body, start) if lines[i].strip().strip(delimiter).strip()]
     if not above:
         raise RecordError(
             f"{where}: no column names above the numbers; name them like "
             "'time [s]', 'force [N]', 'displacement [mm]'"
         )
-    header_at = above.pop()
+    header_at = units_at = above.pop()
     unit_fields: list[str] | None = None
     if _units_row(_fields(lines[header_at], delimiter)) and above:
         unit_fields = _fields(lines[header_at], delimiter)
         header_at = above.pop()
     names = _fields(lines[header_at], delimiter)
-    if len(names) != width or (unit_fields is not None and len(unit_fields) != width):
-        raise RecordError(
-            f"{where}: line {header_at + 1} names {len(names)} columns but the numbers under "
-            f"it have {width}; check the delimiter {delimiter!r} and the column names"
-        )
+    for line_at, what, row in (
+        (header_at, "names", names),
+        (units_at, "has units for", unit_fields),
+    ):
+        if row is not None and len(row) != width:
+            raise RecordError(
+                f"{where}: line {line_at + 1} {what} {len(row)} columns but the numbers under "
+                f"it have {width}; check the delimiter {delimiter!r} and the column names"
+            )
     notes = []
     for i in above:
         line = lines[i]
