@@ -385,3 +385,16 @@ def test_lab_csv_a_blank_spreadsheet_row_of_delimiters(tmp_path: Path) -> None:
     path = tmp_path / "lab.csv"
     path.write_text("\n".join(lines) + "\n")
     check_lab_record(read_record(path))
+
+
+def test_a_toml_file_given_as_a_record_says_so(tmp_path: Path) -> None:
+    path = tmp_path / "test-1.toml"
+    path.write_text('clearance = "0.1mm"\n')
+    with pytest.raises(RecordError, match="a TOML file is not a record"):
+        read_record(path)
+
+
+def test_record_metadata_text_keeps_the_unit_message() -> None:
+    t = np.arange(100) / 100.0
+    with pytest.raises(RecordError, match=r"clearance 0\.1: give a unit, e\.g\. 0\.1mm"):
+        Record(time=t, force=t, displacement=t, clearance="0.1")

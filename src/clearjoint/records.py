@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint._checks import refuse_to_overwrite
-from clearjoint.errors import ClearjointError
+from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.units import SI_UNITS, registry, to_si
 
 FloatArray = NDArray[np.float64]
@@ -151,6 +151,8 @@ class Record:
                 continue
             try:
                 number = float(to_si(value, _META_SI[name], name=f"{where}: {name}"))
+            except ParameterError as exc:  # a unit string without or with the wrong unit
+                raise RecordError(str(exc)) from None
             except (TypeError, ValueError) as exc:
                 raise RecordError(f"{where}: {name} must be a number, got {value!r}") from exc
             if not math.isfinite(number) or number < 0.0:
@@ -829,6 +831,11 @@ def sniff(path: str | Path) -> str:
         raise RecordError(f"{where}: cannot read it ({exc.strerror})") from None
     if not head:
         raise RecordError(f"{where}: empty file")
+    if path.suffix.lower() == ".toml":  # else read as a CSV whose sidecar is itself
+        raise RecordError(
+            f"{where}: a TOML file is not a record; give the record file (a .toml beside a "
+            "CSV of the same name holds that CSV's metadata)"
+        )
     if head.startswith(_HDF5):
         kind = "netcdf"
     elif head.startswith(b"CDF\x01") or head.startswith(b"CDF\x02"):
