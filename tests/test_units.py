@@ -150,6 +150,9 @@ def test_sweeps_and_records_take_units_too() -> None:
         ),  # pint: 1 mm
         ("Hz", "frequency", "start with the number"),
         ("nan", "length", "--x nan: not a finite number"),
+        ("1 000 mm", "length", "write one number, then its unit"),  # pint: 0 mm
+        ("2 3mm", "length", "write one number"),  # pint: 6 mm
+        ("2(3)mm", "length", "write one number"),  # pint: a measurement 2 +/- 0.3 mm
     ],
 )
 def test_text_pint_misreads_is_refused(text: str, kind: str, words: str) -> None:
@@ -160,7 +163,7 @@ def test_text_pint_misreads_is_refused(text: str, kind: str, words: str) -> None
 
 @pytest.mark.parametrize(
     ("text", "value"),
-    [("1%", 0.01), ("80 %", 0.8), ("500 ppm", 5e-4), ("2mm/m", 2e-3), ("0.3", 0.3)],
+    [("1%", 0.01), ("80 %", 0.8), ("500 ppm", 5e-4), ("2mm/m", 2e-3), ("0.3", 0.3), ("1e-2", 0.01)],
 )
 def test_dimensionless_units_are_converted_not_dropped(text: str, value: float) -> None:
     # "1%" is a unitless pint quantity of magnitude 1: a damping ratio of 1%, not 1

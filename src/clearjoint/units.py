@@ -9,8 +9,8 @@ expected, but is refused where an angular frequency is (the API's ``omega``):
 pint gives sqrt(k/m) in 1/s, which is rad/s, so reading it as Hz would silently
 multiply it by 2 pi. On the command line a bare number for a dimensional
 quantity is refused (``bare="refuse"``); in the Python API a bare float is SI.
-Text must start with a number written with a decimal point: pint reads
-"0,106mm" as 0 mm and "mm" as 1 mm, so both are refused.
+Text must be one number, written with a decimal point, then its unit: pint reads
+"0,106mm" as 0 mm, "mm" as 1 mm and "1 000 mm" as 0 mm, so these are refused.
 """
 
 from __future__ import annotations
@@ -73,7 +73,9 @@ EXAMPLES: dict[str, str] = {
 }
 
 #: The number a quantity's text must start with (pint would read "mm" as 1 mm).
-_LEADING_NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+|nan|inf)", re.IGNORECASE)
+_LEADING_NUMBER = re.compile(r"^[+-]?((\d+\.?\d*|\.\d+)(e[+-]?\d+)?|nan|inf)", re.IGNORECASE)
+#: A second number right after the first, which pint multiplies: "1 000 mm" is 0 mm.
+_SECOND_NUMBER = re.compile(r"^\s*(?!1\s*/)[\d.(]")  # "50 1/s" is one number and a unit
 
 _KIND_OF_UNIT = {unit: kind for kind, unit in SI_UNITS.items()}
 _TWO_PI = 2.0 * math.pi
@@ -170,9 +172,15 @@ def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "refuse") ->
         raise ParameterError(
             f"{name} {raw}: write the decimal point as '.', e.g. {raw.replace(',', '.')}"
         )
-    if not _LEADING_NUMBER.match(raw):
+    number = _LEADING_NUMBER.match(raw)
+    if not number:
         raise ParameterError(
             f"{name}: cannot read {raw!r} as a {kind}; start with the number, e.g. {example}"
+        )
+    if _SECOND_NUMBER.match(raw[number.end() :]):
+        raise ParameterError(
+            f"{name}: cannot read {raw!r} as a {kind}; write one number, then its unit "
+            f"(pint multiplies numbers side by side: '1 000 mm' is 0 mm), e.g. {example}"
         )
     ureg = registry()
     try:
