@@ -398,3 +398,17 @@ def test_record_metadata_text_keeps_the_unit_message() -> None:
     t = np.arange(100) / 100.0
     with pytest.raises(RecordError, match=r"clearance 0\.1: give a unit, e\.g\. 0\.1mm"):
         Record(time=t, force=t, displacement=t, clearance="0.1")
+
+
+def test_lab_csv_in_latin1_with_a_micro_sign(tmp_path: Path) -> None:
+    """Windows DAQ software writes 'µm' as the single byte 0xB5: Latin-1, not UTF-8."""
+    lines = ["time [s];force [kN];displacement [\u00b5m]"]
+    for i in range(N_LAB):
+        t, f, x = lab_signals(i)
+        lines.append(f"{t:.6f};{f:.6f};{x * 1e3:.4f}".replace(".", ","))
+    path = tmp_path / "lab.csv"
+    path.write_bytes("\n".join(lines).encode("latin-1"))
+    assert b"\xb5m" in path.read_bytes()
+    r = read_record(path)
+    check_lab_record(r)
+    assert r.units["displacement"] == "\u00b5m"
