@@ -235,6 +235,13 @@ EXAMPLE_AS_OPTIONS = [
         ["--youngs-modulus", "150GPa"],
         ["--contact-friction-coefficient", "0.3"],
         ["--damping-ratio", "0.05"],
+        ["--gap-stiffness", "1e6N/m"],
+        ["--gap-stiffness", "1e6N/m", "--gap-offset=-0.01mm"],  # the offset matters when k0 > 0
+        ["--restitution", "0.5"],
+        ["--friction-coefficient", "0.3"],
+        ["--pin-length", "30mm"],
+        ["--hole-radius", "5.1mm"],
+        ["--poisson-ratio", "0.33"],
     ],
 )
 def test_every_option_beside_study_overrides_it(
