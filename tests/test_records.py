@@ -20,6 +20,7 @@ from clearjoint.records import (
     sniff,
     write_record,
 )
+from clearjoint.units import registry
 
 #: The real records, in shared/ beside the clone (as on the developers' machines and CI).
 BRFD = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
@@ -412,3 +413,17 @@ def test_lab_csv_in_latin1_with_a_micro_sign(tmp_path: Path) -> None:
     r = read_record(path)
     check_lab_record(r)
     assert r.units["displacement"] == "\u00b5m"
+
+
+def test_channels_given_as_pint_quantities_are_converted_not_stripped() -> None:
+    # np.asarray(Quantity) keeps the magnitude and drops the unit: ms would be read as s
+    ureg = registry()
+    i = np.arange(100.0)
+    r = Record(
+        time=ureg.Quantity(i, "ms"),
+        force=ureg.Quantity(np.ones(100), "kN"),
+        displacement=ureg.Quantity(np.full(100, 20.0), "um"),
+    )
+    assert (r.time[-1], r.force[0], r.displacement[0]) == pytest.approx((0.099, 1000.0, 2e-5))
+    with pytest.raises(RecordError, match="is not a length"):
+        Record(time=i / 100, force=i, displacement=ureg.Quantity(i, "N"))

@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.units import SI_UNITS, registry, to_si
+from clearjoint.units import SI_UNITS, is_quantity, registry, to_si
 
 FloatArray = NDArray[np.float64]
 
@@ -179,6 +179,11 @@ class Record:
 
 
 def _channel(where: str, name: str, value: ArrayLike) -> FloatArray:
+    if is_quantity(value):  # np.asarray would drop the unit: a time in ms read as s
+        try:
+            value = to_si(value, SI[name], name=f"{where}: {name}")
+        except ParameterError as exc:
+            raise RecordError(str(exc)) from None
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
