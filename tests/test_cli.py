@@ -235,6 +235,13 @@ EXAMPLE_AS_OPTIONS = [
         ["--youngs-modulus", "150GPa"],
         ["--contact-friction-coefficient", "0.3"],
         ["--damping-ratio", "0.05"],
+        ["--gap-stiffness", "1e6N/m"],
+        ["--gap-stiffness", "1e6N/m", "--gap-offset=-0.01mm"],  # the offset matters when k0 > 0
+        ["--restitution", "0.5"],
+        ["--friction-coefficient", "0.3"],
+        ["--pin-length", "30mm"],
+        ["--hole-radius", "5.1mm"],
+        ["--poisson-ratio", "0.33"],
     ],
 )
 def test_every_option_beside_study_overrides_it(
@@ -369,3 +376,85 @@ def test_a_warning_is_one_line_naming_the_command(capsys: pytest.CaptureFixture[
     lines = err.splitlines()
     assert len(lines) == 1, err
     assert lines[0].startswith("clearjoint dissipation: warning: Hertz contact half-angle")
+
+
+# ---- review: a loss given without what it needs is an error, not a silent zero ----------------
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["--friction-coefficient", "0.2"], "--friction-coefficient needs --lateral-load too"),
+        (["--lateral-load", "300N"], "--lateral-load needs --friction-coefficient too"),
+        (
+            ["--friction-coefficient=-0.2", "--lateral-load", "300N"],
+            "friction coefficient must be >= 0",
+        ),
+        (["--friction-coefficient", "0.2", "--lateral-load=-300N"], "lateral_load must be >= 0"),
+        (["--friction-region", "free-play"], "--friction-region needs sliding friction"),
+        (["--contact-friction-coefficient", "0.2"], "acts on the pin: give --pin-radius"),
+        (["--damping-ratio", "0,02"], "write the decimal point as '.'"),
+    ],
+)
+def test_a_loss_without_what_it_needs_is_one_line(
+    extra: list[str], words: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, err = run([*DISSIPATION, "--amplitude", "5um", *extra], capsys)
+    assert (code, out) == (2, "")
+    assert words in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_friction_can_still_be_switched_off_over_a_study(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    study = str(Path(__file__).resolve().parents[1] / "examples" / "study.toml")
+    code, out, err = run(
+        ["dissipation", "--study", study, "--amplitude", "5um", "--json", "--lateral-load", "0N"],
+        capsys,
+    )
+    assert code == 0, err
+    assert json.loads(out)["sliding_friction_j"] == 0.0
+
+
+def test_a_damping_ratio_in_percent_is_a_hundredth(capsys: pytest.CaptureFixture[str]) -> None:
+    # "1%" is 0.01 (pint gives it as a unitless 1, which was taken as zeta = 1)
+    args = [*DISSIPATION, "--amplitude", "5um", "--json", "--damping-ratio"]
+    _, percent, _ = run([*args, "1%"], capsys)
+    _, plain, _ = run([*args, "0.01"], capsys)
+    assert json.loads(percent)["viscous_j"] == pytest.approx(json.loads(plain)["viscous_j"])
+
+
+def test_a_negative_value_after_a_space_says_how_to_write_it(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, _, err = run([*BASE, "--amplitude", "5um", "--gap-offset", "-0.01mm"], capsys)
+    assert code == 2
+    assert "for a negative value write --gap-offset=-0.01mm" in err
+    code, _, err = run([*BASE, "--amplitude", "5um", "--gap-offset=-0.01mm", "--json"], capsys)
+    assert code == 0, err
+
+
+@pytest.mark.parametrize("command", ["rig", "reproduce", "report", "identify --figures"])
+def test_an_output_folder_that_is_a_file_is_refused_before_the_work(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("x")
+    records = tmp_path / "records"
+    records.mkdir()
+    study = str(Path(__file__).resolve().parents[1] / "examples" / "study.toml")
+    target = str(blocker / "sub")  # a folder to make under a file
+    args = {
+        "rig": ["rig", "--out", target, "--quiet"],
+        "reproduce": ["reproduce", "--out", target],
+        "report": ["report", "--records", str(records), "--out", target],
+        "identify --figures": [
+            "identify", study, "--out", str(tmp_path / "r.csv"), "--figures", target, "--quiet",
+        ],
+    }[command]  # fmt: skip
+    code, out, err = run(args, capsys)
+    assert (code, out) == (2, "")
+    assert err.strip().endswith(f"{blocker} is a file; give a folder"), err
+    assert not any(line.startswith("- ") for line in err.splitlines())  # before any stage
+    assert not (tmp_path / "r.csv").exists()

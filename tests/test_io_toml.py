@@ -80,3 +80,10 @@ def test_read_table_refuses_with_one_line(table: dict[str, object], words: str) 
 
 def test_zero_needs_no_unit() -> None:
     assert quantity(0, "length", name="f: gap_offset", error=FileError) == 0.0
+
+
+def test_a_byte_order_mark_is_not_a_toml_error(tmp_path: Path) -> None:
+    # Notepad and Excel save UTF-8 with a BOM; tomllib alone calls it "Invalid statement"
+    path = tmp_path / "x.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + b'[a]\nmass = "2kg"\n')
+    assert read_toml(path, what="study", error=FileError) == {"a": {"mass": "2kg"}}

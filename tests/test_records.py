@@ -20,6 +20,7 @@ from clearjoint.records import (
     sniff,
     write_record,
 )
+from clearjoint.units import registry
 
 #: The real records, in shared/ beside the clone (as on the developers' machines and CI).
 BRFD = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
@@ -330,6 +331,25 @@ def test_uneven_beyond_the_clock_resolution_is_still_refused(tmp_path: Path) -> 
         read_record(path)
 
 
+@pytest.mark.parametrize("stamp", ["{:.6e}", "{:.9e}", "{:g}"])
+def test_lab_csv_time_stamps_in_scientific_notation(tmp_path: Path, stamp: str) -> None:
+    """%.6e stamps are rounded to 1e-11 s near 0 but 1e-7 s near 0.1 s: still a uniform clock."""
+    body = "time [s],force [kN],displacement [mm]\n" + "".join(
+        (stamp + ",{:.6f},{:.7f}\n").format(*lab_signals(i)) for i in range(N_LAB)
+    )
+    check_lab_record(read_record(write_csv(tmp_path, body)))
+
+
+def test_uneven_scientific_stamps_are_still_refused(tmp_path: Path) -> None:
+    jitter = [0.0, 3e-6, -2e-6, 1e-6]  # 3 us on stamps written to 1e-7 s or finer
+    body = "time [s],force [kN],displacement [mm]\n" + "".join(
+        "{:.6e},{:.6f},{:.7f}\n".format(lab_signals(i)[0] + jitter[i % 4], *lab_signals(i)[1:])
+        for i in range(N_LAB)
+    )
+    with pytest.raises(RecordError, match="not uniformly sampled"):
+        read_record(write_csv(tmp_path, body))
+
+
 @pytest.mark.parametrize(
     ("text", "words"),
     [
@@ -337,6 +357,7 @@ def test_uneven_beyond_the_clock_resolution_is_still_refused(tmp_path: Path) -> 
         ("time;force;displacement\n", "has no unit"),
         ("time [s];force [N];displacement [m];velocity [m/s]\n", "names 4 columns"),
         ("time [s];force [(];displacement [m]\n", "unknown unit '('"),  # pint asserted here
+        ("time;force;displacement\ns;N\n", "line 2 has units for 2 columns"),
     ],
 )
 def test_lab_csv_problems_are_named(tmp_path: Path, text: str, words: str) -> None:
@@ -345,3 +366,64 @@ def test_lab_csv_problems_are_named(tmp_path: Path, text: str, words: str) -> No
         read_record(path)
     assert words in str(info.value)
     assert str(path) in str(info.value)
+
+
+def test_lab_csv_in_utf16_as_excel_saves_unicode_text(tmp_path: Path) -> None:
+    """Excel's "Unicode text" is UTF-16 with a BOM, tab-separated: text, not a binary file."""
+    lines = ["time (s)\tforce (kN)\tdisplacement (mm)"]
+    lines += ["{:.6f}\t{:.6f}\t{:.7f}".format(*lab_signals(i)) for i in range(N_LAB)]
+    path = tmp_path / "lab.txt"
+    path.write_bytes("\r\n".join(lines).encode("utf-16"))  # BOM first, then UTF-16-LE
+    check_lab_record(read_record(path))
+
+
+def test_lab_csv_a_blank_spreadsheet_row_of_delimiters(tmp_path: Path) -> None:
+    """';;' between the names and the numbers is a blank row, not a units row of blanks."""
+    lines = ["Time [s];Force [kN];Displacement [mm]", ";;"]
+    lines += [
+        "{:.6f};{:.6f};{:.7f}".format(*lab_signals(i)).replace(".", ",") for i in range(N_LAB)
+    ]
+    path = tmp_path / "lab.csv"
+    path.write_text("\n".join(lines) + "\n")
+    check_lab_record(read_record(path))
+
+
+def test_a_toml_file_given_as_a_record_says_so(tmp_path: Path) -> None:
+    path = tmp_path / "test-1.toml"
+    path.write_text('clearance = "0.1mm"\n')
+    with pytest.raises(RecordError, match="a TOML file is not a record"):
+        read_record(path)
+
+
+def test_record_metadata_text_keeps_the_unit_message() -> None:
+    t = np.arange(100) / 100.0
+    with pytest.raises(RecordError, match=r"clearance 0\.1: give a unit, e\.g\. 0\.1mm"):
+        Record(time=t, force=t, displacement=t, clearance="0.1")
+
+
+def test_lab_csv_in_latin1_with_a_micro_sign(tmp_path: Path) -> None:
+    """Windows DAQ software writes 'µm' as the single byte 0xB5: Latin-1, not UTF-8."""
+    lines = ["time [s];force [kN];displacement [\u00b5m]"]
+    for i in range(N_LAB):
+        t, f, x = lab_signals(i)
+        lines.append(f"{t:.6f};{f:.6f};{x * 1e3:.4f}".replace(".", ","))
+    path = tmp_path / "lab.csv"
+    path.write_bytes("\n".join(lines).encode("latin-1"))
+    assert b"\xb5m" in path.read_bytes()
+    r = read_record(path)
+    check_lab_record(r)
+    assert r.units["displacement"] == "\u00b5m"
+
+
+def test_channels_given_as_pint_quantities_are_converted_not_stripped() -> None:
+    # np.asarray(Quantity) keeps the magnitude and drops the unit: ms would be read as s
+    ureg = registry()
+    i = np.arange(100.0)
+    r = Record(
+        time=ureg.Quantity(i, "ms"),
+        force=ureg.Quantity(np.ones(100), "kN"),
+        displacement=ureg.Quantity(np.full(100, 20.0), "um"),
+    )
+    assert (r.time[-1], r.force[0], r.displacement[0]) == pytest.approx((0.099, 1000.0, 2e-5))
+    with pytest.raises(RecordError, match="is not a length"):
+        Record(time=i / 100, force=i, displacement=ureg.Quantity(i, "N"))

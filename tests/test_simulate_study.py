@@ -214,3 +214,31 @@ def test_simulate_refuses_an_output_suffix_that_is_not_netcdf(
     assert "simulate writes netCDF; name the file .nc" in err
     assert len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+# ---- review: a loss given without what it needs is an error, not a silent zero ----------------
+
+
+@pytest.mark.parametrize(
+    ("losses", "words"),
+    [
+        ("friction_coefficient = 0.2", "friction_coefficient is given without lateral_load"),
+        ('lateral_load = "300N"', "lateral_load is given without friction_coefficient"),
+        ('friction_coefficient = -0.2\nlateral_load = "300N"', "friction coefficient must be >= 0"),
+        ("contact_friction_coefficient = 0.15", "add a [pin] table"),
+        ('damping_ratio = "1,5%"', "write the decimal point as '.'"),
+    ],
+)
+def test_a_loss_without_what_it_needs_is_refused(tmp_path: Path, losses: str, words: str) -> None:
+    path = write(tmp_path, MINIMAL.replace("damping_ratio = 0.02", losses))
+    with pytest.raises(StudyError) as info:
+        load_study(path)
+    assert words in str(info.value)
+    assert len(str(info.value).splitlines()) == 1
+
+
+def test_friction_switched_off_explicitly_and_percent(tmp_path: Path) -> None:
+    text = 'friction_coefficient = 0.2\nlateral_load = "0N"\ndamping_ratio = "2%"'
+    study = load_study(write(tmp_path, MINIMAL.replace("damping_ratio = 0.02", text)))
+    assert study.friction is None
+    assert study.damping_ratio == pytest.approx(0.02)

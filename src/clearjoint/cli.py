@@ -32,6 +32,9 @@ class _Parser(argparse.ArgumentParser):
     """An ArgumentParser whose errors are one line and exit code 2."""
 
     def error(self, message: str) -> NoReturn:
+        if message.endswith("expected one argument"):  # also "--gap-offset -0.01mm"
+            option = message.removeprefix("argument ").split(":")[0].split("/")[-1]
+            message += f"; for a negative value write {option}=-0.01mm"
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
 
 
@@ -439,18 +442,43 @@ def _losses_from(args: argparse.Namespace, base: Any | None, joint: Any) -> dict
     load = number("lateral-load", "force", friction.lateral_load if friction else 0.0)
     region = args.friction_region or (friction.region if friction else "everywhere")
     pin = _pin_from(args, base, joint.clearance)
+    sliding = None
+    if friction is None:  # neither the study nor the options gave both: one alone is no force
+        for given, option, other, example in (
+            (mu_s, "friction-coefficient", "lateral-load", "300N"),
+            (load, "lateral-load", "friction-coefficient", "0.2"),
+        ):
+            if given != 0.0 and getattr(args, other.replace("-", "_")) is None:
+                raise ParameterError(
+                    f"--{option} needs --{other} too (e.g. --{other} {example}): without it "
+                    "there is no sliding friction"
+                )
+    if mu_s != 0.0 or load != 0.0:
+        sliding = Friction(mu_s, load, region)  # validates the signs
+        sliding = sliding if sliding.force > 0.0 else None
+    if args.friction_region and sliding is None:
+        raise ParameterError(
+            "--friction-region needs sliding friction: give --friction-coefficient and "
+            "--lateral-load (or put them in the study file)"
+        )
+    mu_c = number(
+        "contact-friction-coefficient",
+        "dimensionless",
+        base.contact_friction_coefficient if base else 0.0,
+    )
+    if mu_c > 0.0 and pin is None:
+        raise ParameterError(
+            "--contact-friction-coefficient acts on the pin: give --pin-radius and --pin-length "
+            "(or a [pin] table in the study file)"
+        )
     return {
-        "friction": Friction(mu_s, load, region) if mu_s > 0 and load > 0 else None,
+        "friction": sliding,
         "restitution": number("restitution", "dimensionless", base.restitution if base else 1.0),
         "damping_ratio": number(
             "damping-ratio", "dimensionless", base.damping_ratio if base else 0.0
         ),
         "pin": pin,
-        "contact_friction_coefficient": number(
-            "contact-friction-coefficient",
-            "dimensionless",
-            base.contact_friction_coefficient if base else 0.0,
-        ),
+        "contact_friction_coefficient": mu_c,
     }
 
 
@@ -510,6 +538,7 @@ def _run_rig(args: argparse.Namespace) -> int:
     from clearjoint.rig import load_campaign, run_campaign
 
     campaign = load_campaign(args.campaign)
+    _refuse_file_as_folder(args.out, "--out")
     jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
@@ -546,6 +575,9 @@ def _run_identify(args: argparse.Namespace) -> int:
     refuse_to_overwrite([out], force=args.force)
     out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
     options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
+
+    if args.figures:
+        _refuse_file_as_folder(args.figures, "--figures")
     if args.quiet:
         results, failures = identify_files(args.files, **options)
     else:
@@ -686,6 +718,7 @@ def _run_reproduce(args: argparse.Namespace) -> int:
 
     from clearjoint.reproduction import reproduce
 
+    _refuse_file_as_folder(args.out, "--out")
     start = time.perf_counter()
     written = reproduce(
         Path(args.out),
@@ -721,6 +754,7 @@ def _run_report(args: argparse.Namespace) -> int:
         raise RecordError(f"{folder}: no such folder; give --records a folder of record files")
     if not folder.is_dir():
         raise RecordError(f"{folder}: not a folder; give --records a folder of record files")
+    _refuse_file_as_folder(args.out, "--out")
     written = report_records(
         Path(args.records),
         Path(args.out),
@@ -827,6 +861,15 @@ def _plot_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _refuse_file_as_folder(path: str, option: str) -> None:
+    """Refuse an output folder that is (or lies under) a file, before the work, not after it."""
+    for folder in (Path(path), *Path(path).parents):
+        if folder.exists():
+            if not folder.is_dir():
+                raise ParameterError(f"{option} {path}: {folder} is a file; give a folder")
+            return
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
@@ -855,6 +898,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:  # a path the readers and writers did not check themselves
         where = f"{exc.filename}: " if exc.filename else ""
         reason = exc.strerror or str(exc)
+        if isinstance(exc, FileExistsError | NotADirectoryError):  # mkdir met a file
+            reason = "a file stands where a folder is needed"
         print(
             f"clearjoint {args.command}: error: {where}{reason.lower()}; check the path",
             file=sys.stderr,

@@ -68,7 +68,7 @@ def read_toml(path: str | Path, *, what: str, error: type[ClearjointError]) -> d
     if not data.strip():
         raise error(f"{where}: empty file; a {what} file is TOML, see the documented example")
     try:
-        text = data.decode("utf-8")
+        text = data.decode("utf-8-sig")  # Windows editors may start the file with a BOM
     except UnicodeDecodeError:
         raise error(f"{where}: not a text file; a {what} file is TOML") from None
     if "\x00" in text:

@@ -29,8 +29,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint._checks import refuse_to_overwrite
-from clearjoint.errors import ClearjointError
-from clearjoint.units import SI_UNITS, registry, to_si
+from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.units import SI_UNITS, is_quantity, registry, to_si
 
 FloatArray = NDArray[np.float64]
 
@@ -151,6 +151,8 @@ class Record:
                 continue
             try:
                 number = float(to_si(value, _META_SI[name], name=f"{where}: {name}"))
+            except ParameterError as exc:  # a unit string without or with the wrong unit
+                raise RecordError(str(exc)) from None
             except (TypeError, ValueError) as exc:
                 raise RecordError(f"{where}: {name} must be a number, got {value!r}") from exc
             if not math.isfinite(number) or number < 0.0:
@@ -177,6 +179,11 @@ class Record:
 
 
 def _channel(where: str, name: str, value: ArrayLike) -> FloatArray:
+    if is_quantity(value):  # np.asarray would drop the unit: a time in ms read as s
+        try:
+            value = to_si(value, SI[name], name=f"{where}: {name}")
+        except ParameterError as exc:
+            raise RecordError(str(exc)) from None
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -294,6 +301,7 @@ def _metadata_from_toml(where: str, table: dict[str, Any]) -> dict[str, Any]:
 
 
 _DELIMITERS = ("\t", ";", ",")
+_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 _COMMENT = re.compile(r"^\s*(#|//|;|%|!)")
 _KEY_VALUE = re.compile(r"^\s*(?P<key>[^:=,;\t]+?)\s*[:=,;\t]\s*(?P<value>.*)$")
 _NAME_UNIT = re.compile(
@@ -306,7 +314,13 @@ _PREAMBLE_LINES = 1000
 
 
 def _decode(where: str, data: bytes) -> str:
-    """A lab file's text: UTF-8 (with or without a BOM), else Latin-1 (Windows DAQ software)."""
+    """A lab file's text: UTF-8 (with or without a BOM), UTF-16 with its BOM (Excel's
+    "Unicode text"), else Latin-1 (Windows DAQ software)."""
+    if data.startswith(_UTF16_BOMS):
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError:
+            raise RecordError(f"{where}: starts as UTF-16 text but does not decode as it") from None
     if b"\x00" in data[:4096]:
         raise RecordError(f"{where}: a binary file of unknown format; not a record")
     try:
@@ -361,29 +375,35 @@ def _units_row(fields: list[str]) -> bool:
     return True
 
 
-def _resolution(texts: list[str]) -> float:
-    """The clock's resolution implied by how time stamps are written: 10^-decimals."""
-    decimals = 0
+def _resolution(texts: list[str]) -> FloatArray:
+    """The resolution each time stamp is written to: 10^-decimals, less its exponent.
+
+    Per stamp, since in scientific notation ("8.333333e-05", "1.999167e-01") the
+    resolution grows with the stamp: one figure for the whole column, the finest,
+    would call a uniform clock written with ``%.6e`` uneven.
+    """
+    places = []
     for text in texts:
         mantissa, _, exponent = text.lower().replace(",", ".").partition("e")
-        places = len(mantissa.partition(".")[2]) - (int(exponent) if exponent else 0)
-        decimals = max(decimals, places)
-    return 10.0 ** (-decimals)
+        places.append(len(mantissa.partition(".")[2]) - (int(exponent) if exponent else 0))
+    return np.power(10.0, -np.asarray(places, dtype=np.float64))
 
 
-def regular_time(time: FloatArray, resolution: float) -> tuple[FloatArray, float]:
+def regular_time(time: FloatArray, resolution: float | FloatArray) -> tuple[FloatArray, float]:
     """A uniform clock t0 + i dt fitted to time stamps rounded to ``resolution``.
 
     Stamps of a uniform clock rounded to its resolution (12 kHz written to 1 us)
     have steps that differ by up to the resolution: that is rounding, not uneven
-    sampling. Returns the fitted uniform times and the largest distance of a stamp
-    from them; the caller accepts the fit only when that distance is within the
-    resolution.
+    sampling. ``resolution`` may differ from stamp to stamp (scientific notation):
+    each stamp then weighs in by 1 / its resolution. Returns the fitted uniform
+    times and the largest distance of a stamp from them, in units of its own
+    resolution; the caller accepts the fit only when that is at most 1.
     """
     index = np.arange(time.size, dtype=np.float64)
-    slope, intercept = np.polyfit(index, time, 1)
+    scale = np.broadcast_to(np.asarray(resolution, dtype=np.float64), time.shape)
+    slope, intercept = np.polyfit(index, time, 1, w=1.0 / scale)
     uniform = intercept + slope * index
-    return uniform, float(np.max(np.abs(time - uniform)))
+    return uniform, float(np.max(np.abs(time - uniform) / scale))
 
 
 def _read_csv(path: Path, resample_: bool) -> Record:
@@ -425,23 +445,28 @@ def _read_csv(path: Path, resample_: bool) -> Record:
     _, delimiter = max(candidates)
     start, width = found[delimiter]  # type: ignore[misc]
     start += body
-    above = [i for i in range(body, start) if lines[i].strip()]
+    # a row of delimiters alone (";;", a blank spreadsheet row) is a blank line
+    above = [i for i in range(body, start) if lines[i].strip().strip(delimiter).strip()]
     if not above:
         raise RecordError(
             f"{where}: no column names above the numbers; name them like "
             "'time [s]', 'force [N]', 'displacement [mm]'"
         )
-    header_at = above.pop()
+    header_at = units_at = above.pop()
     unit_fields: list[str] | None = None
     if _units_row(_fields(lines[header_at], delimiter)) and above:
         unit_fields = _fields(lines[header_at], delimiter)
         header_at = above.pop()
     names = _fields(lines[header_at], delimiter)
-    if len(names) != width or (unit_fields is not None and len(unit_fields) != width):
-        raise RecordError(
-            f"{where}: line {header_at + 1} names {len(names)} columns but the numbers under "
-            f"it have {width}; check the delimiter {delimiter!r} and the column names"
-        )
+    for line_at, what, row in (
+        (header_at, "names", names),
+        (units_at, "has units for", unit_fields),
+    ):
+        if row is not None and len(row) != width:
+            raise RecordError(
+                f"{where}: line {line_at + 1} {what} {len(row)} columns but the numbers under "
+                f"it have {width}; check the delimiter {delimiter!r} and the column names"
+            )
     notes = []
     for i in above:
         line = lines[i]
@@ -541,14 +566,16 @@ def _clock(
     factor = _factor(where, "time", channels[k][1])
     stamps = [_fields(row, delimiter)[k] for row in rows if row.strip()]
     resolution = _resolution(stamps) * factor
-    uniform, stray = regular_time(time, resolution)
-    if stray <= resolution:
+    uniform, ratio = regular_time(time, resolution)
+    if ratio <= 1.0:  # every stamp within its own resolution of the fitted clock
         return uniform
+    worst = int(np.argmax(np.abs(time - uniform) / resolution))
+    stray, resolution_at = float(abs(time[worst] - uniform[worst])), float(resolution[worst])
     if resample_:
         return time  # uneven beyond the rounding: _assemble interpolates it
     raise RecordError(
         f"{where}: not uniformly sampled: time stamps stray up to {stray:.3g} s from a uniform "
-        f"clock, beyond their resolution {resolution:.3g} s; read it with resample=True "
+        f"clock, beyond their resolution {resolution_at:.3g} s; read it with resample=True "
         "(--resample) to interpolate onto a uniform grid"
     )
 
@@ -809,13 +836,18 @@ def sniff(path: str | Path) -> str:
         raise RecordError(f"{where}: cannot read it ({exc.strerror})") from None
     if not head:
         raise RecordError(f"{where}: empty file")
+    if path.suffix.lower() == ".toml":  # else read as a CSV whose sidecar is itself
+        raise RecordError(
+            f"{where}: a TOML file is not a record; give the record file (a .toml beside a "
+            "CSV of the same name holds that CSV's metadata)"
+        )
     if head.startswith(_HDF5):
         kind = "netcdf"
     elif head.startswith(b"CDF\x01") or head.startswith(b"CDF\x02"):
         raise RecordError(f"{where}: a classic (netCDF-3) file; save it as netCDF-4 / HDF5")
     elif head.lstrip().startswith(b"{"):
         kind = "json"
-    elif b"\x00" in head:
+    elif b"\x00" in head and not head.startswith(_UTF16_BOMS):  # UTF-16 text has NULs
         raise RecordError(f"{where}: a binary file of unknown format; not a record")
     else:
         kind = "csv"

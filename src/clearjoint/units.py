@@ -4,13 +4,19 @@ The command line, the file readers and the Python API's checks (``_checks``) use
 this module; the physics never sees a unit. Every quantity is converted by its
 dimension. Frequencies keep their 2 pi: an angular unit (rad/s, deg/s, rpm) is
 an angular frequency, so "2513rad/s" is 400 Hz and "400rpm" is 6.667 Hz, while
-Hz (and 1/s) counts cycles. On the command line a bare number for a dimensional
+Hz counts cycles. A bare 1/s (or 1/min) is a frequency in Hz where one is
+expected, but is refused where an angular frequency is (the API's ``omega``):
+pint gives sqrt(k/m) in 1/s, which is rad/s, so reading it as Hz would silently
+multiply it by 2 pi. On the command line a bare number for a dimensional
 quantity is refused (``bare="refuse"``); in the Python API a bare float is SI.
+Text must be one number, written with a decimal point, then its unit: pint reads
+"0,106mm" as 0 mm, "mm" as 1 mm and "1 000 mm" as 0 mm, so these are refused.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -66,6 +72,11 @@ EXAMPLES: dict[str, str] = {
     "dimensionless": "0.3",
 }
 
+#: The number a quantity's text must start with (pint would read "mm" as 1 mm).
+_LEADING_NUMBER = re.compile(r"^[+-]?((\d+\.?\d*|\.\d+)(e[+-]?\d+)?|nan|inf)", re.IGNORECASE)
+#: A second number right after the first, which pint multiplies: "1 000 mm" is 0 mm.
+_SECOND_NUMBER = re.compile(r"^\s*(?!1\s*/)[\d.(]")  # "50 1/s" is one number and a unit
+
 _KIND_OF_UNIT = {unit: kind for kind, unit in SI_UNITS.items()}
 _TWO_PI = 2.0 * math.pi
 
@@ -109,6 +120,12 @@ def _convert(quantity: Any, kind: str, name: str, raw: str) -> Any:
             if turns != 0:
                 raise pint.errors.DimensionalityError(quantity.units, "Hz")
             hertz = quantity.to("Hz").magnitude
+            cycles = any("hertz" in unit for unit, _ in quantity.unit_items())
+            if kind == "angular_frequency" and not cycles:
+                raise ParameterError(
+                    f"{name}: {raw!r} is ambiguous for an angular frequency (1/s is rad/s in "
+                    f"SI but Hz to many); write it in rad/s or Hz, like {example} or 400Hz"
+                )
             return hertz if kind == "frequency" else hertz * _TWO_PI
         return quantity.to(si if si else "dimensionless").magnitude
     except pint.errors.DimensionalityError:
@@ -151,6 +168,20 @@ def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "refuse") ->
     raw = text.strip()
     if not raw:
         raise ParameterError(f"{name}: empty value; give a {kind} such as {example}")
+    if "," in raw:
+        raise ParameterError(
+            f"{name} {raw}: write the decimal point as '.', e.g. {raw.replace(',', '.')}"
+        )
+    number = _LEADING_NUMBER.match(raw)
+    if not number:
+        raise ParameterError(
+            f"{name}: cannot read {raw!r} as a {kind}; start with the number, e.g. {example}"
+        )
+    if _SECOND_NUMBER.match(raw[number.end() :]):
+        raise ParameterError(
+            f"{name}: cannot read {raw!r} as a {kind}; write one number, then its unit "
+            f"(pint multiplies numbers side by side: '1 000 mm' is 0 mm), e.g. {example}"
+        )
     ureg = registry()
     try:
         quantity: Any = ureg.Quantity(raw)
@@ -159,8 +190,12 @@ def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "refuse") ->
             f"{name}: cannot read {raw!r} as a {kind} ({exc}); write it like {example}"
         ) from None
     if isinstance(quantity, int | float) or quantity.unitless:
-        magnitude = quantity if isinstance(quantity, int | float) else quantity.magnitude
+        # "1%" is unitless with magnitude 1: its value is 0.01
+        plain = isinstance(quantity, int | float)
+        magnitude = quantity if plain else quantity.to("dimensionless").magnitude
         if kind != "dimensionless" and bare == "refuse" and magnitude != 0:
+            if not math.isfinite(magnitude):
+                raise ParameterError(f"{name} {raw}: not a finite number; write it like {example}")
             raise ParameterError(f"{name} {raw}: give a unit, e.g. {raw}{UNIT_HINTS[kind]}")
         return float(magnitude)
     return float(_convert(quantity, kind, name, raw))

@@ -104,6 +104,7 @@ def load_study(path: str | Path) -> Study:
     if unknown:
         raise StudyError(f"{where}: unknown section(s) {unknown}; known: {sorted(DEFAULT_STUDY)}")
     values: dict[str, dict[str, Any]] = {}
+    stated: set[str] = set()  # "section.key" of every key the file gives
     for section, spec in DEFAULT_STUDY.items():
         given = read_table(
             raw.get(section, {}),
@@ -112,6 +113,7 @@ def load_study(path: str | Path) -> Study:
             section=f"[{section}]",
             error=StudyError,
         )
+        stated.update(f"{section}.{key}" for key in given)
         values[section] = {}
         for key, (default, _kind) in spec.items():
             if key in given:
@@ -121,12 +123,36 @@ def load_study(path: str | Path) -> Study:
             else:
                 values[section][key] = default
     try:
-        return _build(values, raw, where)
+        return _build(values, raw, where, stated)
     except ParameterError as exc:
         raise StudyError(f"{where}: {exc}") from None
 
 
-def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -> Study:
+def _friction(losses: dict[str, Any], stated: set[str], where: str) -> Friction | None:
+    """Sliding friction from [losses]; one of mu_s and P without the other is an error.
+
+    A coefficient with no lateral load (or a load with no coefficient) would give no
+    friction force at all, silently: the file must state the other (0 to switch it off).
+    """
+    pairs = (("friction_coefficient", "lateral_load", '"300N"'),
+             ("lateral_load", "friction_coefficient", "0.2"))  # fmt: skip
+    for key, other, example in pairs:
+        if losses[key] != 0.0 and f"losses.{other}" not in stated:
+            raise StudyError(
+                f"{where}: [losses] {key} is given without {other}, so there would be no "
+                f"sliding friction; give {other} too (e.g. {other} = {example})"
+            )
+    if losses["friction_coefficient"] == 0.0 and losses["lateral_load"] == 0.0:
+        return None
+    friction = Friction(  # validates the signs and the region
+        losses["friction_coefficient"], losses["lateral_load"], losses["friction_region"]
+    )
+    return friction if friction.force > 0.0 else None
+
+
+def _build(
+    values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str, stated: set[str]
+) -> Study:
     j = values["joint"]
     k_c = j["compression_stiffness"]
     tension = j["tension_stiffness"]
@@ -152,11 +178,7 @@ def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -
     if isinstance(duration, str):
         duration = 10.0 * 2.0 * math.pi / omega
     losses = values["losses"]
-    friction = None
-    if losses["friction_coefficient"] > 0.0 and losses["lateral_load"] > 0.0:
-        friction = Friction(
-            losses["friction_coefficient"], losses["lateral_load"], losses["friction_region"]
-        )
+    friction = _friction(losses, stated, where)
     pin = None
     if "pin" in raw:
         pv = values["pin"]
@@ -167,6 +189,11 @@ def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -
             length=pv["length"],
             youngs_modulus=pv["youngs_modulus"],
             poisson_ratio=pv["poisson_ratio"],
+        )
+    if losses["contact_friction_coefficient"] > 0.0 and pin is None:
+        raise StudyError(
+            f"{where}: [losses] contact_friction_coefficient acts on the pin, and the study "
+            "has none: add a [pin] table (radius, length) or remove the coefficient"
         )
     samples = values["output"]["samples_per_period"]
     periods = values["output"]["periods"]
