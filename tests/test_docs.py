@@ -1,7 +1,8 @@
 """The docs site's promises that a test can check without building it.
 
 Every picture a page shows is drawn by a script the docs build runs (a gallery
-example lists it in ``DOCS_FIGURES``) or by docs/make_report_figures.py, so none can
+example lists it in ``DOCS_FIGURES``, the reports' figures by name pattern in
+examples/gallery/plot_report_figures.py), so none can
 fall behind the code; and the LICENSE is the one pyproject.toml names.
 """
 
@@ -12,7 +13,7 @@ import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-#: Figures cut out of the two reports by docs/make_report_figures.py.
+#: Figures cut out of the two reports by examples/gallery/plot_report_figures.py.
 REPORT_FIGURES = ("reproduce_fig", "brfd_fig")
 
 
@@ -47,6 +48,14 @@ def test_every_figure_a_page_shows_is_drawn_by_a_script() -> None:
             f"{page.name} shows figures/{name}, which no script draws: draw it in an "
             "examples/gallery/plot_*.py and add it to that script's DOCS_FIGURES"
         )
+
+
+def test_the_report_figures_are_drawn_by_a_gallery_script() -> None:
+    script = ROOT / "examples" / "gallery" / "plot_report_figures.py"
+    text = script.read_text(encoding="utf-8")
+    for prefix in REPORT_FIGURES:
+        assert f'"{prefix.removesuffix("_fig")}")' in text, prefix
+    assert "DOCS_FIGURES.update(" in text
 
 
 def test_every_gallery_figure_is_shown_somewhere() -> None:

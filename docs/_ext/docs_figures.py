@@ -1,7 +1,8 @@
 """Sphinx-gallery scraper: show the figures an example lists in DOCS_FIGURES, and save them.
 
 An example in examples/gallery/ that draws a figure of the docs adds it to a
-module-level ``DOCS_FIGURES = {"name.png": figure}``. After each code block this
+module-level ``DOCS_FIGURES = {"name.png": figure}`` (a matplotlib figure, or the PNG's
+bytes when the picture comes drawn, as the report's do). After each code block this
 scraper shows every new figure of that mapping in the gallery page and writes it
 to docs/figures/name.png, the file the Markdown pages link to, so building the
 docs redraws every such picture from the code (``python docs/make_figures.py``
@@ -21,11 +22,19 @@ DPI = 110
 _shown: set[tuple[str, str]] = set()
 
 
+def _write(figure: Any, path: Path) -> None:
+    """Save a matplotlib figure, or write a PNG already drawn (bytes, e.g. cut from a report)."""
+    if isinstance(figure, bytes):
+        path.write_bytes(figure)
+    else:
+        figure.savefig(path, dpi=DPI)
+
+
 def save(name: str, figure: Any) -> Path:
     """Write ``figure`` to docs/figures/``name`` and return the path."""
     FIGURES.mkdir(exist_ok=True)
     path = FIGURES / name
-    figure.savefig(path, dpi=DPI)
+    _write(figure, path)
     return path
 
 
@@ -40,6 +49,6 @@ def scraper(block: Any, block_vars: dict[str, Any], gallery_conf: dict[str, Any]
         _shown.add((source, name))
         save(name, figure)
         image = next(block_vars["image_path_iterator"])
-        figure.savefig(image, dpi=DPI)
+        _write(figure, Path(image))
         shown.append(image)
     return figure_rst(shown, gallery_conf["src_dir"]) if shown else ""
