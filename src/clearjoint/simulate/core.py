@@ -273,6 +273,12 @@ def _run(p: FloatArray, state: FloatArray, n_periods: int, t_last: float, record
                 f"more than {kn.MAX_EVENTS_PER_PERIOD} events in one forcing period "
                 "(chattering); add damping or a restitution below 1"
             )
+        if status == kn.STATUS_MARCH_FAILED:
+            raise SimulationError(
+                f"an event was not reached in {kn.MAX_MARCH_STEPS} certified steps at "
+                f"x = {start[kn.S_X]!r} m (a near-grazing state the marching cannot resolve); "
+                "change omega or the force amplitude slightly"
+            )
         state[:] = start
         return _Run(segments[:n_seg], impacts[:n_imp], strobe, ledger, events)
 
