@@ -584,6 +584,20 @@ def steady_state(
         raise SimulationError(f"no periodic orbit within {max_periods} forcing periods: {hint}")
     if multiple > 1:
         multiple = _smallest_multiple(p, state, multiple, strobe, tol, x_scale, v_scale)
+    return _orbit_from(p, joint, state, multiple, done, pin, mu_c, samples_per_period)
+
+
+def _orbit_from(
+    p: FloatArray,
+    joint: Joint,
+    state: FloatArray,
+    multiple: int,
+    periods_to_converge: int,
+    pin: Pin | None,
+    mu_c: float,
+    samples_per_period: int,
+) -> SteadyState:
+    """The SteadyState of the orbit of ``multiple`` periods that starts at ``state`` (phase 0)."""
     start = state.copy()
     run = _run(p, state, multiple, p[kn.P_TF], record=True)
     duration = multiple * p[kn.P_TF]
@@ -595,7 +609,7 @@ def steady_state(
         **fields,  # type: ignore[arg-type]
         period_multiple=multiple,
         period=duration,
-        periods_to_converge=done,
+        periods_to_converge=periods_to_converge,
         initial_state=(
             float(start[0]),
             float(start[1]),
