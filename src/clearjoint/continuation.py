@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from clearjoint.errors import ClearjointError, ParameterError
@@ -108,6 +109,13 @@ class Branch:
     reason: str
 
 
+@njit(cache=True)
+def _solve(a: FloatArray, b: FloatArray) -> FloatArray:
+    """np.linalg.solve compiled: the systems are tiny and called thousands of times."""
+    x: FloatArray = np.asarray(np.linalg.solve(a, b), dtype=np.float64)
+    return x
+
+
 def _tangent(a: FloatArray, previous: FloatArray) -> FloatArray:
     """Unit null vector of the (d, d+1) matrix ``a``, oriented along ``previous``."""
     system = np.vstack((a, previous))
@@ -133,27 +141,34 @@ def _correct(
     """Newton on [R(y); t . (y - y0)] = 0 (or on R at fixed lambda); None if it fails."""
     y = y0.copy()
     d = y.size - 1
-    border = np.zeros(d + 1)
-    border[-1] = 1.0
+    u_scale = scale[:d]
+    system = np.empty((d + 1, d + 1))
+    if fixed_lambda:
+        system[d, :d] = 0.0
+        system[d, d] = 1.0
+    else:
+        system[d] = tangent
+    rhs = np.empty(d + 1)
     for iteration in range(settings.max_iterations + 1):
         try:
-            r, jac_u, r_lam, data = residual(y[:d] * scale[:d], float(y[d] * scale[d]))
+            r, jac_u, r_lam, data = residual(y[:d] * u_scale, float(y[d] * scale[d]))
         except ClearjointError:
             return None
-        a = np.empty((d, d + 1))
-        a[:, :d] = jac_u * scale[:d]
-        a[:, d] = r_lam * scale[d]
-        rs = r / scale[:d]
-        if not np.all(np.isfinite(rs)) or not np.all(np.isfinite(a)):
+        # rows scaled by the unknowns' sizes, columns by the scaled unknowns
+        system[:d, :d] = jac_u * (u_scale / u_scale[:, None])
+        system[:d, d] = r_lam * (scale[d] / u_scale)
+        rs = r / u_scale
+        size = float(np.max(np.abs(rs)))
+        if not math.isfinite(size) or not math.isfinite(float(system.sum())):
             return None
-        if np.max(np.abs(rs)) <= settings.tolerance:
-            return y, a / scale[:d, None], data, iteration
+        if size <= settings.tolerance:
+            return y, system[:d].copy(), data, iteration
         if iteration == settings.max_iterations:
             return None
-        system = np.vstack((a / scale[:d, None], border if fixed_lambda else tangent))
-        rhs = np.concatenate((-rs, [0.0 if fixed_lambda else -float(tangent @ (y - y0))]))
+        rhs[:d] = -rs
+        rhs[d] = 0.0 if fixed_lambda else -float(tangent @ (y - y0))
         try:
-            dy = np.linalg.solve(system, rhs)
+            dy = _solve(system, rhs)
         except np.linalg.LinAlgError:
             return None
         y = y + dy
