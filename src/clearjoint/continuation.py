@@ -5,7 +5,7 @@ use it, and so can harmonic balance. A branch is followed in scaled coordinates
 y = (u / u_scale, lambda / lambda_scale):
 
 - tangent t: the null vector of [dR/du, dR/dlambda], oriented along the last one;
-- predictor y + h t;
+- predictor y + h t + (h^2 / 2) dt/ds, the curvature taken from the last step;
 - corrector: Newton on R(y) = 0 together with the arclength condition
   t . (y - y_predicted) = 0, so that it passes folds where dR/du is singular;
 - step control from the corrector's iteration count: grow after an easy
@@ -229,8 +229,10 @@ def continue_branch(
     h = settings.step
     stop = lam_stop / scale[-1]
     reason = "max_points"
+    curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
     while len(ys) < settings.max_points:
-        attempt = _correct(residual, y + h * t, t, scale, settings, fixed_lambda=False)
+        predicted = y + h * t + 0.5 * h * h * curvature
+        attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
         if attempt is not None:
             y_new, a_new, data_new, its = attempt
             t_new = _tangent(a_new, t)
@@ -257,6 +259,8 @@ def continue_branch(
                 iters.append(its_end)
             reason = "reached"
             break
+        step_length = float(np.linalg.norm(y_new - y))
+        curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         y, t = y_new, t_new
         ys.append(y)
         ts.append(t)

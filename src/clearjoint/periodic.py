@@ -512,7 +512,7 @@ def frequency_response(
         settings=ContinuationSettings(
             step=0.002,
             min_step=1e-7,
-            max_step=0.02,
+            max_step=0.023,
             max_points=max_points,
             tolerance=1e-11,
         ),
