@@ -80,7 +80,7 @@ def test_force_curve_at_a_fixed_frequency(
     [
         (["--from", "20Hz", "--to", "20Hz"], "zero width"),
         (["--from=-5Hz", "--to", "20Hz"], "must be finite and > 0"),
-        (["--from", "nan", "--to", "20Hz"], "must be finite and > 0"),
+        (["--from", "NaN Hz", "--to", "20Hz"], "must be finite and > 0"),
         (["--from", "20N", "--to", "90Hz"], "--from"),
         (["--parameter", "force", "--from", "10N"], "--to"),
         (["--from", "20Hz", "--to", "90Hz", "--frequency", "5Hz"], "--parameter force"),

@@ -1,4 +1,4 @@
-"""simulate.shooting: the exact map's monodromy, and steady_state's period-n label."""
+"""simulate._shooting: the exact map's monodromy, and steady_state's period-n label."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pytest
 
 from clearjoint import Friction, Joint
 from clearjoint.simulate import core, steady_state
+from clearjoint.simulate._shooting import shoot
 from clearjoint.simulate.reference import reference_time_response
-from clearjoint.simulate.shooting import shoot
 
 #: pyHarm's SDOF clearance case: m = 1, c_v = 0.05, k0 = 1, edges at +-0.1745, contact adds 3.
 PYHARM = Joint(

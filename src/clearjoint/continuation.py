@@ -23,10 +23,18 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from clearjoint._jit import njit  # numba.njit that survives a read-only install
 from clearjoint.errors import ClearjointError, ParameterError
+
+__all__ = [
+    "Branch",
+    "ContinuationError",
+    "ContinuationSettings",
+    "Residual",
+    "continue_branch",
+]
 
 FloatArray = NDArray[np.float64]
 

@@ -4,7 +4,7 @@ A periodic orbit of p forcing periods is a fixed point of the exact stroboscopic
 map, P_p(z0) = z0 with z0 = (x, x') at forcing phase 0 (the force is
 F0 sin(omega t)). It is found by Newton's method with the *exact* monodromy
 matrix M = dP_p/dz0, built from the closed-form flow of each state and the
-saltation matrix of each event (``simulate.shooting``). The Floquet multipliers
+saltation matrix of each event (``simulate._shooting``). The Floquet multipliers
 are eig(M); the orbit is stable when all |mu| < 1.
 
 ``frequency_response`` follows the period-1 orbit with pseudo-arclength
@@ -35,15 +35,7 @@ from clearjoint.continuation import ContinuationSettings, continue_branch
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint
 from clearjoint.simulate import _kernel as kn
-from clearjoint.simulate.core import (
-    SimulationError,
-    SteadyState,
-    _initial_state,
-    _orbit_from,
-    _parameters,
-    _run,
-)
-from clearjoint.simulate.shooting import (
+from clearjoint.simulate._shooting import (
     N_RES,
     R_DLAM,
     R_JAC,
@@ -55,10 +47,26 @@ from clearjoint.simulate.shooting import (
     newton_orbit,
     start_state,
 )
+from clearjoint.simulate.core import (
+    SimulationError,
+    SteadyState,
+    _initial_state,
+    _orbit_from,
+    _parameters,
+    _run,
+)
 
 if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.axes import Axes
+
+__all__ = [
+    "FrequencyResponse",
+    "PeriodicOrbit",
+    "ResponseEvent",
+    "frequency_response",
+    "periodic_orbit",
+]
 
 FloatArray = NDArray[np.float64]
 

@@ -21,7 +21,6 @@ from __future__ import annotations
 import csv
 import math
 import os
-import tomllib
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -35,10 +34,10 @@ from scipy import signal
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.io_toml import quantity, read_toml
 from clearjoint.joint import Friction, Joint, Pin
 from clearjoint.records import Record, write_record
 from clearjoint.simulate import SimulationError, steady_state, time_response
-from clearjoint.units import parse_quantity
 
 FloatArray = NDArray[np.float64]
 
@@ -217,17 +216,10 @@ def _merge(base: dict[str, Any], given: dict[str, Any], where: str, prefix: str 
 
 
 def _quantity(where: str, key: str, value: Any) -> float:
-    kind = _KINDS.get(key)
-    if isinstance(value, bool):
-        raise CampaignError(f"{where}: {key} must be a number, got {value!r}")
-    if isinstance(value, int | float):
-        return float(value)
-    if kind is None or not isinstance(value, str):
-        raise CampaignError(f"{where}: {key} must be a number, got {value!r}")
-    try:
-        return parse_quantity(value, kind, name=f"{where}: {key}")
-    except ClearjointError as exc:
-        raise CampaignError(str(exc)) from None
+    value = quantity(
+        value, _KINDS.get(key, "dimensionless"), name=f"{where}: {key}", error=CampaignError
+    )
+    return float(value)
 
 
 def load_campaign(path: str | Path | None = None) -> Campaign:
@@ -239,17 +231,11 @@ def load_campaign(path: str | Path | None = None) -> Campaign:
         The file is missing or not TOML, a key is unknown, or a value is invalid.
     """
     default_path = default_campaign_path()
-    values = tomllib.loads(default_path.read_text(encoding="utf-8"))
+    values = read_toml(default_path, what="campaign", error=CampaignError)
     where = str(default_path)
     if path is not None:
-        path = Path(path)
         where = str(path)
-        try:
-            given = tomllib.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise CampaignError(f"{where}: no such campaign file") from None
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise CampaignError(f"{where}: not valid TOML ({exc})") from None
+        given = read_toml(path, what="campaign", error=CampaignError)
         structures = given.pop("structures", None)
         _merge(values, given, where)
         if structures is not None:

@@ -24,9 +24,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from clearjoint._jit import njit  # numba.njit that survives a read-only install
 from clearjoint.simulate import _kernel as kn
 
 FloatArray = NDArray[np.float64]
