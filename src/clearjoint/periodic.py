@@ -5,7 +5,7 @@ map, P_p(z0) = z0 with z0 = (x, x') at forcing phase 0 (the force is
 F0 sin(omega t)). It is found by Newton's method with the *exact* monodromy
 matrix M = dP_p/dz0, built from the closed-form flow of each state and the
 saltation matrix of each event (``simulate._shooting``). The Floquet multipliers
-are eig(M); the orbit is stable when all |mu| < 1.
+are eig(M); the orbit is stable when every multiplier has modulus < 1.
 
 ``frequency_response`` follows the period-1 orbit with pseudo-arclength
 continuation (``clearjoint.continuation``) in omega (or in F0), stable and
@@ -90,7 +90,7 @@ class PeriodicOrbit:
     multipliers : (2,) complex ndarray
         Floquet multipliers, eig(monodromy).
     stable : bool
-        All |multipliers| < 1.
+        Every multiplier has modulus < 1.
     omega, force_amplitude : float
         rad/s and N.
     period_multiple : int
