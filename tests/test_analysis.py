@@ -71,7 +71,6 @@ def test_no_clearance_gives_the_slope_and_bad_sides_give_nan() -> None:
 
 
 def test_damper_stages_follow_the_force_after_each_reversal() -> None:
-    from clearjoint.analysis import stage_runs
     from clearjoint.identify import CycleResult, Identification
     from clearjoint.records import Record
 
@@ -100,7 +99,7 @@ def test_damper_stages_follow_the_force_after_each_reversal() -> None:
         restoring_force=force,
         stage=np.zeros(t.size, dtype=np.int8),
     )
-    free = [(a, b) for name, a, b in stage_runs(record, ident) if name == "free-play"]
+    free = [(a, b) for name, a, b in ident.stage_runs(record.time) if name == "free-play"]
     assert len(free) >= 3
     for a, b in free:
         # each free play sits just after a reversal (x at a turning point, 0.25 + k/2 s)

@@ -231,6 +231,15 @@ def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
         read_brfd(path)
 
 
+def test_fast_unit_factors_agree_with_pint() -> None:
+    from clearjoint.records import FAST_FACTORS, SI
+    from clearjoint.units import registry
+
+    for (channel, unit), factor in FAST_FACTORS.items():
+        exact = registry().Quantity(1.0, unit).to(SI[channel]).magnitude
+        assert factor == pytest.approx(exact, rel=1e-12), (channel, unit)
+
+
 def test_metadata_takes_units_or_a_unit_named_key_never_a_bare_number(tmp_path: Path) -> None:
     times = [i / 100 for i in range(50)]
     good = write_csv(tmp_path, CSV_MAGIC + "\n# frequency_hz = 10\n# clearance = \"0.1mm\"\n"

@@ -2,5 +2,5 @@
 
 from clearjoint.cli import main
 
-if __name__ == "__main__":  # not when a tool (Sphinx, pkgutil) merely imports the module
+if __name__ == "__main__":  # not when a tool or a spawned Dask worker merely imports it
     raise SystemExit(main())

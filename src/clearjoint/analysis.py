@@ -14,7 +14,6 @@ here: report.py draws and writes.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -325,30 +324,3 @@ def analyse(
     return analysis
 
 
-#: A damper's free play: where |restoring force| is below this fraction of its friction force.
-DAMPER_FREE_PLAY_FRACTION = 0.2
-
-
-def stage_runs(record: Record, ident: Identification) -> list[tuple[str, float, float]]:
-    """Return the record's stages as (name, start s, end s) runs, where they are.
-
-    A clearance joint's stages follow the displacement (inside the gap edges or
-    beyond), as ``Identification.stage_runs`` gives them. A friction damper with
-    backlash plays free after each reversal, not at the zero crossings: its stages
-    follow the restoring force, free play where |F| is below
-    ``DAMPER_FREE_PLAY_FRACTION`` of the identified friction force, compression where
-    F is above it and tension below its negative.
-    """
-    if ident.model != "damper":
-        return ident.stage_runs(record.time)
-    force = ident.restoring_force
-    level = DAMPER_FREE_PLAY_FRACTION * ident.summary["friction_force_n"]
-    stage = np.where(force > level, 1, np.where(force < -level, -1, 0))
-    names = {0: "free-play", 1: "compression", -1: "tension"}
-    change = np.nonzero(np.diff(stage))[0] + 1
-    bounds = np.concatenate(([0], change, [stage.size]))
-    t = record.time
-    return [
-        (names[int(stage[a])], float(t[a]), float(t[min(b, t.size - 1)]))
-        for a, b in itertools.pairwise(bounds)
-    ]

@@ -178,6 +178,14 @@ def _identify_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="results file, .csv or .nc")
     p.add_argument("--figures", help="write two figures per test into this folder")
     p.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="draw every identified loop with its flag into one figure (.png, .pdf or .svg)",
+    )
+    p.add_argument(
+        "--jobs", type=int, default=1, help="processes over the files (default 1; same results)"
+    )
+    p.add_argument(
         "--resample", action="store_true", help="interpolate records that are not uniformly sampled"
     )
     p.add_argument(
@@ -186,7 +194,7 @@ def _identify_parser(sub: Any) -> None:
         default=0.03,
         help="steady-cycle amplitude tolerance (default 0.03)",
     )
-    p.add_argument("--force", action="store_true", help="overwrite existing output")
+    p.add_argument("--force", action="store_true", help="overwrite existing output and --plot")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -263,6 +271,27 @@ def _save_plot(result: Any, path: Path | None, *, quiet: bool) -> None:
         print(f"wrote {path}")
 
 
+def _sweep_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "sweep",
+        help="parameter study or tolerance Monte Carlo from a sweep file, on Dask",
+        description=(
+            "Run the task of SWEEP.toml at every point of its grid axes and Monte Carlo "
+            "draws (see docs/sweep.md), on a local Dask cluster or on a running scheduler, "
+            "writing --out (a zarr store) chunk by chunk. With --plot STORE VAR: draw one "
+            "output (a map, a line or a histogram) to --out (PNG)."
+        ),
+    )
+    p.add_argument("sweep", nargs="?", help="sweep file (TOML)")
+    p.add_argument("--out", help="zarr store to write (.zarr); with --plot, the PNG")
+    p.add_argument("--scheduler", help="a running Dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--workers", type=int, help="local cluster's worker processes (default: cores)")
+    p.add_argument("--resume", action="store_true", help="finish an interrupted --out store")
+    p.add_argument("--force", action="store_true", help="replace an existing --out")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--plot", nargs=2, metavar=("STORE", "VAR"), help="draw VAR of a store")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``clearjoint`` command."""
     parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
@@ -276,6 +305,7 @@ def build_parser() -> argparse.ArgumentParser:
     _reproduce_parser(sub)
     _report_parser(sub)
     _frf_parser(sub)
+    _sweep_parser(sub)
     return parser
 
 
@@ -539,12 +569,14 @@ def _run_identify(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .csv or .nc, got {out.name!r}")
     if not 0.0 < args.tolerance < 1.0:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
+    if args.jobs < 1:
+        raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    plot = _plot_target(args)  # a figure suffix, not overwritten unless --force
     refuse_to_overwrite([out], force=args.force)
     out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
+    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
     if args.quiet:
-        results, failures = identify_files(
-            args.files, resample=args.resample, tolerance=args.tolerance
-        )
+        results, failures = identify_files(args.files, **options)
     else:
         from rich.progress import Progress
 
@@ -552,14 +584,16 @@ def _run_identify(args: argparse.Namespace) -> int:
             task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
             results, failures = identify_files(
                 args.files,
-                resample=args.resample,
-                tolerance=args.tolerance,
+                **options,
                 progress=lambda done, _total: bar.update(task, completed=done),
             )
     if not results and len(failures) == 1:
         raise ParameterError(f"no record could be used: {failures[0]}")  # one file, one line
     for line in failures:
         print(f"not used: {line}", file=sys.stderr)
+    for _, ident in results:
+        for warning in ident.warnings:
+            print(f"clearjoint identify: warning: {warning}", file=sys.stderr)
     if not results:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -567,7 +601,17 @@ def _run_identify(args: argparse.Namespace) -> int:
     _write_rows(rows, out)
     if args.figures:
         _identify_figures(results, Path(args.figures), force=args.force)
-    print(f"identified {len(results)} of {len(args.files)} records; wrote {out}")
+    if plot is not None:
+        from clearjoint.identify import identifications_figure
+
+        plot.parent.mkdir(parents=True, exist_ok=True)
+        identifications_figure([ident for _, ident in results]).savefig(plot, dpi=100)
+        print(f"wrote {plot}")
+    flagged = sum(ident.flag != "ok" for _, ident in results)
+    print(
+        f"identified {len(results)} of {len(args.files)} records ({flagged} flagged, see the "
+        f"flag and flag_reason columns); wrote {out}"
+    )
     return 0
 
 
@@ -604,7 +648,8 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
         first = ident.cycles[0]
         span = slice(first.start, ident.cycles[-1].stop)
         runs = ident.stage_runs(record.time)
-        fig = displacement_stages_figure(record.time, record.displacement, runs, title=stem)
+        title = f"{stem} [{ident.flag}]"  # the credibility flag on every figure
+        fig = displacement_stages_figure(record.time, record.displacement, runs, title=title)
         fig.savefig(targets[0], dpi=100)
         fig = identified_loop_figure(
             record.displacement[span],
@@ -612,7 +657,7 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
             ident.stage[span],
             (first.upper_edge, first.lower_edge),
             first.lines,
-            title=stem,
+            title=title,
         )
         fig.savefig(targets[1], dpi=100)
 
@@ -828,6 +873,91 @@ def _warning_printer(command: str) -> Callable[..., None]:
     return show
 
 
+def _run_sweep(args: argparse.Namespace) -> int:
+    import contextlib
+    import time
+
+    if args.plot:
+        return _plot_sweep(args)
+    from clearjoint.parallel import dask_client
+    from clearjoint.sweep import Sweep, run_sweep
+
+    if args.sweep is None or args.out is None:
+        raise ParameterError("give a sweep file and --out results.zarr (or --plot STORE VAR)")
+    if Path(args.out).suffix != ".zarr":
+        raise ParameterError(f"--out must end in .zarr, got {args.out!r}")
+    if args.scheduler and args.workers is not None:
+        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    start = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        if args.scheduler:  # an unreachable scheduler is said first, within seconds
+            client = stack.enter_context(dask_client(args.scheduler))
+        sweep = Sweep.from_toml(args.sweep)
+        if not args.scheduler:  # a bad sweep file is said before a cluster starts
+            client = stack.enter_context(dask_client(workers=args.workers))
+        already: list[int] = []  # points found in the store on --resume
+        bar: Any = None
+        if not args.quiet and sys.stderr.isatty():
+            from rich.progress import Progress, TimeRemainingColumn
+
+            bar = stack.enter_context(
+                Progress(
+                    *Progress.get_default_columns()[:-1], TimeRemainingColumn(), transient=True
+                )
+            )
+            task = bar.add_task(f"{sweep.n_points} points", total=sweep.n_points)
+
+        def progress(done: int, _total: int) -> None:
+            if not already:
+                already.append(done)
+            if bar is not None:
+                bar.update(task, completed=done)
+
+        try:
+            results = run_sweep(
+                sweep,
+                client=client,
+                out=args.out,
+                resume=args.resume,
+                force=args.force,
+                progress=progress,
+            )
+        except KeyboardInterrupt:
+            print(
+                f"clearjoint sweep: interrupted; finished chunks are in {args.out}: "
+                f"run again with --resume to compute only the rest",
+                file=sys.stderr,
+            )
+            return 130
+    failed = results.attrs["points_failed"]
+    kept = f", {already[0]} of them kept from the store" if already and already[0] else ""
+    print(
+        f"wrote {results.attrs['points']} points{kept} ({failed} failed: see `status`) "
+        f"to {args.out} in {time.perf_counter() - start:.1f} s"
+    )
+    return 0
+
+
+def _plot_sweep(args: argparse.Namespace) -> int:
+    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.sweep import open_sweep
+    from clearjoint.sweep.plot import plot_sweep
+
+    store, variable = args.plot
+    if args.sweep is not None:
+        raise ParameterError("--plot STORE VAR takes no sweep file")
+    out = (
+        Path(args.out) if args.out else Path(store).with_name(f"{Path(store).stem}_{variable}.png")
+    )
+    if out.suffix.lower() != ".png":
+        raise ParameterError(f"with --plot, --out is the picture and must end in .png, got {out}")
+    refuse_to_overwrite([out], force=args.force)
+    ax = plot_sweep(open_sweep(store), variable)
+    ax.figure.savefig(out, dpi=110)
+    print(f"wrote {out}")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
@@ -841,6 +971,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "reproduce": _run_reproduce,
         "report": _run_report,
         "frf": _run_frf,
+        "sweep": _run_sweep,
     }
     try:
         with warnings.catch_warnings():

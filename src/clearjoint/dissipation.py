@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -550,6 +550,36 @@ class AgreementMap:
     gap: dict[str, FloatArray]
 
 
+def _agreement_row(
+    args: tuple[Joint, float, FloatArray, dict[str, Any], int],
+) -> tuple[FloatArray, dict[str, FloatArray]]:
+    """One frequency of :func:`agreement_map`: the forces stepped upward from rest."""
+    from clearjoint.simulate import SimulationError
+
+    joint, omega, f, losses, max_periods = args
+    penetration = np.full(f.size, np.nan)
+    gaps: dict[str, FloatArray] = {}
+    initial: tuple[float, float, int, int] | None = None
+    for n, force in enumerate(f):
+        try:
+            result = compare(
+                joint,
+                float(force),
+                omega,
+                **losses,
+                initial=initial,
+                samples_per_period=128,
+                max_periods=max_periods,
+            )
+        except SimulationError:
+            continue
+        initial = result.cycle.initial_state
+        penetration[n] = result.penetration
+        for key, value in result.gap.items():
+            gaps.setdefault(key, np.full(f.size, np.nan))[n] = value
+    return penetration, gaps
+
+
 def agreement_map(
     joint: Joint,
     omegas: ArrayLike,
@@ -561,40 +591,35 @@ def agreement_map(
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
     max_periods: int = 2000,
+    executor: Any = None,
 ) -> AgreementMap:
     """Return the closed-form-to-exact gap of every energy over a grid of (omega, F0).
 
     At each frequency the forces are stepped upward, each step starting from the
     last steady state (as a test rig would), so every point is an exact steady
     cycle compared with the closed forms at its own penetration (:func:`compare`).
+    Frequencies run one after the other here, or side by side on ``executor`` (a
+    concurrent.futures Executor or a dask.distributed Client: clearjoint.parallel),
+    with the same result.
     """
-    from clearjoint.simulate import SimulationError
+    from clearjoint.parallel import run_ordered
 
     w = np.atleast_1d(np.asarray(omegas, dtype=np.float64))
     f = np.sort(np.atleast_1d(np.asarray(forces, dtype=np.float64)))
+    losses: dict[str, Any] = {
+        "friction": friction,
+        "pin": pin,
+        "contact_friction_coefficient": contact_friction_coefficient,
+        "restitution": restitution,
+        "damping_ratio": damping_ratio,
+    }
+    rows = run_ordered(
+        _agreement_row, [(joint, float(omega), f, losses, max_periods) for omega in w], executor
+    )
     penetration = np.full((w.size, f.size), np.nan)
     gaps: dict[str, FloatArray] = {}
-    for i, omega in enumerate(w):
-        initial: tuple[float, float, int, int] | None = None
-        for n, force in enumerate(f):
-            try:
-                result = compare(
-                    joint,
-                    float(force),
-                    float(omega),
-                    friction=friction,
-                    pin=pin,
-                    contact_friction_coefficient=contact_friction_coefficient,
-                    restitution=restitution,
-                    damping_ratio=damping_ratio,
-                    initial=initial,
-                    samples_per_period=128,
-                    max_periods=max_periods,
-                )
-            except SimulationError:
-                continue
-            initial = result.cycle.initial_state
-            penetration[i, n] = result.penetration
-            for key, value in result.gap.items():
-                gaps.setdefault(key, np.full((w.size, f.size), np.nan))[i, n] = value
+    for i, (row_penetration, row_gaps) in enumerate(rows):
+        penetration[i] = row_penetration
+        for key, value in row_gaps.items():
+            gaps.setdefault(key, np.full((w.size, f.size), np.nan))[i] = value
     return AgreementMap(omega=w, force=f, penetration=penetration, gap=gaps)

@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from clearjoint import fit
-from clearjoint.analysis import Analysis, side_data, stage_runs, tests_of
+from clearjoint.analysis import Analysis, side_data, tests_of
 
 #: Line styles that stay apart in grey print, cycled per curve.
 _STYLES: tuple[tuple[Any, str], ...] = (
@@ -551,7 +551,7 @@ def report_figures(
             span = slice(first.start, ident.cycles[-1].stop)
             runs = [
                 r
-                for r in stage_runs(record, ident)
+                for r in ident.stage_runs(record.time)
                 if r[2] >= record.time[span.start] and r[1] <= record.time[span.stop - 1]
             ]
             how = (

@@ -218,8 +218,28 @@ def resample(
 # ---- units --------------------------------------------------------------------------------
 
 
+#: Exact factors of the units most files use, so that reading them does not build pint's
+#: registry (a second or two); tests/test_records.py checks each against pint.
+FAST_FACTORS = {
+    ("time", "s"): 1.0,
+    ("force", "N"): 1.0,
+    ("force", "kN"): 1e3,
+    ("force", "kip"): 4448.2216152605,
+    ("displacement", "m"): 1.0,
+    ("displacement", "mm"): 1e-3,
+    ("displacement", "um"): 1e-6,
+    ("displacement", "in"): 0.0254,
+    ("velocity", "m/s"): 1.0,
+    ("velocity", "in/s"): 0.0254,
+    ("acceleration", "m/s^2"): 1.0,
+}
+
+
 def _factor(where: str, channel: str, unit: str) -> float:
     """The factor that takes ``channel`` in ``unit`` to SI; errors name the file and channel."""
+    fast = FAST_FACTORS.get((channel, unit.strip()))
+    if fast is not None:
+        return fast
     import pint
 
     target = SI[channel]

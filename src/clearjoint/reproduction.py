@@ -16,6 +16,7 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -110,6 +111,7 @@ def reproduce(
     progress: Progress | None = None,
     campaign_path: Path | None = None,
     jobs: int | None = None,
+    executor: Any = None,
 ) -> list[Path]:
     """Run the paper's whole study on the virtual rig and write the report into ``out_dir``.
 
@@ -118,14 +120,18 @@ def reproduce(
     without the rig's installation sensitivity (in a temporary folder; the same records
     when the sensitivity is already off) decides each finding's source; the figures and
     the report follow, with the identification checked against the rig's truth and the
-    dissipation model of section 2 set against the exact cycles.
+    dissipation model of section 2 set against the exact cycles. The rig's tests run
+    over ``jobs`` processes, or on ``executor`` (an Executor or a Dask client whose
+    workers see ``out_dir``: clearjoint.parallel).
     """
     say = progress or (lambda _m: None)
     out_dir = Path(out_dir)
     refuse_to_overwrite([out_dir / n for n in ("report.html", "results.json")], force=force)
     campaign = load_campaign(campaign_path)
     say(f"virtual rig: {len(campaign.tests)} tests")
-    manifest = run_campaign(campaign, out_dir / "records", jobs=jobs, force=force)
+    manifest = run_campaign(
+        campaign, out_dir / "records", jobs=jobs, force=force, executor=executor
+    )
     with manifest.open() as handle:
         truth = {row["file"]: row for row in csv.DictReader(handle)}
     say("identifying the records")
@@ -140,7 +146,10 @@ def reproduce(
         say("control run: the same campaign without the installation sensitivity")
         with tempfile.TemporaryDirectory(prefix="clearjoint-control-") as folder:
             control_manifest = run_campaign(
-                without_installation_sensitivity(campaign), Path(folder), jobs=jobs
+                without_installation_sensitivity(campaign),
+                Path(folder),
+                jobs=jobs,
+                executor=executor,
             )
             with control_manifest.open() as handle:
                 names = [row["file"] for row in csv.DictReader(handle)]
