@@ -116,7 +116,11 @@ def run_pyharm(python: str) -> dict[str, object] | None:
         script.write_text(PYHARM_SCRIPT, encoding="utf-8")
         out = Path(tmp) / "out.json"
         done = subprocess.run(
-            [python, str(script), str(out)], capture_output=True, text=True, timeout=3600
+            [python, str(script), str(out)],
+            capture_output=True,
+            text=True,
+            timeout=3600,
+            cwd=tmp,  # pyHarm writes a .pyHarm/ folder into its working directory
         )
         if done.returncode != 0 or not out.exists():
             print(f"pyHarm failed (exit {done.returncode}): {done.stderr.strip()[-400:]}")
