@@ -25,6 +25,7 @@ starts from the last), so numpy vectorisation does not apply.
 
 from __future__ import annotations
 
+import cmath
 import math
 
 import numpy as np
@@ -53,6 +54,7 @@ EV_VELOCITY_ZERO = 5
 EV_RELEASE_UP = 6
 EV_RELEASE_DOWN = 7
 EV_PERIOD_END = 8
+EV_MARCH_FAILED = 9
 
 # segment record layout
 SEG_PERIOD, SEG_T0, SEG_DT, SEG_REGION, SEG_SLIP, SEG_X0, SEG_V0, SEG_PHI = range(8)
@@ -63,9 +65,12 @@ IMP_WIDTH = 4
 L_INPUT, L_VISCOUS, L_SLIDING, L_IMPACT = range(4)
 LEDGER_WIDTH = 4
 
-STATUS_OK, STATUS_SEGMENTS_FULL, STATUS_TOO_MANY_EVENTS = 0, 1, 2
+STATUS_OK, STATUS_SEGMENTS_FULL, STATUS_TOO_MANY_EVENTS, STATUS_MARCH_FAILED = 0, 1, 2, 3
 
 MAX_EVENTS_PER_PERIOD = 100_000
+#: Certified steps allowed to reach one event; a state that needs more is an error
+#: (``EV_MARCH_FAILED``), never a silent jump to the end of the period.
+MAX_MARCH_STEPS = 100_000
 
 # 8-point Gauss-Legendre rule on [-1, 1]
 _GL_X = np.array(
@@ -396,7 +401,7 @@ def _next_event(
         ff = p[P_FF]
         rest = fc - k * q[Q_XSTICK]
         bound = f0 * w**3
-        for _ in range(100_000):
+        for _ in range(MAX_MARCH_STEPS):
             theta = q[Q_PHI] + w * tau
             net = f0 * math.sin(theta) + rest
             d1 = f0 * w * math.cos(theta)
@@ -407,10 +412,10 @@ def _next_event(
             h = min(h_up, h_dn)
             if h >= remaining:
                 return tau_end, EV_PERIOD_END
-            if h <= eps:
+            if h <= eps or tau + h == tau:  # converged, or below the resolution of tau
                 return tau + h, EV_RELEASE_UP if h_up <= h_dn else EV_RELEASE_DOWN
             tau += h
-        return tau, EV_PERIOD_END
+        return tau, EV_MARCH_FAILED
     b3, b4 = derivative_bounds(q, tau_end)
     # at tau = 0 take the state and its derivatives from the equation of motion itself:
     # the closed form carries round-off there, and the event that started this state
@@ -423,7 +428,7 @@ def _next_event(
     if v == 0.0 and abs(a) * m <= 1e-12 * (p[P_F0] + abs(fc) + abs(k * x) + p[P_FF]):
         a = 0.0  # a slip that starts from stick: the net force is exactly at the friction limit
     j = (p[P_F0] * p[P_W] * math.cos(q[Q_PHI]) - k * v - c * a) / m
-    for it in range(100_000):
+    for it in range(MAX_MARCH_STEPS):
         if it > 0:
             x, v, a, j = evaluate(q, slip, tau)
         remaining = tau_end - tau
@@ -454,23 +459,112 @@ def _next_event(
                 code = EV_LEAVE_TENSION
         if code == EV_PERIOD_END:
             return tau_end, EV_PERIOD_END
-        if best <= eps:
+        if best <= eps or tau + best == tau:  # converged, or below the resolution of tau
             return tau + best, code
         tau += best
-    return tau, EV_PERIOD_END
+    return tau, EV_MARCH_FAILED
 
 
 @njit(cache=True)
-def _segment_energy(
-    p: np.ndarray, q: np.ndarray, slip: int, duration: float, t_scale: float
+def _moment(z: complex, n: int) -> complex:
+    """E_n(z) = integral over 0 <= u <= 1 of u^n exp(z u) du, n = 0, 1, 2, without cancellation."""
+    if abs(z) < 1.0:
+        total = 0.0 + 0.0j
+        term = 1.0 + 0.0j  # z^k / k!
+        for k in range(30):
+            total += term / (k + n + 1)
+            term = term * z / (k + 1)
+            if abs(term) < 1e-18:
+                break
+        return total
+    ez = cmath.exp(z)
+    if n == 0:
+        return (ez - 1.0) / z
+    if n == 1:
+        return (ez * (z - 1.0) + 1.0) / (z * z)
+    return (ez * (z * z - 2.0 * z + 2.0) - 2.0) / (z * z * z)
+
+
+@njit(cache=True)
+def _velocity_terms(
+    q: np.ndarray, slip: int, rates: np.ndarray, consts: np.ndarray, slopes: np.ndarray
+) -> tuple[int, float]:
+    """Write x'(tau) = sum_j (consts_j + slopes_j tau) exp(rates_j tau); return (terms, size).
+
+    ``size`` is the largest coefficient magnitude, to judge cancellation between terms.
+    """
+    k = q[Q_K]
+    m = q[Q_M]
+    alpha = q[Q_ALPHA]
+    d2 = q[Q_D2]
+    root = q[Q_ROOT]
+    xh0 = q[Q_XH]
+    vh0 = q[Q_VH]
+    g = alpha * vh0 - (k / m) * xh0  # x_h'' at tau = 0
+    n = 0
+    if d2 < 0.0:
+        c1 = 0.5 * vh0 + g / (2.0j * root)
+        rates[0] = complex(alpha, root)
+        consts[0] = c1
+        slopes[0] = 0.0
+        rates[1] = complex(alpha, -root)
+        consts[1] = c1.conjugate()
+        slopes[1] = 0.0
+        n = 2
+    elif d2 > 0.0:
+        rates[0] = alpha + root
+        consts[0] = 0.5 * vh0 + g / (2.0 * root)
+        slopes[0] = 0.0
+        rates[1] = alpha - root
+        consts[1] = 0.5 * vh0 - g / (2.0 * root)
+        slopes[1] = 0.0
+        n = 2
+    else:
+        rates[0] = alpha
+        consts[0] = vh0
+        slopes[0] = g
+        n = 1
+    w = q[Q_W]
+    e_phi = cmath.exp(1j * q[Q_PHI])
+    if q[Q_SECULAR] == 0.0:
+        cp = 0.5 * w * complex(q[Q_A], q[Q_B]) * e_phi
+        sp = 0.0j
+    else:
+        cp = 0.5 * q[Q_SEC] * e_phi
+        sp = 0.5j * q[Q_SEC] * w * e_phi
+    rates[n] = 1j * w
+    consts[n] = cp
+    slopes[n] = sp
+    rates[n + 1] = -1j * w
+    consts[n + 1] = cp.conjugate()
+    slopes[n + 1] = sp.conjugate()
+    n += 2
+    kind = q[Q_CONST_KIND]
+    if kind == 1.0:
+        rates[n] = 0.0
+        consts[n] = q[Q_FC] / q[Q_C]
+        slopes[n] = 0.0
+        n += 1
+    elif kind == 2.0:
+        rates[n] = 0.0
+        consts[n] = 0.0
+        slopes[n] = q[Q_FC] / m
+        n += 1
+    size = 0.0
+    for j in range(n):
+        size = max(size, abs(consts[j]))
+    return n, size
+
+
+@njit(cache=True)
+def _segment_energy_quadrature(
+    p: np.ndarray, q: np.ndarray, slip: int, duration: float, scale: float
 ) -> tuple[float, float]:
-    """Work of the excitation and viscous loss over one state, by Gauss-Legendre quadrature."""
-    if slip == 0 or duration <= 0.0:
-        return 0.0, 0.0
+    """Work of the excitation and viscous loss over one state, Gauss-Legendre on scale / 8."""
     f0 = p[P_F0]
     w = p[P_W]
     c = p[P_DAMP]
-    pieces = max(1, math.ceil(duration / (t_scale / 8.0)))
+    pieces = max(1, math.ceil(duration / (scale / 8.0)))
     h = duration / pieces
     work = 0.0
     viscous = 0.0
@@ -483,6 +577,58 @@ def _segment_energy(
             work += weight * f0 * math.sin(q[Q_PHI] + w * tau) * v
             viscous += weight * c * v * v
     return work, viscous
+
+
+@njit(cache=True)
+def _segment_energy(
+    p: np.ndarray, q: np.ndarray, slip: int, duration: float, scratch: np.ndarray
+) -> tuple[float, float]:
+    """Work of the excitation and viscous loss over one state, in closed form.
+
+    x'(tau) is a sum of (a + b tau) exp(s tau) terms (homogeneous, forced and
+    constant parts), and so is F0 sin(phi + w tau); every product integrates to
+    tau^n exp(s tau) moments (``_moment``). Near-critical damping, where the
+    exponential terms cancel each other, falls back to quadrature on the state's
+    own time scale. ``scratch`` is a (3, 6) complex work array.
+    """
+    if slip == 0 or duration <= 0.0:
+        return 0.0, 0.0
+    rates = scratch[0]
+    consts = scratch[1]
+    slopes = scratch[2]
+    n, size = _velocity_terms(q, slip, rates, consts, slopes)
+    _, v_end, _, _ = evaluate(q, slip, duration)
+    typical = abs(q[Q_V0]) + abs(v_end) + q[Q_W] * math.hypot(q[Q_A], q[Q_B])
+    if size > 1e4 * typical:
+        # the terms cancel: integrate numerically over the state's own time scale
+        scale = 2.0 * math.pi / q[Q_W]
+        if q[Q_ROOT] > 0.0:
+            scale = min(scale, 2.0 * math.pi / q[Q_ROOT])
+        if q[Q_ALPHA] < 0.0:
+            scale = min(scale, -2.0 * math.pi / q[Q_ALPHA])
+        return _segment_energy_quadrature(p, q, slip, duration, scale)
+    f0 = p[P_F0]
+    w = p[P_W]
+    e_phi = cmath.exp(1j * q[Q_PHI])
+    force_plus = f0 * e_phi / 2.0j  # F0 sin(phi + w tau) = force_plus e^{i w tau} + conj
+    work = 0.0j
+    viscous = 0.0j
+    t = duration
+    for j in range(n):
+        for sign in (1.0, -1.0):
+            fk = force_plus if sign > 0.0 else force_plus.conjugate()
+            z = (rates[j] + sign * 1j * w) * t
+            work += fk * (consts[j] * t * _moment(z, 0) + slopes[j] * t * t * _moment(z, 1))
+        if p[P_DAMP] == 0.0:
+            continue
+        for i in range(n):
+            z = (rates[i] + rates[j]) * t
+            viscous += (
+                consts[i] * consts[j] * t * _moment(z, 0)
+                + (consts[i] * slopes[j] + slopes[i] * consts[j]) * t * t * _moment(z, 1)
+                + slopes[i] * slopes[j] * t * t * t * _moment(z, 2)
+            )
+    return work.real, p[P_DAMP] * viscous.real
 
 
 @njit(cache=True)
@@ -508,6 +654,43 @@ def _store(state: np.ndarray, x: float, v: float, region: int, slip: int) -> Non
 
 
 @njit(cache=True)
+def apply_event(
+    p: np.ndarray, code: int, x: float, v: float, region: int, slip: int, phi: float
+) -> tuple[float, float, int, int, float, int]:
+    """The state just after event ``code`` at forcing phase ``phi`` (MODEL.md sec. 2 event rules).
+
+    Returns (x, v, region, slip, approach speed, side): side is +1 / -1 for an
+    impact into compression / tension (x' -> e x'), 0 for any other event.
+    """
+    speed = 0.0
+    side = 0
+    if code in (EV_ENTER_COMPRESSION, EV_ENTER_TENSION):
+        side = 1 if code == EV_ENTER_COMPRESSION else -1
+        x = p[P_GC] if side == 1 else -p[P_GT]
+        speed = abs(v)
+        v = p[P_E] * v
+        region = side
+        if v == 0.0:
+            slip = decide_slip(p, region, x, phi)
+    elif code == EV_LEAVE_COMPRESSION:
+        x = p[P_GC]
+        region = FREE
+    elif code == EV_LEAVE_TENSION:
+        x = -p[P_GT]
+        region = FREE
+    elif code == EV_VELOCITY_ZERO:
+        v = 0.0
+        slip = decide_slip(p, region, x, phi)
+    elif code == EV_RELEASE_UP:
+        slip = 1
+        v = 0.0
+    elif code == EV_RELEASE_DOWN:
+        slip = -1
+        v = 0.0
+    return x, v, region, slip, speed, side
+
+
+@njit(cache=True)
 def advance(
     p: np.ndarray,
     state: np.ndarray,
@@ -530,8 +713,7 @@ def advance(
     tf = p[P_TF]
     w = p[P_W]
     m = p[P_MASS]
-    e = p[P_E]
-    beta = 0.5 * (1.0 - e * e)
+    beta = 0.5 * (1.0 - p[P_E] ** 2)
     t_scale = time_scale(p)
     x = state[S_X]
     v = state[S_V]
@@ -540,6 +722,7 @@ def advance(
     n_seg = 0
     n_imp = 0
     n_events = 0
+    scratch = np.zeros((3, 6), dtype=np.complex128)
     for period in range(n_periods):
         t_end = t_last if period == n_periods - 1 else tf
         t_in = 0.0
@@ -549,6 +732,9 @@ def advance(
             phi = w * t_in
             q = phase_coefficients(p, region, slip, x, v, phi)
             tau, code = _next_event(p, q, region, slip, t_end - t_in, t_scale)
+            if code == EV_MARCH_FAILED:
+                _store(state, x, v, region, slip)
+                return n_seg, n_imp, n_events, STATUS_MARCH_FAILED
             if code == EV_PERIOD_END:
                 tau = t_end - t_in
             x1, v1, _, _ = evaluate(q, slip, tau)
@@ -566,7 +752,7 @@ def advance(
                 row[SEG_V0] = v
                 row[SEG_PHI] = phi
                 n_seg += 1
-                work, viscous = _segment_energy(p, q, slip, tau, t_scale)
+                work, viscous = _segment_energy(p, q, slip, tau, scratch)
                 ledger[period, L_INPUT] += work
                 ledger[period, L_VISCOUS] += viscous
             if slip != 0 and friction_active(p, region):
@@ -583,10 +769,8 @@ def advance(
                 _store(state, x, v, region, slip)
                 return n_seg, n_imp, n_events, STATUS_TOO_MANY_EVENTS
             phi = w * t_in
-            if code in (EV_ENTER_COMPRESSION, EV_ENTER_TENSION):
-                side = 1 if code == EV_ENTER_COMPRESSION else -1
-                x = p[P_GC] if side == 1 else -p[P_GT]
-                speed = abs(v)
+            x, v, region, slip, speed, side = apply_event(p, code, x, v, region, slip, phi)
+            if side != 0:
                 ledger[period, L_IMPACT] += beta * m * speed * speed
                 if record and n_imp < impacts.shape[0]:
                     impacts[n_imp, 0] = period
@@ -594,25 +778,6 @@ def advance(
                     impacts[n_imp, 2] = speed
                     impacts[n_imp, 3] = side
                     n_imp += 1
-                v = e * v
-                region = side
-                if v == 0.0:
-                    slip = decide_slip(p, region, x, phi)
-            elif code == EV_LEAVE_COMPRESSION:
-                x = p[P_GC]
-                region = FREE
-            elif code == EV_LEAVE_TENSION:
-                x = -p[P_GT]
-                region = FREE
-            elif code == EV_VELOCITY_ZERO:
-                v = 0.0
-                slip = decide_slip(p, region, x, phi)
-            elif code == EV_RELEASE_UP:
-                slip = 1
-                v = 0.0
-            elif code == EV_RELEASE_DOWN:
-                slip = -1
-                v = 0.0
         _store(strobe[period], x, v, region, slip)
         # the next period starts at forcing phase 0 with the same state
     _store(state, x, v, region, slip)

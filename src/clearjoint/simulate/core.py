@@ -26,6 +26,7 @@ from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.joint import Friction, Joint, Pin
 from clearjoint.simulate import _kernel as kn
+from clearjoint.simulate._shooting import newton_orbit, start_state
 from clearjoint.stiffness import viscous_coefficient
 from clearjoint.units import to_si
 
@@ -434,6 +435,12 @@ def _run(p: FloatArray, state: FloatArray, n_periods: int, t_last: float, record
                 f"more than {kn.MAX_EVENTS_PER_PERIOD} events in one forcing period "
                 "(chattering); add damping or a restitution below 1"
             )
+        if status == kn.STATUS_MARCH_FAILED:
+            raise SimulationError(
+                f"an event was not reached in {kn.MAX_MARCH_STEPS} certified steps at "
+                f"x = {start[kn.S_X]!r} m (a near-grazing state the marching cannot resolve); "
+                "change omega or the force amplitude slightly"
+            )
         state[:] = start
         return _Run(segments[:n_seg], impacts[:n_imp], strobe, ledger, events)
 
@@ -618,6 +625,41 @@ def _periodic_multiple(
     return 0
 
 
+def _smallest_multiple(
+    p: FloatArray,
+    state: FloatArray,
+    multiple: int,
+    strobe: FloatArray,
+    tolerance: float,
+    x_scale: float,
+    v_scale: float,
+) -> int:
+    """Test each multiple below the detected one against the orbit itself.
+
+    A transient that converges with alternating sign (a multiplier near -1, or
+    a complex pair whose angle is near 2 pi/n) repeats sooner over n periods
+    than over one. For each d < ``multiple``, Newton's method on the exact
+    d-period map (``_shooting.newton_orbit``) from the current state looks for a
+    d-periodic orbit; it is accepted when it is stable and the recent states
+    approach it (their distance to it shrinks), and ``state`` is moved onto it.
+    Returns the smallest multiple that holds.
+    """
+    scale = np.array([x_scale, v_scale])
+    for d in range(1, multiple):
+        found = newton_orbit(p, state[:2], d, scale, tolerance=tolerance)
+        if found is None:
+            continue
+        z, shot, _ = found
+        if np.max(np.abs(np.linalg.eigvals(shot.monodromy))) >= 1.0:
+            continue  # an unstable d-orbit (e.g. past a period doubling): not where we converge
+        dist = np.max(np.abs(strobe[:, :2] - z) / scale, axis=1)
+        if dist[-1] > 10.0 * tolerance and dist[-1] > 0.9 * float(np.max(dist[:-multiple])):
+            continue  # the states circle the d-orbit instead of approaching it
+        start_state(p, float(z[0]), float(z[1]), state)
+        return d
+    return multiple
+
+
 def steady_state(
     joint: Joint,
     force_amplitude: float,
@@ -701,6 +743,22 @@ def steady_state(
             else "raise max_periods, or the response may be chaotic"
         )
         raise SimulationError(f"no periodic orbit within {max_periods} forcing periods: {hint}")
+    if multiple > 1:
+        multiple = _smallest_multiple(p, state, multiple, strobe, tol, x_scale, v_scale)
+    return _orbit_from(p, joint, state, multiple, done, pin, mu_c, samples_per_period)
+
+
+def _orbit_from(
+    p: FloatArray,
+    joint: Joint,
+    state: FloatArray,
+    multiple: int,
+    periods_to_converge: int,
+    pin: Pin | None,
+    mu_c: float,
+    samples_per_period: int,
+) -> SteadyState:
+    """The SteadyState of the orbit of ``multiple`` periods that starts at ``state`` (phase 0)."""
     start = state.copy()
     run = _run(p, state, multiple, p[kn.P_TF], record=True)
     duration = multiple * p[kn.P_TF]
@@ -712,7 +770,7 @@ def steady_state(
         **fields,  # type: ignore[arg-type]
         period_multiple=multiple,
         period=duration,
-        periods_to_converge=done,
+        periods_to_converge=periods_to_converge,
         initial_state=(
             float(start[0]),
             float(start[1]),

@@ -1,0 +1,303 @@
+"""Pseudo-arclength continuation of the solutions of R(u, lambda) = 0 (MODEL.md sec. 5.1).
+
+Generic over the residual: periodic orbits by shooting (``clearjoint.periodic``)
+use it, and so can harmonic balance. A branch is followed in scaled coordinates
+y = (u / u_scale, lambda / lambda_scale):
+
+- tangent t: the null vector of [dR/du, dR/dlambda], oriented along the last one;
+- predictor y + h t + (h^2 / 2) dt/ds, the curvature taken from the last step;
+- corrector: Newton on R(y) = 0 together with the arclength condition
+  t . (y - y_predicted) = 0, so that it passes folds where dR/du is singular;
+- step control from the corrector's iteration count: grow after an easy
+  correction, shrink after a hard one, halve and retry after a failure or a
+  turn of the tangent sharper than ``max_turn`` (that is how the corrector is kept
+  from jumping to another branch near a fold). At the smallest step a sharp turn
+  is accepted: the branch has a kink there (grazing), which it must cross.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint._jit import njit  # numba.njit that survives a read-only install
+from clearjoint.errors import ClearjointError, ParameterError
+
+__all__ = [
+    "Branch",
+    "ContinuationError",
+    "ContinuationSettings",
+    "Residual",
+    "continue_branch",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: residual(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data for the caller)
+Residual = Callable[[FloatArray, float], tuple[FloatArray, FloatArray, FloatArray, Any]]
+
+
+class ContinuationError(ClearjointError, RuntimeError):
+    """The continuation could not start or could not go on."""
+
+
+@dataclass(frozen=True)
+class ContinuationSettings:
+    """Step control of the pseudo-arclength continuation (lengths in scaled coordinates).
+
+    Attributes
+    ----------
+    step, min_step, max_step : float
+        First, smallest and largest arclength step.
+    max_points : int
+        Points on the branch at most.
+    tolerance : float
+        Converged when every scaled residual component is below it.
+    max_iterations : int
+        Corrector iterations per attempt.
+    easy, hard : int
+        The step grows by ``growth`` after at most ``easy`` iterations and shrinks
+        by ``1 / growth`` after at least ``hard``.
+    growth : float
+    max_turn : float
+        Largest angle between successive tangents, rad, before the step is cut.
+    chord_parameter : bool
+        Ask for dR/dlambda only at the first corrector iteration of each step and
+        keep it (a chord in that one column): the residual is then called as
+        ``residual(u, lam, False)`` after the first iteration and may return None
+        for dR/dlambda. Worth it when that derivative costs a second evaluation.
+    """
+
+    step: float = 0.01
+    min_step: float = 1e-6
+    max_step: float = 0.05
+    max_points: int = 2000
+    tolerance: float = 1e-11
+    max_iterations: int = 8
+    easy: int = 2
+    hard: int = 5
+    growth: float = 1.5
+    max_turn: float = 0.3
+    chord_parameter: bool = False
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.min_step <= self.step <= self.max_step:
+            raise ParameterError(
+                "the steps must satisfy 0 < min_step <= step <= max_step, got "
+                f"{self.min_step!r}, {self.step!r}, {self.max_step!r}"
+            )
+        if self.max_points < 2:
+            raise ParameterError(f"max_points must be >= 2, got {self.max_points!r}")
+
+
+@dataclass(frozen=True)
+class Branch:
+    """A followed branch: unknowns, parameter, tangents and the residual's data per point.
+
+    Attributes
+    ----------
+    u : (n, d) ndarray
+        Unknowns at each point.
+    lam : (n,) ndarray
+        Continuation parameter at each point.
+    tangent : (n, d + 1) ndarray
+        Unit tangents in scaled coordinates (last component: the parameter's).
+    iterations : (n,) ndarray of int
+        Corrector iterations each point took.
+    data : list
+        What the residual returned as data at each converged point.
+    reason : str
+        Why it stopped: "reached", "max_points", "step too small", "left the range".
+    """
+
+    u: FloatArray
+    lam: FloatArray
+    tangent: FloatArray
+    iterations: NDArray[np.int64]
+    data: list[Any] = field(repr=False)
+    reason: str
+
+
+@njit(cache=True)
+def _solve(a: FloatArray, b: FloatArray) -> FloatArray:
+    """np.linalg.solve compiled: the systems are tiny and called thousands of times."""
+    x: FloatArray = np.asarray(np.linalg.solve(a, b), dtype=np.float64)
+    return x
+
+
+def _tangent(a: FloatArray, previous: FloatArray) -> FloatArray:
+    """Unit null vector of the (d, d+1) matrix ``a``, oriented along ``previous``."""
+    system = np.vstack((a, previous))
+    rhs = np.zeros(a.shape[1])
+    rhs[-1] = 1.0
+    try:
+        t = np.linalg.solve(system, rhs)
+    except np.linalg.LinAlgError:
+        _, _, vt = np.linalg.svd(a)
+        t = vt[-1]
+    unit: FloatArray = np.asarray(t / np.linalg.norm(t), dtype=np.float64)
+    return unit if float(unit @ previous) >= 0.0 else np.asarray(-unit, dtype=np.float64)
+
+
+def _correct(
+    residual: Residual,
+    y0: FloatArray,
+    tangent: FloatArray,
+    scale: FloatArray,
+    settings: ContinuationSettings,
+    fixed_lambda: bool,
+) -> tuple[FloatArray, FloatArray, Any, int] | None:
+    """Newton on [R(y); t . (y - y0)] = 0 (or on R at fixed lambda); None if it fails."""
+    y = y0.copy()
+    d = y.size - 1
+    u_scale = scale[:d]
+    system = np.empty((d + 1, d + 1))
+    if fixed_lambda:
+        system[d, :d] = 0.0
+        system[d, d] = 1.0
+    else:
+        system[d] = tangent
+    rhs = np.empty(d + 1)
+    for iteration in range(settings.max_iterations + 1):
+        try:
+            if settings.chord_parameter and iteration > 0:
+                r, jac_u, _, data = residual(  # type: ignore[call-arg]
+                    y[:d] * u_scale, float(y[d] * scale[d]), False
+                )
+            else:
+                r, jac_u, r_lam, data = residual(y[:d] * u_scale, float(y[d] * scale[d]))
+                system[:d, d] = r_lam * (scale[d] / u_scale)
+        except ClearjointError:
+            return None
+        # rows scaled by the unknowns' sizes, columns by the scaled unknowns
+        system[:d, :d] = jac_u * (u_scale / u_scale[:, None])
+        rs = r / u_scale
+        size = float(np.max(np.abs(rs)))
+        if not math.isfinite(size) or not math.isfinite(float(system.sum())):
+            return None
+        if size <= settings.tolerance:
+            return y, system[:d].copy(), data, iteration
+        if iteration == settings.max_iterations:
+            return None
+        rhs[:d] = -rs
+        rhs[d] = 0.0 if fixed_lambda else -float(tangent @ (y - y0))
+        try:
+            dy = _solve(system, rhs)
+        except np.linalg.LinAlgError:
+            return None
+        y = y + dy
+    return None
+
+
+def continue_branch(
+    residual: Residual,
+    u0: FloatArray,
+    lam0: float,
+    lam_stop: float,
+    *,
+    u_scale: FloatArray,
+    lam_scale: float,
+    settings: ContinuationSettings | None = None,
+) -> Branch:
+    """Follow R(u, lambda) = 0 from (u0, lam0) until lambda reaches ``lam_stop``.
+
+    Parameters
+    ----------
+    residual : callable
+        residual(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data).
+    u0 : (d,) ndarray
+        A solution, or a guess close to one, at ``lam0`` (corrected there first).
+    lam0, lam_stop : float
+        Start and end of the parameter range.
+    u_scale : (d,) ndarray
+        Typical sizes of the unknowns (the residual is scaled by them too).
+    lam_scale : float
+        Typical size of a change of the parameter.
+    settings : ContinuationSettings, optional
+
+    Returns
+    -------
+    Branch
+
+    Raises
+    ------
+    ContinuationError
+        No solution at ``lam0`` near ``u0``.
+    """
+    settings = settings or ContinuationSettings()
+    u0 = np.asarray(u0, dtype=np.float64)
+    d = u0.size
+    scale = np.concatenate((np.asarray(u_scale, dtype=np.float64), [float(lam_scale)]))
+    direction = 1.0 if lam_stop > lam0 else -1.0
+    y = np.concatenate((u0, [lam0])) / scale
+    t = np.zeros(d + 1)
+    t[-1] = direction
+    first = _correct(residual, y, t, scale, settings, fixed_lambda=True)
+    if first is None:
+        raise ContinuationError(
+            f"no solution near the start at parameter {lam0!r}; give a better starting guess"
+        )
+    y, a, data, its = first
+    t = _tangent(a, t)
+    ys, ts, datas, iters = [y], [t], [data], [its]
+    h = settings.step
+    stop = lam_stop / scale[-1]
+    reason = "max_points"
+    curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
+    while len(ys) < settings.max_points:
+        predicted = y + h * t + 0.5 * h * h * curvature
+        attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
+        if attempt is not None:
+            y_new, a_new, data_new, its = attempt
+            t_new = _tangent(a_new, t)
+            turn = math.acos(min(1.0, max(-1.0, float(t_new @ t))))
+            if turn > settings.max_turn and h > settings.min_step:
+                attempt = None
+        if attempt is None:
+            if h <= settings.min_step:
+                reason = "step too small"
+                break
+            h = max(0.5 * h, settings.min_step)
+            continue
+        if direction * (y_new[-1] - stop) >= 0.0:
+            # passed the end: land exactly on it, from the last point's side
+            frac = (stop - y[-1]) / (y_new[-1] - y[-1])
+            guess = y + frac * (y_new - y)
+            guess[-1] = stop
+            end = _correct(residual, guess, t, scale, settings, fixed_lambda=True)
+            if end is not None:
+                y_end, a_end, data_end, its_end = end
+                ys.append(y_end)
+                ts.append(_tangent(a_end, t_new))
+                datas.append(data_end)
+                iters.append(its_end)
+            reason = "reached"
+            break
+        step_length = float(np.linalg.norm(y_new - y))
+        curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
+        y, t = y_new, t_new
+        ys.append(y)
+        ts.append(t)
+        datas.append(data_new)
+        iters.append(its)
+        if direction * (y[-1] * scale[-1] - lam0) < -abs(lam_scale):
+            reason = "left the range"
+            break
+        if its <= settings.easy:
+            h = min(h * settings.growth, settings.max_step)
+        elif its >= settings.hard:
+            h = max(h / settings.growth, settings.min_step)
+    points = np.array(ys) * scale
+    return Branch(
+        u=points[:, :d],
+        lam=points[:, d],
+        tangent=np.array(ts),
+        iterations=np.array(iters, dtype=np.int64),
+        data=datas,
+        reason=reason,
+    )

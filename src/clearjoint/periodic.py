@@ -1,0 +1,623 @@
+"""Exact periodic orbits, their stability, and whole frequency-response curves (MODEL.md sec. 5.1).
+
+A periodic orbit of p forcing periods is a fixed point of the exact stroboscopic
+map, P_p(z0) = z0 with z0 = (x, x') at forcing phase 0 (the force is
+F0 sin(omega t)). It is found by Newton's method with the *exact* monodromy
+matrix M = dP_p/dz0, built from the closed-form flow of each state and the
+saltation matrix of each event (``simulate._shooting``). The Floquet multipliers
+are eig(M); the orbit is stable when every multiplier has modulus < 1.
+
+``frequency_response`` follows the period-1 orbit with pseudo-arclength
+continuation (``clearjoint.continuation``) in omega (or in F0), stable and
+unstable alike, through folds. The derivative of the map in the parameter is
+a finite difference of the exact map; the one in the state is exact. Events:
+
+- fold: the parameter component of the tangent changes sign (a multiplier
+  passes +1); it is placed at the bracketing point where the parameter is extreme;
+- period doubling: 1 + tr M + det M (the characteristic polynomial at -1)
+  changes sign (a multiplier passes -1); a period-2 branch is born there and is
+  not followed;
+- grazing: the orbit starts or stops touching a gap edge (x_max - g_c or
+  -g_t - x_min changes sign); the branch has a kink there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from clearjoint import _checks
+from clearjoint.continuation import ContinuationSettings, continue_branch
+from clearjoint.errors import ParameterError
+from clearjoint.joint import Friction, Joint
+from clearjoint.simulate import _kernel as kn
+from clearjoint.simulate._shooting import (
+    N_RES,
+    R_DLAM,
+    R_JAC,
+    R_RES,
+    R_XMAX,
+    R_XMIN,
+    Shot,
+    map_residual,
+    newton_orbit,
+    start_state,
+)
+from clearjoint.simulate.core import (
+    SimulationError,
+    SteadyState,
+    _initial_state,
+    _orbit_from,
+    _parameters,
+    _run,
+)
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.axes import Axes
+
+__all__ = [
+    "FrequencyResponse",
+    "PeriodicOrbit",
+    "ResponseEvent",
+    "frequency_response",
+    "periodic_orbit",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: Transient periods run before Newton when no starting point is given, per attempt.
+_TRANSIENT_PERIODS = 32
+_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True)
+class PeriodicOrbit:
+    """An exact periodic orbit of ``period_multiple`` forcing periods, with its stability.
+
+    Attributes
+    ----------
+    initial_state : tuple of float
+        (x0, x0') at forcing phase 0, m and m/s.
+    cycle : SteadyState
+        The orbit sampled, with its stages and energy ledger.
+    monodromy : (2, 2) ndarray
+        dP_p/dz0, exact (closed-form flows and saltation matrices).
+    multipliers : (2,) complex ndarray
+        Floquet multipliers, eig(monodromy).
+    stable : bool
+        Every multiplier has modulus < 1.
+    omega, force_amplitude : float
+        rad/s and N.
+    period_multiple : int
+    newton_iterations : int
+    """
+
+    initial_state: tuple[float, float]
+    cycle: SteadyState = field(repr=False)
+    monodromy: FloatArray = field(repr=False)
+    multipliers: NDArray[np.complex128] = field(repr=False)
+    stable: bool
+    omega: float
+    force_amplitude: float
+    period_multiple: int = 1
+    newton_iterations: int = 0
+
+    @property
+    def x_max(self) -> float:
+        """Largest x along the orbit, m."""
+        return self.cycle.x_max
+
+    @property
+    def x_min(self) -> float:
+        """Smallest x along the orbit, m."""
+        return self.cycle.x_min
+
+    @property
+    def amplitude(self) -> float:
+        """X = (x_max - x_min) / 2, m."""
+        return self.cycle.amplitude
+
+    def __repr__(self) -> str:
+        mu = float(np.max(np.abs(self.multipliers)))
+        return (
+            f"PeriodicOrbit(period-{self.period_multiple}, {self.omega / (2 * math.pi):.6g} Hz, "
+            f"F0={self.force_amplitude:.4g} N, X={self.amplitude:.4g} m, "
+            f"{'stable' if self.stable else 'unstable'}, max|mu|={mu:.4g})"
+        )
+
+
+def _scales(joint: Joint, p: FloatArray, z: FloatArray) -> FloatArray:
+    x_scale = max(joint.clearance, abs(float(z[0])), 1e-300)
+    v_scale = max(abs(float(z[1])), x_scale * p[kn.P_W])
+    return np.array([x_scale, v_scale])
+
+
+def periodic_orbit(
+    joint: Joint,
+    force_amplitude: float,
+    omega: float,
+    *,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+    period_multiple: int = 1,
+    initial: ArrayLike | None = None,
+) -> PeriodicOrbit:
+    """Return the exact periodic orbit by Newton's method on the exact map (MODEL.md sec. 5.1).
+
+    Parameters
+    ----------
+    joint : Joint
+    force_amplitude : float
+        F0 > 0, N.
+    omega : float
+        Forcing circular frequency > 0, rad/s.
+    damping_ratio, friction, restitution
+        As for :func:`clearjoint.simulate.steady_state`.
+    period_multiple : int
+        p >= 1: the orbit closes after p forcing periods.
+    initial : (2,) array_like, optional
+        (x0, x0') at forcing phase 0 to start Newton from; by default a short
+        transient from rest provides it (and more transient if Newton fails).
+
+    Returns
+    -------
+    PeriodicOrbit
+
+    Raises
+    ------
+    SimulationError
+        Newton's method found no orbit.
+    """
+    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    if isinstance(period_multiple, bool) or not isinstance(period_multiple, int | np.integer):
+        raise ParameterError(f"period_multiple must be an integer >= 1, got {period_multiple!r}")
+    n = int(period_multiple)
+    if n < 1:
+        raise ParameterError(f"period_multiple must be an integer >= 1, got {period_multiple!r}")
+    state = _initial_state(p, initial)
+    attempts = 1 if initial is not None else 6
+    for attempt in range(attempts):
+        if initial is None:
+            _run(p, state, _TRANSIENT_PERIODS * 2**attempt, p[kn.P_TF], record=False)
+        found = newton_orbit(p, state[:2], n, _scales(joint, p, state[:2]), tolerance=_TOLERANCE)
+        if found is not None:
+            z, shot, iterations = found
+            return _orbit(joint, p, z, shot, n, iterations)
+    raise SimulationError(
+        f"Newton's method found no period-{n} orbit at omega = {omega!r} rad/s; "
+        "give initial=(x0, v0) near the orbit, or another period_multiple"
+    )
+
+
+def _orbit(
+    joint: Joint, p: FloatArray, z: FloatArray, shot: Shot, n: int, iterations: int
+) -> PeriodicOrbit:
+    state = np.zeros(4)
+    start_state(p, float(z[0]), float(z[1]), state)
+    cycle = _orbit_from(p, joint, state, n, 0, None, 0.0, 256)
+    mu = np.linalg.eigvals(shot.monodromy).astype(np.complex128)
+    return PeriodicOrbit(
+        initial_state=(float(z[0]), float(z[1])),
+        cycle=cycle,
+        monodromy=shot.monodromy,
+        multipliers=mu,
+        stable=bool(np.max(np.abs(mu)) < 1.0),
+        omega=float(p[kn.P_W]),
+        force_amplitude=float(p[kn.P_F0]),
+        period_multiple=n,
+        newton_iterations=iterations,
+    )
+
+
+# ---- frequency response ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ResponseEvent:
+    """A fold, period doubling or grazing found along a frequency-response curve.
+
+    Attributes
+    ----------
+    kind : {"fold", "period_doubling", "grazing"}
+    omega : float
+        rad/s.
+    force_amplitude : float
+        N.
+    amplitude : float
+        X of the period-1 orbit there, m.
+    note : str
+        What it means (e.g. that a period-2 branch is born there).
+    """
+
+    kind: str
+    omega: float
+    force_amplitude: float
+    amplitude: float
+    note: str = ""
+
+    def __repr__(self) -> str:
+        return (
+            f"ResponseEvent({self.kind}, {self.omega / (2 * math.pi):.6g} Hz, "
+            f"F0={self.force_amplitude:.4g} N, X={self.amplitude:.4g} m)"
+        )
+
+
+@dataclass(frozen=True)
+class FrequencyResponse:
+    """A whole frequency-response curve of exact period-1 orbits, stable and unstable.
+
+    Attributes
+    ----------
+    omega, force_amplitude : (n,) ndarray
+        rad/s and N at each point (one of them is constant).
+    x_max, x_min, amplitude : (n,) ndarray
+        Extremes and X = (x_max - x_min)/2 of each orbit, m.
+    stable : (n,) ndarray of bool
+    multipliers : (n, 2) complex ndarray
+        Floquet multipliers of each orbit.
+    initial_state : (n, 2) ndarray
+        (x, x') at forcing phase 0, m and m/s.
+    events : list of ResponseEvent
+    parameter : {"omega", "force"}
+    stop_reason : str
+        Why the continuation stopped ("reached" when it got to the end).
+    """
+
+    omega: FloatArray
+    force_amplitude: FloatArray
+    x_max: FloatArray
+    x_min: FloatArray
+    amplitude: FloatArray
+    stable: NDArray[np.bool_]
+    multipliers: NDArray[np.complex128]
+    initial_state: FloatArray
+    events: list[ResponseEvent]
+    parameter: str
+    stop_reason: str
+    settings: dict[str, Any] = field(repr=False, default_factory=dict)
+
+    def __repr__(self) -> str:
+        kinds = ", ".join(
+            f"{sum(e.kind == k for e in self.events)} {k}"
+            for k in ("fold", "period_doubling", "grazing")
+        )
+        f = self.omega / (2 * math.pi)
+        return (
+            f"FrequencyResponse({self.omega.size} points, {f.min():.4g}-{f.max():.4g} Hz, "
+            f"F0 {self.force_amplitude.min():.4g}-{self.force_amplitude.max():.4g} N, "
+            f"max X={self.amplitude.max():.4g} m, {int(np.sum(~self.stable))} unstable, "
+            f"{kinds}, {self.stop_reason})"
+        )
+
+    def cycle(self, index: int) -> SteadyState:
+        """The orbit at point ``index`` as a SteadyState (stages, energy ledger), re-run exactly."""
+        s = self.settings
+        p = _parameters(
+            s["joint"],
+            float(self.force_amplitude[index]),
+            float(self.omega[index]),
+            s["damping_ratio"],
+            s["friction"],
+            s["restitution"],
+        )
+        state = np.zeros(4)
+        start_state(
+            p, float(self.initial_state[index, 0]), float(self.initial_state[index, 1]), state
+        )
+        return _orbit_from(p, s["joint"], state, 1, 0, None, 0.0, 64)
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+        """
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6.4, 4.0))
+        if self.parameter == "force":
+            xs, label = self.force_amplitude, "force amplitude F0 (N)"
+        else:
+            xs, label = self.omega / (2 * math.pi), "frequency (Hz)"
+        ys = self.amplitude * 1e3
+        start = 0
+        for i in range(1, self.stable.size + 1):
+            if i == self.stable.size or self.stable[i] != self.stable[start]:
+                end = min(i + 1, self.stable.size)
+                stable = bool(self.stable[start])
+                ax.plot(
+                    xs[start:end],
+                    ys[start:end],
+                    "-" if stable else "--",
+                    color="C0" if stable else "C3",
+                    lw=1.5,
+                )
+                start = i
+        ax.plot([], [], "-", color="C0", label="stable")
+        ax.plot([], [], "--", color="C3", label="unstable")
+        markers = {"fold": ("o", "k"), "period_doubling": ("s", "C2"), "grazing": ("^", "C1")}
+        for kind, (marker, color) in markers.items():
+            chosen = [e for e in self.events if e.kind == kind]
+            if chosen:
+                ex = [
+                    e.force_amplitude if self.parameter == "force" else e.omega / (2 * math.pi)
+                    for e in chosen
+                ]
+                ey = [e.amplitude * 1e3 for e in chosen]
+                ax.plot(ex, ey, marker, color=color, ls="none", mfc="none", label=kind)
+        ax.set_xlabel(label)
+        ax.set_ylabel("amplitude X (mm)")
+        ax.legend(frameon=False, fontsize="small")
+        return ax
+
+    def to_xarray(self) -> xr.Dataset:
+        """The curve as an xarray Dataset over ``point`` (and ``event``), units in attrs."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "x_max": ("point", self.x_max, {"units": "m"}),
+                "x_min": ("point", self.x_min, {"units": "m"}),
+                "amplitude": ("point", self.amplitude, {"units": "m"}),
+                "stable": ("point", self.stable.astype(np.int8), {"units": "1 stable, 0 not"}),
+                "multiplier_real": (("point", "multiplier"), self.multipliers.real.copy()),
+                "multiplier_imag": (("point", "multiplier"), self.multipliers.imag.copy()),
+                "initial_displacement": ("point", self.initial_state[:, 0], {"units": "m"}),
+                "initial_velocity": ("point", self.initial_state[:, 1], {"units": "m/s"}),
+                "event_kind": ("event", np.array([e.kind for e in self.events], dtype=str)),
+                "event_frequency": (
+                    "event",
+                    np.array([e.omega / (2 * math.pi) for e in self.events]),
+                    {"units": "Hz"},
+                ),
+                "event_force": (
+                    "event",
+                    np.array([e.force_amplitude for e in self.events]),
+                    {"units": "N"},
+                ),
+                "event_amplitude": (
+                    "event",
+                    np.array([e.amplitude for e in self.events]),
+                    {"units": "m"},
+                ),
+            },
+            coords={
+                "omega": ("point", self.omega, {"units": "rad/s"}),
+                "frequency": ("point", self.omega / (2 * math.pi), {"units": "Hz"}),
+                "force_amplitude": ("point", self.force_amplitude, {"units": "N"}),
+            },
+            attrs={
+                "title": "clearjoint frequency response (exact periodic orbits, continuation)",
+                "parameter": self.parameter,
+                "stop_reason": self.stop_reason,
+            },
+        )
+
+
+def _map_residual(p: FloatArray, parameter: str) -> Any:
+    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
+    code = 0 if parameter == "omega" else 1
+
+    def residual(
+        u: FloatArray, lam: float, derivative: bool = True
+    ) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
+        if not lam > 0.0:
+            raise SimulationError(f"the parameter left the positive range ({lam!r})")
+        out = np.zeros(N_RES)
+        status = map_residual(p, code, float(u[0]), float(u[1]), lam, out, derivative)
+        if status != kn.STATUS_OK:
+            raise SimulationError(f"the exact map failed (kernel status {status})")
+        return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
+
+    return residual
+
+
+def frequency_response(
+    joint: Joint,
+    force_amplitude: float,
+    omega_start: float,
+    omega_stop: float | None,
+    *,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+    parameter: Literal["omega", "force"] = "omega",
+    force_stop: float | None = None,
+    max_points: int = 2000,
+) -> FrequencyResponse:
+    """Return the whole frequency-response curve of exact period-1 orbits (MODEL.md sec. 5.1).
+
+    Pseudo-arclength continuation of the periodic orbit from ``omega_start`` to
+    ``omega_stop`` (rad/s), through folds, stable and unstable branches alike,
+    with folds, period doublings and grazings reported as ``events``. With
+    ``parameter="force"`` it continues in F0 from ``force_amplitude`` to
+    ``force_stop`` (N) at the fixed ``omega_start`` (``omega_stop`` is then
+    ignored and may be None).
+
+    Parameters
+    ----------
+    joint : Joint
+    force_amplitude : float
+        F0 > 0, N (the start of the range with ``parameter="force"``).
+    omega_start, omega_stop : float
+        Forcing circular frequencies > 0, rad/s, either order.
+    damping_ratio, friction, restitution
+        As for :func:`clearjoint.simulate.steady_state`.
+    parameter : {"omega", "force"}
+    force_stop : float, optional
+        End of the force range, N (required with ``parameter="force"``).
+    max_points : int
+        Largest number of points on the curve.
+
+    Returns
+    -------
+    FrequencyResponse
+
+    Raises
+    ------
+    ParameterError
+        A range of zero width, a value that is not finite and positive, or
+        ``force_stop`` missing with ``parameter="force"``.
+    SimulationError
+        No periodic orbit at the start.
+    """
+    if parameter not in ("omega", "force"):
+        raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
+    w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
+    f0 = _checks.positive("force_amplitude", force_amplitude, unit="N")
+    if parameter == "omega":
+        if omega_stop is None:
+            raise ParameterError("omega_stop is required with parameter='omega' (rad/s)")
+        w1 = _checks.positive("omega_stop", omega_stop, unit="rad/s")
+        if w1 == w0:
+            raise ParameterError(
+                f"the omega range has zero width ({w0!r} to {w1!r} rad/s); give two values"
+            )
+        start, stop = w0, w1
+    else:
+        if force_stop is None:
+            raise ParameterError(
+                "force_stop is required with parameter='force': give the end of the force range (N)"
+            )
+        f1 = _checks.positive("force_stop", force_stop, unit="N")
+        if f1 == f0:
+            raise ParameterError(
+                f"the force range has zero width ({f0!r} to {f1!r} N); give two values"
+            )
+        start, stop = f0, f1
+    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
+        raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
+    first = periodic_orbit(
+        joint,
+        f0,
+        w0,
+        damping_ratio=damping_ratio,
+        friction=friction,
+        restitution=restitution,
+    )
+    if np.min(np.abs(first.multipliers - 1.0)) < 1e-9:
+        raise SimulationError(
+            f"the orbit at the start ({first!r}) has a multiplier of exactly 1: it is one of a "
+            "continuum of orbits (it stays in the gap with gap_stiffness = 0, or sticks), so "
+            "no single curve exists; give gap_stiffness > 0 or start where the joint is in contact"
+        )
+    p = _parameters(joint, f0, w0, damping_ratio, friction, restitution)
+    x_scale = max(joint.clearance / 2.0, first.amplitude)
+    v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
+    branch = continue_branch(
+        _map_residual(p, parameter),
+        np.array(first.initial_state),
+        start,
+        stop,
+        u_scale=np.array([x_scale, v_scale]),
+        lam_scale=abs(stop - start),
+        settings=ContinuationSettings(
+            step=0.002,
+            min_step=1e-7,
+            max_step=0.023,
+            max_points=max_points,
+            tolerance=1e-11,
+            chord_parameter=True,
+        ),
+    )
+    rows = np.array(branch.data)
+    n = branch.lam.size
+    omega = branch.lam.copy() if parameter == "omega" else np.full(n, w0)
+    force = branch.lam.copy() if parameter == "force" else np.full(n, f0)
+    x_max = rows[:, R_XMAX]
+    x_min = rows[:, R_XMIN]
+    mono = rows[:, R_JAC : R_JAC + 4].reshape(n, 2, 2) + np.eye(2)
+    mu = np.linalg.eigvals(mono).astype(np.complex128)
+    mu = np.take_along_axis(mu, np.argsort(-np.abs(mu), axis=1), axis=1)
+    stable = np.max(np.abs(mu), axis=1) < 1.0
+    amplitude = 0.5 * (x_max - x_min)
+    events = _events(joint, branch.tangent[:, -1], mono, x_max, x_min, omega, force, amplitude)
+    return FrequencyResponse(
+        omega=omega,
+        force_amplitude=force,
+        x_max=x_max,
+        x_min=x_min,
+        amplitude=amplitude,
+        stable=stable,
+        multipliers=mu,
+        initial_state=branch.u.copy(),
+        events=events,
+        parameter=parameter,
+        stop_reason=branch.reason,
+        settings={
+            "joint": joint,
+            "damping_ratio": damping_ratio,
+            "friction": friction,
+            "restitution": restitution,
+        },
+    )
+
+
+def _events(
+    joint: Joint,
+    lam_tangent: FloatArray,
+    mono: FloatArray,
+    x_max: FloatArray,
+    x_min: FloatArray,
+    omega: FloatArray,
+    force: FloatArray,
+    amplitude: FloatArray,
+) -> list[ResponseEvent]:
+    """Folds, period doublings and grazings between successive points, located linearly."""
+    trace = mono[:, 0, 0] + mono[:, 1, 1]
+    det = mono[:, 0, 0] * mono[:, 1, 1] - mono[:, 0, 1] * mono[:, 1, 0]
+    tests = {
+        "fold": (lam_tangent, ""),
+        "period_doubling": (
+            1.0 + trace + det,
+            "a multiplier passes -1: a period-2 branch is born here (not followed)",
+        ),
+        "grazing": (x_max - joint.compression_gap, "the orbit touches the compression edge"),
+        "grazing_t": (-joint.tension_gap - x_min, "the orbit touches the tension edge"),
+    }
+    events: list[tuple[int, ResponseEvent]] = []
+    for name, (g, note) in tests.items():
+        kind = "grazing" if name.startswith("grazing") else name
+        for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
+            frac = float(g[i] / (g[i] - g[i + 1]))
+            if kind == "fold":
+                # the parameter is extreme at a fold: take the bracketing point that is further
+                # out (a linear interpolation of the tangent is wrong at a grazing kink)
+                lam = omega if np.ptp(omega) > 0.0 else force
+                turn = float(np.sign(lam[i + 1] - lam[i]) * np.sign(g[i]))
+                frac = 1.0 if turn > 0 else 0.0
+
+            def at(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
+                return float(a[i] + frac * (a[i + 1] - a[i]))
+
+            events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), note)))
+    events.sort(key=lambda item: item[0])
+    merged: list[tuple[int, ResponseEvent]] = []
+    for index, event in events:
+        if (
+            merged
+            and event.kind == "grazing"
+            and merged[-1][1].kind == "grazing"
+            and merged[-1][0] == index
+        ):
+            merged[-1] = (
+                index,
+                ResponseEvent(
+                    "grazing",
+                    event.omega,
+                    event.force_amplitude,
+                    event.amplitude,
+                    "the orbit touches both gap edges",
+                ),
+            )
+            continue
+        merged.append((index, event))
+    return [e for _, e in merged]

@@ -1,0 +1,389 @@
+"""The exact stroboscopic map over p forcing periods, its monodromy matrix, and Newton on it.
+
+MODEL.md sec. 5.1: the map P_p(z0) carries z0 = (x, x') at forcing phase 0 over
+p forcing periods with the exact event-driven flow (the same kernel as
+``time_response``). Its Jacobian, the monodromy matrix, is exact: in each
+state the flow is linear, Phi = exp(A tau) in closed form, and at each event on
+a surface h(z) = 0 with jump z+ = R z- the saltation matrix
+
+    S = R + (f+ - R f-) grad(h)^T / (grad(h) . f-)
+
+is applied (Leine & Nijmeijer 2004, ch. 7), so M = Phi_k S_k ... S_1 Phi_1.
+Events: a gap edge (grad h = (1, 0), R = diag(1, e) on entering contact), a
+velocity zero (grad h = (0, 1); the vector field after it is that of the new
+slip direction, or zero when the mass sticks), the release from stick (the
+acceleration just after release is zero, so S = I). A sticking state's flow is
+diag(1, 0): x' stays 0. Grazing (grad h . f- -> 0) makes S singular; the
+smallest normalised approach speed at a gap edge is returned so that callers
+can flag it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint._jit import njit  # numba.njit that survives a read-only install
+from clearjoint.simulate import _kernel as kn
+
+FloatArray = NDArray[np.float64]
+
+# output vector layout of ``shoot_map``
+O_XMAX, O_XMIN, O_EDGE_SPEED, O_EVENTS, O_M00, O_M01, O_M10, O_M11 = range(8)
+N_OUT = 8
+
+
+@njit(cache=True)
+def _acceleration(p: np.ndarray, region: int, slip: int, x: float, v: float, phi: float) -> float:
+    """x'' from the equation of motion in a state (0 while sticking)."""
+    if slip == 0:
+        return 0.0
+    k, fc = kn.region_force(p, region)
+    if kn.friction_active(p, region):
+        fc -= slip * p[kn.P_FF]
+    return float((p[kn.P_F0] * math.sin(phi) + fc - k * x - p[kn.P_DAMP] * v) / p[kn.P_MASS])
+
+
+@njit(cache=True)
+def _flow(q: np.ndarray, slip: int, tau: float, phi_out: np.ndarray) -> None:
+    """Write exp(A tau), the state's homogeneous flow over tau, into the 2x2 ``phi_out``."""
+    if slip == 0:
+        phi_out[0, 0] = 1.0
+        phi_out[0, 1] = 0.0
+        phi_out[1, 0] = 0.0
+        phi_out[1, 1] = 0.0
+        return
+    alpha = q[kn.Q_ALPHA]
+    d2 = q[kn.Q_D2]
+    root = q[kn.Q_ROOT]
+    if d2 < 0.0:
+        ea = math.exp(alpha * tau)
+        e_part = ea * math.cos(root * tau)
+        g_part = ea * math.sin(root * tau) / root
+    elif d2 > 0.0:
+        em = math.exp((alpha - root) * tau)
+        ep = math.exp((alpha + root) * tau)
+        e_part = 0.5 * (ep + em)
+        if 2.0 * root * tau < 1.0:
+            g_part = em * math.expm1(2.0 * root * tau) / (2.0 * root)
+        else:
+            g_part = (ep - em) / (2.0 * root)
+    else:
+        e_part = math.exp(alpha * tau)
+        g_part = tau * e_part
+    kq = q[kn.Q_K] / q[kn.Q_M]
+    phi_out[0, 0] = e_part - g_part * alpha
+    phi_out[0, 1] = g_part
+    phi_out[1, 0] = -g_part * kq
+    phi_out[1, 1] = e_part + g_part * alpha
+
+
+@njit(cache=True)
+def _left_multiply(a: np.ndarray, m: np.ndarray) -> None:
+    """m <- a @ m for 2x2 arrays, in place."""
+    m00 = a[0, 0] * m[0, 0] + a[0, 1] * m[1, 0]
+    m01 = a[0, 0] * m[0, 1] + a[0, 1] * m[1, 1]
+    m10 = a[1, 0] * m[0, 0] + a[1, 1] * m[1, 0]
+    m11 = a[1, 0] * m[0, 1] + a[1, 1] * m[1, 1]
+    m[0, 0] = m00
+    m[0, 1] = m01
+    m[1, 0] = m10
+    m[1, 1] = m11
+
+
+@njit(cache=True)
+def shoot_map(p: np.ndarray, state: np.ndarray, n_periods: int, out: np.ndarray) -> int:
+    """Advance ``state`` (x, v, region, slip) over ``n_periods`` periods, with the monodromy.
+
+    ``out`` receives x_max, x_min over the stretch, the smallest approach speed
+    at a gap edge (inf if none), the number of events and the monodromy matrix
+    M = dz(end)/dz(start) row by row. Returns a kernel status code.
+    """
+    tf = p[kn.P_TF]
+    w = p[kn.P_W]
+    e = p[kn.P_E]
+    t_scale = kn.time_scale(p)
+    x = state[kn.S_X]
+    v = state[kn.S_V]
+    region = int(state[kn.S_REGION])
+    slip = int(state[kn.S_SLIP])
+    mono = np.eye(2)
+    phi_m = np.zeros((2, 2))
+    sal = np.zeros((2, 2))
+    x_max = x
+    x_min = x
+    edge_speed = math.inf
+    n_events = 0
+    for _period in range(n_periods):
+        t_in = 0.0
+        events_here = 0
+        while True:
+            phase = w * t_in
+            q = kn.phase_coefficients(p, region, slip, x, v, phase)
+            tau, code = kn._next_event(p, q, region, slip, tf - t_in, t_scale)
+            if code == kn.EV_MARCH_FAILED:
+                return kn.STATUS_MARCH_FAILED
+            if code == kn.EV_PERIOD_END:
+                tau = tf - t_in
+            x, v, _, _ = kn.evaluate(q, slip, tau)
+            _flow(q, slip, tau, phi_m)
+            _left_multiply(phi_m, mono)
+            x_max = max(x_max, x)
+            x_min = min(x_min, x)
+            t_in += tau
+            if code == kn.EV_PERIOD_END:
+                break
+            n_events += 1
+            events_here += 1
+            if events_here > kn.MAX_EVENTS_PER_PERIOD:
+                return kn.STATUS_TOO_MANY_EVENTS
+            phase = w * t_in
+            a_before = _acceleration(p, region, slip, x, v, phase)
+            v_before = v
+            x, v, new_region, new_slip, _, _ = kn.apply_event(p, code, x, v, region, slip, phase)
+            a_after = _acceleration(p, new_region, new_slip, x, v, phase)
+            v_after = v if new_slip != 0 else 0.0
+            # saltation matrix S = R + (f+ - R f-) grad(h)^T / (grad(h) . f-)
+            sal[0, 0] = 1.0
+            sal[0, 1] = 0.0
+            sal[1, 0] = 0.0
+            sal[1, 1] = 1.0
+            if code in (kn.EV_ENTER_COMPRESSION, kn.EV_ENTER_TENSION):
+                edge_speed = min(edge_speed, abs(v_before))
+                if v_before != 0.0:
+                    sal[1, 1] = e
+                    sal[0, 0] = 1.0 + (v_after - v_before) / v_before
+                    sal[1, 0] = (a_after - e * a_before) / v_before
+            elif code in (kn.EV_LEAVE_COMPRESSION, kn.EV_LEAVE_TENSION):
+                edge_speed = min(edge_speed, abs(v_before))
+                if v_before != 0.0:
+                    sal[1, 0] = (a_after - a_before) / v_before
+            elif code == kn.EV_VELOCITY_ZERO and a_before != 0.0:
+                sal[1, 1] = a_after / a_before
+            _left_multiply(sal, mono)
+            region = new_region
+            slip = new_slip
+            x_max = max(x_max, x)
+            x_min = min(x_min, x)
+    state[kn.S_X] = x
+    state[kn.S_V] = v
+    state[kn.S_REGION] = region
+    state[kn.S_SLIP] = slip
+    out[O_XMAX] = x_max
+    out[O_XMIN] = x_min
+    out[O_EDGE_SPEED] = edge_speed
+    out[O_EVENTS] = n_events
+    out[O_M00] = mono[0, 0]
+    out[O_M01] = mono[0, 1]
+    out[O_M10] = mono[1, 0]
+    out[O_M11] = mono[1, 1]
+    return kn.STATUS_OK
+
+
+@njit(cache=True)
+def start_state(p: np.ndarray, x: float, v: float, state: np.ndarray) -> None:
+    """The full kernel state (x, v, region, slip) of the point (x, v) at forcing phase 0."""
+    region = kn.region_of(p, x, v)
+    state[kn.S_X] = x
+    state[kn.S_V] = v
+    state[kn.S_REGION] = region
+    if v > 0.0:
+        state[kn.S_SLIP] = 1
+    elif v < 0.0:
+        state[kn.S_SLIP] = -1
+    else:
+        state[kn.S_SLIP] = kn.decide_slip(p, region, x, 0.0)
+
+
+@dataclass(frozen=True)
+class Shot:
+    """One evaluation of the map P_p: end point, monodromy and extremes along the way.
+
+    Attributes
+    ----------
+    end : (2,) ndarray
+        (x, x') after the p periods, m and m/s.
+    end_state : (4,) ndarray
+        x, x', region, slip after the p periods (kernel layout).
+    monodromy : (2, 2) ndarray
+        dP_p / dz0.
+    x_max, x_min : float
+        Extremes of x along the stretch, m.
+    edge_speed : float
+        Smallest approach speed at a gap edge, m/s (inf when no edge is met).
+    events : int
+    """
+
+    end: FloatArray
+    end_state: FloatArray
+    monodromy: FloatArray
+    x_max: float
+    x_min: float
+    edge_speed: float
+    events: int
+
+
+class MapError(RuntimeError):
+    """The kernel could not evaluate the map (carries the kernel status)."""
+
+    def __init__(self, status: int) -> None:
+        super().__init__(f"kernel status {status}")
+        self.status = status
+
+
+def shoot(p: FloatArray, z0: FloatArray, n_periods: int) -> Shot:
+    """Evaluate the exact map P_p at z0 = (x, x') with its monodromy (MODEL.md sec. 5.1).
+
+    Parameters
+    ----------
+    p : (13,) ndarray
+        Kernel parameter vector (``core._parameters``).
+    z0 : (2,) or (4,) ndarray
+        (x, x') at forcing phase 0, or a full kernel state (x, x', region, slip).
+    n_periods : int
+        p, the number of forcing periods.
+
+    Raises
+    ------
+    MapError
+        The kernel stopped (a march out of steps, chattering).
+    """
+    state = np.zeros(4)
+    if len(z0) == 4:
+        state[:] = z0
+    else:
+        start_state(p, float(z0[0]), float(z0[1]), state)
+    out = np.zeros(N_OUT)
+    status = shoot_map(p, state, n_periods, out)
+    if status != kn.STATUS_OK:
+        raise MapError(status)
+    return Shot(
+        end=state[:2].copy(),
+        end_state=state,
+        monodromy=out[O_M00:].reshape(2, 2).copy(),
+        x_max=float(out[O_XMAX]),
+        x_min=float(out[O_XMIN]),
+        edge_speed=float(out[O_EDGE_SPEED]),
+        events=int(out[O_EVENTS]),
+    )
+
+
+def newton_orbit(
+    p: FloatArray,
+    z0: FloatArray,
+    n_periods: int,
+    scale: FloatArray,
+    *,
+    tolerance: float = 1e-12,
+    max_iterations: int = 30,
+) -> tuple[FloatArray, Shot, int] | None:
+    """Solve P_p(z) = z by Newton's method with the exact monodromy (MODEL.md sec. 5.1).
+
+    Parameters
+    ----------
+    p : (13,) ndarray
+        Kernel parameter vector.
+    z0 : (2,) ndarray
+        Starting guess (x, x') at forcing phase 0.
+    n_periods : int
+        p.
+    scale : (2,) ndarray
+        Sizes of x and x' that the tolerance is relative to.
+    tolerance : float
+        Converged when |P_p(z) - z| / scale <= tolerance in both components.
+
+    Returns
+    -------
+    (z, shot, iterations), or None
+        The fixed point, the map evaluated at it, and the Newton iterations used;
+        None when Newton did not converge.
+    """
+    z = np.array(z0[:2], dtype=np.float64)
+    for iteration in range(max_iterations + 1):
+        try:
+            shot = shoot(p, z, n_periods)
+        except MapError:
+            return None
+        residual = shot.end - z
+        if np.all(np.abs(residual) <= tolerance * scale):
+            return z, shot, iteration
+        jac = shot.monodromy - np.eye(2)
+        try:
+            step = np.linalg.solve(jac, -residual)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(step)):
+            return None
+        # damp steps that would jump far across the state space
+        size = float(np.max(np.abs(step) / scale))
+        if size > 1.0:
+            step /= size
+        z = z + step
+    return None
+
+
+# residual vector layout of ``map_residual``
+R_RES, R_JAC, R_DLAM, R_XMAX, R_XMIN, R_EDGE, R_EVENTS = 0, 2, 6, 8, 9, 10, 11
+N_RES = 12
+
+
+@njit(cache=True)
+def _set_parameter(p: np.ndarray, parameter: int, value: float) -> None:
+    if parameter == 0:
+        p[kn.P_W] = value
+        p[kn.P_TF] = 2.0 * math.pi / value
+    else:
+        p[kn.P_F0] = value
+
+
+@njit(cache=True)
+def map_residual(
+    p: np.ndarray,
+    parameter: int,
+    x: float,
+    v: float,
+    lam: float,
+    out: np.ndarray,
+    derivative: bool = True,
+) -> int:
+    """R = P_1(z) - z at parameter ``lam`` (0: omega, 1: F0), dR/dz and dR/dlam, in one call.
+
+    ``out`` receives R (2), dR/dz = M - I row by row (4), dR/dlam (2) by a forward
+    difference of the exact map with step 1e-7 lam, then x_max, x_min, the
+    smallest approach speed at an edge and the number of events. Without
+    ``derivative`` dR/dlam is not computed (left as it is in ``out``). Returns a
+    kernel status code.
+    """
+    q = p.copy()
+    _set_parameter(q, parameter, lam)
+    state = np.zeros(4)
+    start_state(q, x, v, state)
+    o1 = np.zeros(N_OUT)
+    status = shoot_map(q, state, 1, o1)
+    if status != kn.STATUS_OK:
+        return status
+    if derivative:
+        delta = 1e-7 * lam
+        _set_parameter(q, parameter, lam + delta)
+        shifted = np.zeros(4)
+        start_state(q, x, v, shifted)
+        o2 = np.zeros(N_OUT)
+        status = shoot_map(q, shifted, 1, o2)
+        if status != kn.STATUS_OK:
+            return status
+        out[R_DLAM] = (shifted[kn.S_X] - state[kn.S_X]) / delta
+        out[R_DLAM + 1] = (shifted[kn.S_V] - state[kn.S_V]) / delta
+    out[R_RES] = state[kn.S_X] - x
+    out[R_RES + 1] = state[kn.S_V] - v
+    out[R_JAC] = o1[O_M00] - 1.0
+    out[R_JAC + 1] = o1[O_M01]
+    out[R_JAC + 2] = o1[O_M10]
+    out[R_JAC + 3] = o1[O_M11] - 1.0
+    out[R_XMAX] = o1[O_XMAX]
+    out[R_XMIN] = o1[O_XMIN]
+    out[R_EDGE] = o1[O_EDGE_SPEED]
+    out[R_EVENTS] = o1[O_EVENTS]
+    return kn.STATUS_OK

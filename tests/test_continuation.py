@@ -1,0 +1,63 @@
+"""continuation: pseudo-arclength through the two folds of an S-curve with known folds."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint.continuation import (
+    ContinuationError,
+    ContinuationSettings,
+    continue_branch,
+)
+from clearjoint.errors import ParameterError
+
+
+def _s_curve(u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """u^3 - u - lambda = 0: folds at u = +-1/sqrt(3), lambda = -+2/(3 sqrt(3))."""
+    r = np.array([u[0] ** 3 - u[0] - lam])
+    return r, np.array([[3 * u[0] ** 2 - 1.0]]), np.array([-1.0]), float(u[0])
+
+
+def test_follows_an_s_curve_through_both_folds_without_jumping() -> None:
+    branch = continue_branch(
+        _s_curve,
+        np.array([-1.5]),
+        -1.875,
+        1.875,
+        u_scale=np.array([1.0]),
+        lam_scale=1.0,
+        settings=ContinuationSettings(step=0.01, max_step=0.05),
+    )
+    assert branch.reason == "reached"
+    assert branch.lam[-1] == pytest.approx(1.875)
+    u = branch.u[:, 0]
+    # every point solves the equation, and u only grows: the middle branch is followed,
+    # never skipped by a jump from one outer branch to the other
+    assert np.max(np.abs(u**3 - u - branch.lam)) < 1e-10
+    assert np.all(np.diff(u) > 0.0)
+    assert np.max(np.diff(u)) < 0.1
+    assert u[-1] == pytest.approx(1.5)
+    # two folds, where the parameter component of the tangent changes sign
+    t = branch.tangent[:, -1]
+    folds = np.nonzero(np.sign(t[:-1]) != np.sign(t[1:]))[0]
+    assert folds.size == 2
+    fold_lam = sorted(float(branch.lam[i]) for i in folds)
+    expected = 2.0 / (3.0 * math.sqrt(3.0))
+    assert fold_lam[0] == pytest.approx(-expected, abs=5e-3)
+    assert fold_lam[1] == pytest.approx(expected, abs=5e-3)
+
+
+def test_no_solution_at_the_start_is_an_error() -> None:
+    def nowhere(u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, None]:
+        return np.array([u[0] ** 2 + 1.0]), np.array([[2 * u[0]]]), np.array([0.0]), None
+
+    with pytest.raises(ContinuationError, match="no solution near the start"):
+        continue_branch(nowhere, np.array([0.3]), 0.0, 1.0, u_scale=np.ones(1), lam_scale=1.0)
+
+
+def test_settings_are_validated() -> None:
+    with pytest.raises(ParameterError, match="min_step <= step <= max_step"):
+        ContinuationSettings(step=1.0, max_step=0.1)

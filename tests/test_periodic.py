@@ -1,0 +1,279 @@
+"""periodic: exact orbits, their stability and whole frequency-response curves.
+
+Independent routes: steady_state (time marching from a perturbed start, no
+Newton), time_response from perturbed orbits, the energy ledger, the linear
+closed form inside the gap, frequency_sweep for the period-2 region, and eq 7.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint import Friction, Joint, ParameterError
+from clearjoint.periodic import FrequencyResponse, frequency_response, periodic_orbit
+from clearjoint.simulate import frequency_sweep, steady_state, time_response
+from clearjoint.stiffness import equivalent_linear_response
+
+#: pyHarm's SDOF clearance case: m = 1, c_v = 0.05, k0 = 1, edges at +-0.1745, contact adds 3.
+PYHARM = Joint(
+    mass=1.0,
+    clearance=2 * 0.1745,
+    gap_stiffness=1.0,
+    compression_stiffness=3.0,
+    tension_stiffness=3.0,
+)
+ZETA = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 2 zeta sqrt(m k_c) = 0.05
+F0 = 0.03
+
+#: One-sided soft contact with period doubling between about 2.29 and 3.28 rad/s.
+ONE_SIDED = Joint(
+    mass=1.0,
+    clearance=0.2,
+    gap_stiffness=1.0,
+    compression_stiffness=20.0,
+    tension_stiffness=1e-3,
+)
+
+
+@pytest.fixture(scope="module")
+def curve() -> FrequencyResponse:
+    return frequency_response(PYHARM, F0, 0.05, 1.8, damping_ratio=ZETA)
+
+
+def _relative(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / np.max(np.abs(b)))
+
+
+@pytest.mark.parametrize(
+    ("omega", "losses"),
+    [
+        (1.3, {"damping_ratio": ZETA}),
+        (1.2, {"damping_ratio": ZETA, "restitution": 0.7}),
+        (1.0, {"damping_ratio": ZETA, "friction": Friction(0.3, 0.01)}),
+    ],
+)
+def test_stable_orbit_agrees_with_steady_state(omega: float, losses: dict[str, object]) -> None:
+    orbit = periodic_orbit(PYHARM, F0, omega, **losses)  # type: ignore[arg-type]
+    assert orbit.stable
+    ss = steady_state(PYHARM, F0, omega, initial=orbit.initial_state, **losses)  # type: ignore[arg-type]
+    assert ss.period_multiple == 1
+    scale = np.array([orbit.amplitude, orbit.amplitude * omega])
+    assert np.max(np.abs(np.subtract(ss.initial_state[:2], orbit.initial_state)) / scale) < 1e-9
+    assert orbit.x_max == pytest.approx(ss.x_max, rel=1e-9)
+    assert orbit.x_min == pytest.approx(ss.x_min, rel=1e-9)
+    assert orbit.cycle.energy.balance_error < 1e-9
+    assert "PeriodicOrbit(period-1" in repr(orbit)
+    assert "[" not in repr(orbit)
+
+
+def test_period_2_orbit_is_found_and_matches_steady_state() -> None:
+    omega = 2.786
+    ss = steady_state(ONE_SIDED, 1.0, omega, damping_ratio=0.05)
+    assert ss.period_multiple == 2
+    orbit = periodic_orbit(ONE_SIDED, 1.0, omega, damping_ratio=0.05, period_multiple=2)
+    assert orbit.stable
+    assert orbit.cycle.period_multiple == 2
+    # the same orbit, possibly started one forcing period later
+    starts = [np.array(ss.initial_state[:2])]
+    back = time_response(
+        ONE_SIDED, 1.0, omega, 2 * math.pi / omega, initial=ss.initial_state[:2], damping_ratio=0.05
+    )
+    starts.append(np.array(back.final_state))
+    scale = np.array([orbit.amplitude, orbit.amplitude * omega])
+    assert min(np.max(np.abs(s - orbit.initial_state) / scale) for s in starts) < 1e-8
+
+
+def _distance_after(orbit_state: tuple[float, float], omega: float, periods: int) -> float:
+    """Relative distance from the orbit's start after ``periods`` periods from a 1e-6 offset."""
+    start = np.array(orbit_state) + np.array([1e-6, 0.0])
+    motion = time_response(
+        PYHARM, F0, omega, periods * 2 * math.pi / omega, initial=start, damping_ratio=ZETA
+    )
+    return float(abs(motion.final_state[0] - orbit_state[0]))
+
+
+def test_unstable_orbit_leaves_and_stable_orbit_returns(curve: FrequencyResponse) -> None:
+    omega = 1.4
+    middle = [
+        i
+        for i in range(curve.omega.size - 1)
+        if (curve.omega[i] - omega) * (curve.omega[i + 1] - omega) <= 0
+    ]
+    unstable = [i for i in middle if not curve.stable[i]]
+    stable = [i for i in middle if curve.stable[i]]
+    assert len(unstable) == 1
+    assert len(stable) == 2
+    orbit_u = periodic_orbit(
+        PYHARM, F0, omega, damping_ratio=ZETA, initial=curve.initial_state[unstable[0]]
+    )
+    assert not orbit_u.stable
+    assert np.max(np.abs(orbit_u.multipliers)) > 1.0
+    assert _distance_after(orbit_u.initial_state, omega, 60) > 1e-3  # left: 1000x the offset
+    for i in stable:
+        orbit_s = periodic_orbit(
+            PYHARM, F0, omega, damping_ratio=ZETA, initial=curve.initial_state[i]
+        )
+        assert orbit_s.stable
+        assert _distance_after(orbit_s.initial_state, omega, 60) < 1e-7  # came back
+
+
+def test_curve_turns_back_at_two_folds_through_an_unstable_branch(
+    curve: FrequencyResponse,
+) -> None:
+    assert curve.stop_reason == "reached"
+    assert curve.omega.size >= 300
+    folds = [e for e in curve.events if e.kind == "fold"]
+    assert len(folds) == 2
+    # omega turns back at each fold: larger (upper fold) or smaller (lower) than its neighbours
+    upper, lower = sorted(folds, key=lambda e: -e.amplitude)
+    assert upper.omega > lower.omega
+    assert upper.omega == pytest.approx(curve.omega[curve.amplitude > 0.3].max(), rel=1e-4)
+    # the lower fold is the kink where the middle branch meets the linear orbit that just
+    # touches the edges: F0 / |1 - w^2 + 0.05 i w| = 0.1745 (closed form)
+    w2 = 1.0 + math.sqrt((F0 / PYHARM.compression_gap) ** 2 - 0.05**2 * 1.0785**2)
+    assert lower.omega == pytest.approx(math.sqrt(w2), rel=1e-3)
+    # between the folds the orbits are unstable with a real multiplier > 1 (saddle)
+    unstable = ~curve.stable
+    assert unstable.sum() > 20
+    assert np.all(np.abs(curve.multipliers[unstable, 0].imag) < 1e-9)
+    assert np.all(curve.multipliers[unstable, 0].real > 1.0)
+    # pyHarm (12 harmonics) puts the peak at 0.3973 near 1.5339 and the upper fold near 1.5348
+    peak = int(np.argmax(curve.amplitude))
+    assert curve.amplitude[peak] == pytest.approx(0.3973, abs=5e-4)
+    assert upper.omega == pytest.approx(1.5348, abs=2e-3)
+
+
+def test_grazing_kink_is_reported_and_crossed(curve: FrequencyResponse) -> None:
+    grazings = [e for e in curve.events if e.kind == "grazing"]
+    assert len(grazings) == 2  # the lower branch leaves the gap on the way up, re-enters after
+    for event in grazings:
+        assert event.amplitude == pytest.approx(PYHARM.compression_gap, rel=1e-3)
+    # where the linear orbit reaches the edges: F0 / |1 - w^2 + 0.05 i w| = 0.1745
+    touch = [
+        float(w)
+        for w in np.linspace(0.8, 1.2, 400001)
+        if abs(F0 / math.hypot(1.0 - w * w, 0.05 * w) - PYHARM.compression_gap) < 2e-6
+    ]
+    assert grazings[0].omega == pytest.approx(min(touch), rel=2e-3)
+    assert grazings[1].omega == pytest.approx(max(touch), rel=2e-3)
+    # inside the gap the orbit is linear: X = F0 / |k0 - m w^2 + i c w| exactly
+    inside = curve.amplitude < PYHARM.compression_gap * 0.999
+    w = curve.omega[inside]
+    linear = F0 / np.hypot(1.0 - w**2, 0.05 * w)
+    assert _relative(curve.amplitude[inside], linear) < 1e-9
+    # points on both sides of each grazing: the continuation went on
+    assert curve.omega[-1] == pytest.approx(1.8)
+
+
+def test_stable_points_agree_with_steady_state(curve: FrequencyResponse) -> None:
+    stable = np.nonzero(curve.stable)[0]
+    for i in stable[:: max(1, stable.size // 8)]:
+        omega = float(curve.omega[i])
+        start = curve.initial_state[i] * (1.0 + 1e-4)  # off the orbit: steady_state must converge
+        ss = steady_state(PYHARM, F0, omega, damping_ratio=ZETA, initial=start)
+        scale = curve.amplitude[i]
+        assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
+        assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
+        assert abs(ss.initial_state[0] - curve.initial_state[i, 0]) / scale < 1e-9
+
+
+def test_energy_ledger_closes_on_every_point(curve: FrequencyResponse) -> None:
+    worst = max(curve.cycle(i).energy.balance_error for i in range(curve.omega.size))
+    assert worst < 1e-9
+    # and the orbit closes: the mechanical energy change over the period vanishes
+    assert abs(curve.cycle(int(np.argmax(curve.amplitude))).energy.mechanical_energy_change) < 1e-12
+
+
+def test_period_doubling_where_a_sweep_finds_period_2_orbits() -> None:
+    grid = np.array([2.0, 2.6, 3.0, 3.6])
+    sweep = frequency_sweep(ONE_SIDED, 1.0, grid, direction="up", damping_ratio=0.05)
+    assert list(sweep.multiple_up) == [1, 2, 2, 1]
+    fr = frequency_response(ONE_SIDED, 1.0, 1.8, 3.8, damping_ratio=0.05)
+    doublings = sorted(e.omega for e in fr.events if e.kind == "period_doubling")
+    assert len(doublings) == 2
+    assert 2.0 < doublings[0] < 2.6
+    assert 3.0 < doublings[1] < 3.6
+    between = (fr.omega > doublings[0] + 1e-3) & (fr.omega < doublings[1] - 1e-3)
+    assert not fr.stable[between].any()
+    assert np.all(fr.multipliers[between, 0].real < -1.0)  # through -1, not +1
+    assert all("period-2" in e.note for e in fr.events if e.kind == "period_doubling")
+
+
+def test_force_continuation_is_linear_inside_the_gap_and_meets_steady_state() -> None:
+    omega = 0.6
+    fr = frequency_response(
+        PYHARM, 0.01, omega, None, damping_ratio=ZETA, parameter="force", force_stop=0.2
+    )
+    assert fr.stop_reason == "reached"
+    assert np.all(fr.omega == omega)
+    assert fr.force_amplitude[-1] == pytest.approx(0.2)
+    inside = fr.amplitude < PYHARM.compression_gap * 0.999
+    gain = 1.0 / math.hypot(1.0 - omega**2, 0.05 * omega)
+    assert _relative(fr.amplitude[inside], fr.force_amplitude[inside] * gain) < 1e-9
+    assert any(e.kind == "grazing" for e in fr.events)
+    ss = steady_state(PYHARM, 0.2, omega, damping_ratio=ZETA)
+    assert fr.amplitude[-1] == pytest.approx(ss.amplitude, rel=1e-9)
+
+
+def test_eq7_shortcut_holds_off_the_peak_and_misses_the_fold(curve: FrequencyResponse) -> None:
+    def exact_at(omega: float) -> list[float]:
+        out = []
+        for i in range(curve.omega.size - 1):
+            a, b = curve.omega[i], curve.omega[i + 1]
+            if (a - omega) * (b - omega) <= 0 and a != b:
+                f = (omega - a) / (b - a)
+                out.append(
+                    float(curve.amplitude[i] + f * (curve.amplitude[i + 1] - curve.amplitude[i]))
+                )
+        return sorted(out)
+
+    for omega in (1.1, 1.2, 1.3, 1.4, 1.5):
+        eq7 = sorted(
+            b.displacement_amplitude
+            for b in equivalent_linear_response(PYHARM, F0, omega, ZETA, method="period")
+        )
+        exact = exact_at(omega)
+        assert len(eq7) == len(exact) == 3
+        assert np.allclose(eq7, exact, rtol=1e-2)
+    # near the peak the shortcut's fold comes too early: no contacting orbit at 1.53 rad/s
+    near_peak = equivalent_linear_response(PYHARM, F0, 1.53, ZETA, method="period")
+    assert len(near_peak) == 1
+    assert len(exact_at(1.53)) == 3
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"omega_start": 1.0, "omega_stop": 1.0}, "zero width"),
+        ({"omega_start": -1.0, "omega_stop": 1.0}, "omega_start must be > 0"),
+        ({"omega_start": 1.0, "omega_stop": 0.0}, "omega_stop must be > 0"),
+        ({"omega_start": float("nan"), "omega_stop": 1.0}, "must be finite"),
+        ({"omega_start": 1.0, "omega_stop": 2.0, "parameter": "force"}, "force_stop is required"),
+        ({"omega_start": 1.0, "omega_stop": 2.0, "parameter": "amplitude"}, "'omega' or 'force'"),
+    ],
+)
+def test_bad_input_is_one_clear_error(kwargs: dict[str, object], match: str) -> None:
+    with pytest.raises(ParameterError, match=match):
+        frequency_response(PYHARM, F0, **kwargs)  # type: ignore[arg-type]
+
+
+def test_result_repr_plot_and_xarray(curve: FrequencyResponse) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    text = repr(curve)
+    assert "FrequencyResponse(" in text
+    assert "2 fold" in text
+    assert "[" not in text
+    ax = curve.plot()
+    assert ax.get_xlabel() == "frequency (Hz)"
+    styles = {line.get_linestyle() for line in ax.get_lines() if len(line.get_xdata()) > 1}
+    assert {"-", "--"} <= styles
+    data = curve.to_xarray()
+    assert data["amplitude"].attrs["units"] == "m"
+    assert data["frequency"].attrs["units"] == "Hz"
+    assert data.sizes["point"] == curve.omega.size
+    assert list(data["event_kind"].values).count("fold") == 2

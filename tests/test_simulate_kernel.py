@@ -1,0 +1,98 @@
+"""simulate._kernel: march limits, the closed-form segment energies, stiff contact."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from clearjoint import Joint
+from clearjoint.simulate import _kernel as kn
+from clearjoint.simulate import core, time_response
+
+#: k_contact / k0 = 1e8: free flights of seconds between contacts of a fraction of a ms.
+STIFF = Joint(
+    mass=1.0,
+    clearance=0.2,
+    gap_stiffness=1.0,
+    compression_stiffness=1e8,
+    tension_stiffness=1e8,
+)
+
+
+def test_a_march_that_runs_out_of_steps_raises_instead_of_jumping() -> None:
+    # with the JIT off the step limit is read at run time, so one step is enough to hit it
+    script = textwrap.dedent(
+        """
+        from clearjoint import Friction, Joint
+        from clearjoint.simulate import _kernel as kn, time_response, SimulationError
+        kn.MAX_MARCH_STEPS = 1
+        joint = Joint(mass=1.0, clearance=0.2, gap_stiffness=1.0, compression_stiffness=4.0)
+        for kwargs in ({}, {"friction": Friction(0.5, 1.0)}):  # moving state, sticking state
+            try:
+                time_response(joint, 1.0, 1.0, 6.0, **kwargs)
+            except SimulationError as error:
+                assert "certified steps" in str(error), error
+                print("raised")
+            else:
+                print("returned")
+        """
+    )
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    out = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["raised", "raised"]
+
+
+def _quadrature_energy(p: np.ndarray, q: np.ndarray, duration: float) -> tuple[float, float]:
+    """64-point Gauss-Legendre on 40 pieces of the state's velocity, one point at a time."""
+    nodes, weights = np.polynomial.legendre.leggauss(64)
+    edges = np.linspace(0.0, duration, 41)
+    work = viscous = 0.0
+    for a, b in itertools.pairwise(edges):
+        for node, weight in zip(nodes, weights, strict=True):
+            tau = 0.5 * (a + b) + 0.5 * (b - a) * node
+            v = kn.evaluate(q, 1, tau)[1]
+            force = p[kn.P_F0] * math.sin(q[kn.Q_PHI] + p[kn.P_W] * tau)
+            work += 0.5 * (b - a) * weight * force * v
+            viscous += 0.5 * (b - a) * weight * p[kn.P_DAMP] * v * v
+    return work, viscous
+
+
+@pytest.mark.parametrize("damping", [0.0, 0.05, 2.0, 3.0])  # light, over-damped free-play
+@pytest.mark.parametrize("region", [kn.FREE, kn.COMPRESSION, kn.TENSION])
+def test_closed_form_segment_energy_matches_adaptive_quadrature(
+    damping: float, region: int
+) -> None:
+    joint = Joint(mass=1.0, clearance=0.2, gap_stiffness=1.0, compression_stiffness=30.0)
+    p = core._parameters(joint, 0.7, 1.3, 0.0, None, 1.0)
+    p[kn.P_DAMP] = damping
+    rng = np.random.default_rng(region + 7)
+    scratch = np.zeros((3, 6), dtype=np.complex128)
+    for _ in range(5):
+        x0, v0, phi = rng.normal() * 0.2, rng.normal(), rng.uniform(0.0, 2 * math.pi)
+        q = kn.phase_coefficients(p, region, 1, x0, v0, phi)
+        duration = rng.uniform(0.1, 4.0)
+        work, viscous = kn._segment_energy(p, q, 1, duration, scratch)
+        ref_work, ref_viscous = _quadrature_energy(p, q, duration)
+        scale = abs(ref_work) + ref_viscous
+        assert work == pytest.approx(ref_work, abs=1e-11 * scale)
+        assert viscous == pytest.approx(ref_viscous, abs=1e-11 * scale)
+
+
+def test_stiff_contact_runs_and_closes_its_ledger() -> None:
+    # 100 periods with k_contact / k0 = 1e8 and e = 0.8: before the closed-form energies the
+    # free flights were cut into pieces of the contact period / 8 (seconds per call), and a
+    # velocity zero below the resolution of the time stalled the march
+    omega = 1.0
+    motion = time_response(STIFF, 1.0, omega, 100 * 2 * math.pi / omega, restitution=0.8)
+    assert motion.impact_times.size > 100
+    assert motion.energy.balance_error < 1e-9
