@@ -6,7 +6,7 @@
 motion with an energy ledger.
 """
 
-from clearjoint.structure.builders import chain, truss
+from clearjoint.structure.builders import chain, mast, truss
 from clearjoint.structure.model import Member, Modes, Structure, StructureError
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
 
@@ -18,6 +18,7 @@ __all__ = [
     "StructureMotion",
     "chain",
     "free_decay",
+    "mast",
     "time_response",
     "truss",
 ]
