@@ -211,12 +211,14 @@ class _Flow:
 
     def jerk_bound(self, pat: _Pattern, y: FloatArray) -> FloatArray:
         """(J,) bounds on each joint's third derivative of delta over the next base step."""
-        plain = np.linalg.norm(pat.jerk_rows, axis=1) * (pat.growth * float(np.linalg.norm(y)))
+        norms = np.linalg.norm(pat.jerk_rows, axis=1)
+        plain: FloatArray = norms * (pat.growth * float(np.linalg.norm(y)))
         if pat.modal_weights is None or pat.modal_inverse is None:
             return plain
         modal = pat.modal_weights @ np.abs(pat.modal_inverse @ y)
         # round-off in the eigenvectors: keep a sliver of the plain bound as a margin
-        return np.minimum(modal * (1.0 + 1e-9) + 1e-9 * plain, plain)
+        bound: FloatArray = np.minimum(modal * (1.0 + 1e-9) + 1e-9 * plain, plain)
+        return bound
 
     def propagate(
         self, pat: _Pattern, y: FloatArray, tau: float, energy: FloatArray | None
