@@ -1,58 +1,108 @@
-"""Samples per second of the identification, end to end (read + identify) for one record.
+"""Samples per second of ``clearjoint identify`` end to end on the command line.
 
-Run on demand: ``python benchmarks/bench_identify.py [BRFD_FOLDER]``. Target (issue 6):
-at least 10^6 samples per second for one record. It times, best of five, a long rig
-record (20 Hz, 30 cycles at 12 kHz, netCDF), a short one (100 Hz), and a real BRFD
-JSON file when the data set is found.
+Run on demand::
+
+    python benchmarks/bench_identify.py [--brfd DIR] [--records DIR] [--old-src SRC] [--jobs N]
+
+It times the command (process start, reading, identification, writing results.csv) over
+the default rig campaign (written to a temporary folder unless ``--records`` names one)
+and over the BRFD folder, best of ``--repeats``, in wall-clock seconds and in CPU seconds
+(user + system of the command's processes, which contention inflates less). With
+``--old-src`` (for example the ``src`` folder of another checkout) the same command runs
+with that code too, in the same loop, and the ratio is printed: on a shared machine only
+ratios measured side by side mean anything. Target (issue 15): 1e6 samples per second.
 """
 
 from __future__ import annotations
 
+import argparse
+import os
+import resource
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from clearjoint.identify import identify
+import h5py
+
 from clearjoint.records import read_record
 from clearjoint.rig import load_campaign, run_campaign
 
 TARGET = 1e6
+HERE = Path(__file__).resolve()
 
 
-def rate(path: Path, repeats: int = 5) -> tuple[int, float]:
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        record = read_record(path)
-        identify(record)
-        best = min(best, time.perf_counter() - start)
-    return record.time.size, best
+def samples(files: list[Path]) -> int:
+    total = 0
+    for path in files:
+        if path.suffix == ".nc":
+            with h5py.File(path, "r") as handle:
+                total += int(handle["time"].shape[0])
+        else:
+            total += read_record(path).time.size
+    return total
+
+
+def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float, float]:
+    """Wall-clock and CPU seconds (user + system, of the command's processes) of one run."""
+    env = dict(os.environ)
+    if src:
+        env["PYTHONPATH"] = src
+    command = [sys.executable, "-m", "clearjoint", "identify", *map(str, files)]
+    command += ["--out", str(out), "--quiet", "--force"]
+    if jobs > 1 and not src:
+        command += ["--jobs", str(jobs)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run(command, env=env, check=True, capture_output=True)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--brfd", default=str(HERE.parents[2] / "shared" / "data" / "brfd"))
+    parser.add_argument("--records", help="folder of rig records (default: run the campaign)")
+    parser.add_argument("--old-src", help="src folder of the code to compare with")
+    parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
-        campaign_file = Path(folder) / "campaign.toml"
-        campaign_file.write_text(
-            '[grid]\nfrequencies = ["20Hz", "100Hz"]\nforce_amplitudes = ["1600N"]\n'
-            '[[structures]]\nname = "joint-1"\nclearance = "0.106mm"\n'
-        )
-        manifest = run_campaign(load_campaign(campaign_file), Path(folder) / "out", jobs=1)
-        files = sorted(manifest.parent.glob("*.nc"))
-        brfd = (
-            Path(sys.argv[1])
-            if len(sys.argv) > 1
-            else (Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd")
-        )
+        if args.records:
+            rig = Path(args.records)
+        else:
+            manifest = run_campaign(load_campaign(), Path(folder) / "rig", jobs=1)
+            rig = manifest.parent
+        sets = {"default rig campaign": sorted(rig.glob("*.nc"))}
+        brfd = Path(args.brfd)
         if brfd.exists():
-            files.append(brfd / "0.5Hz36lbtension1.5amplitude.json")
-        for path in files:
-            samples, seconds = rate(path)
-            verdict = "meets" if samples / seconds >= TARGET else "below"
-            print(
-                f"{path.name:40s} {samples:6d} samples in {seconds * 1e3:6.1f} ms: "
-                f"{samples / seconds:.3g} samples/s ({verdict} the target of {TARGET:.0e})"
+            sets["BRFD folder"] = sorted(brfd.glob("*.json"))
+        out = Path(folder) / "results.csv"
+        for name, files in sets.items():
+            n = samples(files)
+            best = {"new": (float("inf"), 0.0), "old": (float("inf"), 0.0)}
+            for _ in range(args.repeats):
+                best["new"] = min(best["new"], run(files, None, args.jobs, out))
+                if args.old_src:
+                    best["old"] = min(best["old"], run(files, args.old_src, 1, out))
+            wall, cpu = best["new"]
+            rate = n / wall
+            verdict = "meets" if rate >= TARGET else "below"
+            line = (
+                f"{name:22s} {len(files):3d} files {n:8d} samples: {wall:6.2f} s wall, "
+                f"{rate:.3g} samples/s ({verdict} {TARGET:.0e}; jobs={args.jobs}); "
+                f"{cpu:6.2f} CPU s, {n / cpu:.3g} samples per CPU s"
             )
+            if args.old_src:
+                old_wall, old_cpu = best["old"]
+                line += (
+                    f"; old code {old_wall:6.2f} s wall, {old_cpu:6.2f} CPU s: ratio "
+                    f"{old_wall / wall:.2f}x wall, {old_cpu / cpu:.2f}x CPU"
+                )
+            print(line)
 
 
 if __name__ == "__main__":

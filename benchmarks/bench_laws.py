@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from clearjoint import fit
+from clearjoint.analysis import analyse
 from clearjoint.identify import identify_files
-from clearjoint.report import analyse
 from clearjoint.rig import load_campaign, run_campaign, structure_under_test
 from clearjoint.simulate import steady_state
 

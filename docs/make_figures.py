@@ -1,189 +1,42 @@
-"""Regenerate the pictures in docs/figures/ from the library: ``python docs/make_figures.py``."""
+"""Redraw the pictures in docs/figures/ without Sphinx: ``python docs/make_figures.py``.
+
+Each script examples/gallery/plot_*.py draws figures of the docs and lists them in
+``DOCS_FIGURES``; this runs every script and saves those figures here, exactly as the
+docs build does (docs/_ext/docs_figures.py). To add a figure to the docs, draw it in a
+gallery script and add it to that script's ``DOCS_FIGURES``.
+"""
 
 from __future__ import annotations
 
-import math
-import warnings
+import os
+import runpy
+import sys
 from pathlib import Path
 
-import numpy as np
+import matplotlib
 
-from clearjoint import Friction, Joint, Pin
-from clearjoint import dissipation as ds
-from clearjoint.contact import HertzValidityWarning
-from clearjoint.figures import (
-    EnergyPanel,
-    agreement_map_figure,
-    displacement_stages_figure,
-    dissipation_figure,
-    force_displacement_figure,
-    stiffness_coefficient_figure,
-)
-from clearjoint.report import example_cycle, stiffness_study
-from clearjoint.simulate import SimulationError
+matplotlib.use("Agg")
 
-HERE = Path(__file__).parent / "figures"
+HERE = Path(__file__).resolve().parent
+GALLERY = HERE.parent / "examples" / "gallery"
+sys.path.insert(0, str(HERE / "_ext"))
 
-
-#: The losses of examples/study.toml.
-LOSSES = {
-    "damping_ratio": 0.01,
-    "restitution": 0.8,
-    "friction": Friction(0.2, 300.0),
-    "contact_friction_coefficient": 0.15,
-}
-
-
-def _joint(clearance: float) -> Joint:
-    return Joint(mass=2.0, clearance=clearance, compression_stiffness=8e7, tension_stiffness=5e7)
-
-
-def dissipation_pictures() -> None:
-    """Energies against amplitude for the paper's two clearances, and the agreement map.
-
-    The largest forces push the pin's contact arc past Hertz's limit; the library
-    warns of it at each such cycle, and docs/dissipation.md says so once.
-    """
-    warnings.simplefilter("ignore", HertzValidityWarning)
-    panels = []
-    for clearance in (0.106e-3, 0.196e-3):
-        joint = _joint(clearance)
-        pin = Pin.for_clearance(radius=5e-3, clearance=clearance, length=25e-3)
-        grid = np.geomspace(2e-6, 3e-4, 80)
-        closed = ds.energies(joint, grid, pin=pin, **LOSSES)  # type: ignore[arg-type]
-        exact_a, exact = [], {key: [] for key in ds.ENERGY_KEYS if key.endswith("_j")}
-        initial = None
-        for force in np.geomspace(300.0, 8000.0, 24):
-            try:
-                result = ds.compare(
-                    joint,
-                    float(force),
-                    2 * math.pi * 400.0,
-                    pin=pin,
-                    initial=initial,
-                    samples_per_period=256,
-                    max_periods=4000,
-                    **LOSSES,
-                )  # type: ignore[arg-type]
-            except SimulationError:
-                continue
-            initial = result.cycle.initial_state
-            if result.penetration <= 0.0:
-                continue
-            exact_a.append(result.penetration)
-            for key in exact:
-                exact[key].append(result.exact[key])
-        panels.append(
-            EnergyPanel(
-                title=f"c = {clearance * 1e3:.3f} mm (exact: 400 Hz, F0 stepped)",
-                amplitude=grid,
-                closed=closed,
-                exact_amplitude=np.array(exact_a),
-                exact={key: np.array(val) for key, val in exact.items()},
-            )
-        )
-    dissipation_figure(panels).savefig(HERE / "dissipation_vs_amplitude.png", dpi=110)
-    joint = _joint(0.106e-3)
-    pin = Pin.for_clearance(radius=5e-3, clearance=0.106e-3, length=25e-3)
-    survey = ds.agreement_map(
-        joint,
-        2 * math.pi * np.linspace(100.0, 900.0, 17),
-        np.linspace(200.0, 5000.0, 17),
-        pin=pin,
-        **LOSSES,
-    )  # type: ignore[arg-type]
-    fig = agreement_map_figure(
-        survey.omega,
-        survey.force,
-        survey.gap["total_j"],
-        survey.penetration,
-        title="c = 0.106 mm: grey where the closed-form total\nis within 5 % of the exact cycle",
-    )
-    fig.savefig(HERE / "dissipation_agreement_map.png", dpi=110)
-    inside = np.abs(survey.gap["total_j"]) <= 0.05
-    print(
-        f"agreement map: {int(np.sum(inside))} of {inside.size} points within 5 %, "
-        f"{int(np.sum(np.isnan(survey.gap['total_j'])))} without a periodic orbit"
-    )
-
-
-def rig_picture() -> None:
-    """One record of the default campaign, with the exact cycle's stages over its last cycles."""
-    from clearjoint.rig import load_campaign, simulate_test, structure_under_test
-    from clearjoint.simulate import steady_state
-
-    campaign = load_campaign()
-    spec = next(t for t in campaign.tests if t.file_stem == "joint-1_40Hz_1600N")
-    seed = np.random.SeedSequence(campaign.seed).spawn(len(campaign.tests))[spec.index]
-    record, _ = simulate_test(campaign.rig, spec, campaign.periods, seed)
-    joint, _, _ = structure_under_test(campaign.rig, spec)
-    rig = campaign.rig
-    cycle = steady_state(
-        joint,
-        spec.force_amplitude,
-        2 * math.pi * spec.frequency_hz,
-        damping_ratio=rig.damping_ratio,
-        friction=rig.bearing_friction,
-        restitution=rig.restitution,
-    )
-    period = 1.0 / spec.frequency_hz
-    first = campaign.periods - 3
-    stages = [
-        (st.name, (first + k) * period + st.start, (first + k) * period + st.end)
-        for k in range(3)
-        for st in cycle.stages
-    ]
-    keep = record.time >= first * period
-    fig = displacement_stages_figure(
-        record.time[keep],
-        record.displacement[keep],
-        stages,
-        title="Virtual rig, joint 1 (c = 0.106 mm), 1.6 kN at 40 Hz: the measured record",
-    )
-    fig.savefig(HERE / "rig_record_stages.png", dpi=110)
-    restoring = record.force - record.mass * record.acceleration  # type: ignore[operator]
-    fig = force_displacement_figure(
-        record.displacement[keep],
-        restoring[keep],
-        label="force - m x'' (measured)",
-        title="The same record: restoring force against displacement",
-    )
-    fig.axes[0].lines[0].set_linestyle("none")
-    fig.axes[0].lines[0].set_marker(".")
-    fig.axes[0].lines[0].set_markersize(2)
-    fig.savefig(HERE / "rig_record_loop.png", dpi=110)
+from docs_figures import save  # noqa: E402
 
 
 def main() -> None:
-    HERE.mkdir(exist_ok=True)
-    fig = stiffness_coefficient_figure(
-        stiffness_study(), title="Stiffness coefficient against amplitude (paper Fig. 12)"
-    )
-    fig.savefig(HERE / "fig12_stiffness_coefficient.png", dpi=110)
-    print(f"wrote {HERE / 'fig12_stiffness_coefficient.png'}")
+    import matplotlib.pyplot as plt
 
-    # the exact steady cycle of examples/study.toml's joint, without the pin
-    ss = example_cycle()
-    stages = [(s.name, s.start, s.end) for s in ss.stages]
-    fig = displacement_stages_figure(
-        ss.time,
-        ss.displacement,
-        stages,
-        title="Exact steady cycle, 1 kN at 400 Hz, c = 0.106 mm (paper Fig. 7)",
-    )
-    fig.savefig(HERE / "fig7_displacement_stages.png", dpi=110)
-    fig = force_displacement_figure(
-        ss.displacement,
-        ss.excitation,
-        label="excitation force F0 sin(wt)",
-        title="Excitation force against displacement",
-    )
-    fig.savefig(HERE / "loop_force_displacement.png", dpi=110)
-    print(f"wrote {HERE / 'fig7_displacement_stages.png'} and the loop")
-    dissipation_pictures()
-    print("wrote the dissipation pictures")
-    rig_picture()
-    print("wrote the rig pictures")
+    for script in sorted(GALLERY.glob("plot_*.py")):
+        here = Path.cwd()
+        os.chdir(script.parent)  # as sphinx-gallery runs it
+        try:
+            names = runpy.run_path(str(script), run_name="__main__")
+        finally:
+            os.chdir(here)
+        for name, figure in names.get("DOCS_FIGURES", {}).items():
+            print(f"wrote {save(name, figure)}")
+        plt.close("all")
 
 
 if __name__ == "__main__":

@@ -18,11 +18,26 @@ from clearjoint.cli import main as cli
 HERE = Path(__file__).parent / "figures"
 
 
+def _name(alt: str) -> str | None:
+    """A figure's file name from its caption: figN, fig8_contact (slopes) or fig_truth."""
+    number = re.match(r"Fig\. (\d+)", alt)
+    if number:
+        return f"fig{number.group(1)}"
+    if alt.startswith("Contact slopes"):
+        return "fig8_contact"
+    if alt.startswith("Identification against"):
+        return "fig_truth"
+    return None
+
+
 def save_figures(report: Path, prefix: str) -> None:
     page = report.read_text(encoding="utf-8")
-    pattern = r'<img alt="Fig\. (\d+)[^"]*" src="data:image/png;base64,([^"]+)"'
-    for number, data in re.findall(pattern, page):
-        path = HERE / f"{prefix}_fig{number}.png"
+    pattern = r'<img alt="([^"]*)" src="data:image/png;base64,([^"]+)"'
+    for alt, data in re.findall(pattern, page):
+        name = _name(alt)
+        if name is None:
+            continue
+        path = HERE / f"{prefix}_{name}.png"
         path.write_bytes(base64.b64decode(data))
         print(f"wrote {path}")
 

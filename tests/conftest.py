@@ -8,9 +8,34 @@ explicit regression tests, as tests/test_simulate.py does).
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
+import pytest
 from hypothesis import settings
 
 settings.register_profile("repeatable", derandomize=True, print_blob=True)
 settings.register_profile("explore", derandomize=False, max_examples=200)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
+
+
+#: A small campaign for the study tests: 3 structures x 3 frequencies x 3 forces.
+SMALL_CAMPAIGN = """
+seed = 5
+periods = 12
+[grid]
+frequencies = ["20Hz", "60Hz", "100Hz"]
+force_amplitudes = ["1000N", "2000N", "3000N"]
+"""
+
+
+@pytest.fixture(scope="session")
+def reproduction(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A `clearjoint reproduce` of SMALL_CAMPAIGN (with its control run), shared by the tests."""
+    from clearjoint.cli import main
+
+    folder = tmp_path_factory.mktemp("reproduce")
+    campaign = folder / "campaign.toml"
+    campaign.write_text(SMALL_CAMPAIGN)
+    out = folder / "out"
+    assert main(["reproduce", "--out", str(out), "--campaign", str(campaign), "--jobs", "2"]) == 0
+    return out

@@ -206,6 +206,73 @@ def test_bad_input(call: object, words: str) -> None:
         call()  # type: ignore[operator]
 
 
+# ---- Energies: what energies() returns, as a result ----------------------------------------
+
+LOSSES = {
+    "friction": Friction(0.2, 300.0),
+    "pin": PIN,
+    "contact_friction_coefficient": 0.15,
+    "restitution": 0.8,
+    "damping_ratio": 0.01,
+}
+
+
+def test_energies_result_is_still_the_mapping_it_was() -> None:
+    values = ds.energies(joint(), np.array([5e-6, 2e-5]), **LOSSES)  # type: ignore[arg-type]
+    assert list(values) == list(ds.ENERGY_KEYS)
+    assert dict(values).keys() == set(ds.ENERGY_KEYS)
+    assert values["impact_j"] is values.impact_j
+    with pytest.raises(KeyError):
+        values["amplitude"]
+
+
+def test_energies_repr_stays_short_for_many_amplitudes() -> None:
+    a = np.geomspace(1e-6, 2e-5, 10_000)
+    values = ds.energies(joint(), a, **LOSSES)  # type: ignore[arg-type]
+    text = repr(values)
+    assert len(text) < 200
+    assert "10000 amplitudes" in text
+    # the impact energy alone bounds the total from below; the total's top end is printed
+    top = float(np.max(values["total_j"])) * 1e3
+    assert f"{top:.4g} mJ" in text
+
+
+def test_energies_to_xarray_and_pandas_round_trip_with_units() -> None:
+    a = np.array([1e-6, 5e-6, 2e-5])
+    values = ds.energies(joint(), a, **LOSSES)  # type: ignore[arg-type]
+    data = values.to_xarray()
+    np.testing.assert_array_equal(data["amplitude"].values, a)
+    assert data["amplitude"].attrs["units"] == "m"
+    for key in ds.ENERGY_KEYS:
+        np.testing.assert_array_equal(data[key].values, values[key])
+    assert data["total_j"].attrs["units"] == "J"
+    assert data["loss_factor"].attrs["units"] == "1"
+    assert data["hertz_half_width_m"].attrs["units"] == "m"
+    table = values.to_pandas()
+    assert list(table.columns) == list(ds.ENERGY_KEYS)
+    np.testing.assert_array_equal(table.index.to_numpy(), a)
+    # a scalar amplitude is a one-row table
+    assert ds.energies(joint(), 1e-5).to_pandas().shape == (1, len(ds.ENERGY_KEYS))
+
+
+def test_energies_plot_draws_the_total_in_mj_against_a_in_um() -> None:
+    from matplotlib.figure import Figure
+
+    a = np.geomspace(1e-6, 2e-5, 40)
+    values = ds.energies(joint(), a, **LOSSES)  # type: ignore[arg-type]
+    ax = Figure().add_subplot()
+    assert values.plot(ax) is ax
+    lines = {line.get_label(): line for line in ax.lines}
+    total = lines["total E_Z"]
+    np.testing.assert_allclose(total.get_xdata(), a * 1e6)
+    # the total is the sum of the mechanisms, added here independently of the library's total
+    parts = sum(values[k] for k in ("sliding_friction_j", "contact_friction_j", "impact_j"))
+    np.testing.assert_allclose(total.get_ydata(), (parts + values["viscous_j"]) * 1e3, rtol=1e-14)
+    impact = lines["impact E_I"]
+    np.testing.assert_allclose(impact.get_ydata(), values["impact_j"] * 1e3)
+    assert ax.get_xscale() == "log"
+
+
 def test_energies_accept_a_losses_value_for_the_five_keywords() -> None:
     from clearjoint import Joint, Losses
 

@@ -42,3 +42,20 @@ def test_loop_figure_closes_the_loop() -> None:
     fig = force_displacement_figure(1e-5 * x, 100 * x)
     line = fig.axes[0].get_lines()[0]
     assert line.get_xdata()[0] == line.get_xdata()[-1]
+
+
+def test_fig13_names_its_reference_and_puts_the_one_to_one_line_in_the_legend() -> None:
+    from clearjoint.figures import law_versus_measured_figure
+
+    measured = np.geomspace(0.05, 0.4, 12)
+    fig = law_versus_measured_figure(measured, measured * 1.1, reference="virtual rig")
+    (ax,) = fig.axes
+    assert ax.get_xlabel().startswith("virtual rig")
+    assert "1:1" in [t.get_text() for t in ax.get_legend().get_texts()]
+    fig.canvas.draw()  # labels exist only once drawn
+    assert all(not t.get_text() for t in ax.xaxis.get_minorticklabels())
+    shown = [t.get_text() for t in ax.xaxis.get_majorticklabels() if t.get_text()]
+    assert 2 <= len(shown) <= 6  # 1, 2, 5 per decade over less than a decade
+    assert (
+        law_versus_measured_figure(measured, measured).axes[0].get_xlabel().startswith("measured")
+    )

@@ -120,3 +120,54 @@ def test_refuses_too_few_points_and_singular_designs() -> None:
         fit.stiffness_law([1.0, 2.0, 3.0, 4.0, math.nan], [1.0] * 5, [1.0] * 5)
     with pytest.raises(fit.FitError, match="energies must be > 0"):
         fit.exponential_law([1.0, 2.0, 3.0], [1.0, 0.0, 2.0])
+
+
+def test_each_law_is_evaluated_through_its_own_design() -> None:
+    omega, amplitude, rng = grid(n=40)
+    clearance = rng.choice([0.106e-3, 0.196e-3], omega.size)
+    energy = np.exp(-3.0 + 2e-3 * omega + 4e4 * amplitude + rng.normal(0, 0.01, omega.size))
+    exp_law = fit.exponential_law(amplitude, energy)
+    np.testing.assert_allclose(
+        fit.evaluate_exponential_law(exp_law, amplitude),
+        np.exp(exp_law.values[0]) * np.exp(exp_law.values[1] * amplitude),
+    )
+    power = fit.power_law(omega, clearance, amplitude, energy)
+    g0, g1, g2, g3 = power.values
+    np.testing.assert_allclose(
+        fit.evaluate_power_law(power, omega, clearance, amplitude),
+        np.exp(g0) * omega**g1 * amplitude**g2 * np.exp(g3 * clearance),
+    )
+    k = 2e3 * omega + 1e10 * amplitude + 5e7
+    law = fit.stiffness_law(omega, amplitude, k)
+    assert fit.evaluate_stiffness_law(law, 100.0, 20e-6) == pytest.approx(
+        2e3 * 100.0 + 1e10 * 20e-6 + 5e7
+    )
+
+
+def test_slope_and_its_standard_error_by_hand() -> None:
+    omega, amplitude, rng = grid(n=50)
+    clearance = rng.choice([0.106e-3, 0.196e-3], omega.size)
+    energy = np.exp(-4.0 + 1e-3 * omega - 3e3 * clearance + 2e4 * amplitude)
+    energy *= np.exp(rng.normal(0, 0.03, omega.size))
+    law = fit.dissipation_law(omega, clearance, amplitude, energy)
+    a = 40e-6
+    value, error = fit.slope(law, [0, 0, 1, 0, 0, a])  # d ln E / dc at A
+    assert value == pytest.approx(law.values[2] + a * law.values[5])
+    var = law.covariance[2, 2] + a * a * law.covariance[5, 5] + 2 * a * law.covariance[2, 5]
+    assert error == pytest.approx(math.sqrt(var))
+    with pytest.raises(fit.FitError, match="3 weights"):
+        fit.slope(law, [1, 0, 0])
+
+
+def test_quadratic_check_sees_saturation_and_a_first_fall() -> None:
+    omega, amplitude, rng = grid(n=60)
+    saturating = 1.0 - np.exp(-amplitude / 30e-6) + rng.normal(0, 1e-3, omega.size)
+    law = fit.quadratic_law(amplitude, omega, saturating)
+    assert law.values[2] < -3 * law.errors[2]  # the rate of increase falls
+    falling_first = (omega - 400.0) ** 2 * 1e-3 + rng.normal(0, 1.0, omega.size)
+    law = fit.quadratic_law(omega, amplitude, falling_first)
+    first, error = fit.slope(law, [0, 1, 2 * omega.min(), 0])
+    assert first < -3 * error
+    np.testing.assert_allclose(
+        fit.evaluate_quadratic_law(law, omega, amplitude), falling_first, atol=5.0
+    )

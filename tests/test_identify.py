@@ -1,4 +1,7 @@
-"""identify.py: accuracy against the rig's truth, an exact friction loop, and the real BRFD data."""
+"""clearjoint.identify: against the rig's truth, an exact friction loop, an independent
+solve_ivp simulator with 1 % noise on every channel (tests/independent_joint.py), real BRFD
+records shipped in tests/data/brfd (and all 31 when ../shared is beside the clone), flags,
+the result object and the command line."""
 
 from __future__ import annotations
 
@@ -11,11 +14,14 @@ import pytest
 import xarray as xr
 
 from clearjoint.cli import main
-from clearjoint.identify import IdentificationError, identify
+from clearjoint.identify import IdentificationError, identify, identify_files
 from clearjoint.records import Record, read_record
 from clearjoint.rig import load_campaign, run_campaign
+from independent_joint import TrueJoint, steady_truth, write_record
 
 BRFD = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
+#: Three real BRFD records shipped with the tests (2 Hz, 0.5 in; 0, 30 and 36 lb; CC BY-SA 4.0).
+SHIPPED = Path(__file__).resolve().parent / "data" / "brfd"
 
 REDUCED = """
 seed = 11
@@ -136,26 +142,27 @@ def test_exact_friction_loop_with_backlash() -> None:
 
 @pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
 def test_real_brfd_records() -> None:
-    identified = 0
-    for path in sorted(BRFD.glob("*.json")):
-        if path.name == "2Hz0lbtension1amplitude.json":  # two steady cycles only (docs)
-            with pytest.raises(IdentificationError, match="steady cycles"):
-                identify(read_record(path))
-            continue
-        result = identify(read_record(path))
-        identified += 1
+    results, failures = identify_files([str(p) for p in sorted(BRFD.glob("*.json"))])
+    # the one record refused: its ramps leave two steady cycles (docs)
+    assert len(failures) == 1
+    assert "2Hz0lbtension1amplitude.json: 2 steady cycles" in failures[0]
+    assert "a record needs at least 3 steady cycles" in failures[0]  # the rule, stated
+    assert len(results) == 30
+    backlash: dict[str, list[float]] = {}
+    for _, result in results:
         s = result.summary
-        assert result.cycles_used >= 2
-        assert s["energy_per_cycle_j"] > 0
-        # the 0 lb band-tension tests have little friction and, per the data set's own
-        # notes, possibly a wrong tension: their loops are not rigid-plastic (docs)
-        if "0lbtension" not in path.name:
-            assert result.model == "damper", path.name
-            # independent route: a rigid-plastic friction loop with backlash b
-            estimate = 2 * s["friction_force_n"] * (2 * s["amplitude_m"] - s["clearance_m"])
-            assert 0.7 < s["energy_per_cycle_j"] / estimate < 1.25, path.name
-            assert 3e-3 < s["clearance_m"] < 8e-3, path.name
-    assert identified == 30
+        assert result.model == "damper", result.source
+        assert result.cycles_used >= 3
+        # independent route: an elastic-plastic friction loop with a gap b
+        assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
+        tension = result.source.split("Hz")[1].split("lb")[0]
+        backlash.setdefault(tension, []).append(s["clearance_m"])
+    # one device: the backlash within 15 % of the median at its band tension; three of the
+    # thirty miss it today (docs/identify.md says which)
+    misses = sum(
+        abs(b / np.median(values) - 1.0) > 0.15 for values in backlash.values() for b in values
+    )
+    assert misses <= 3
 
 
 def test_short_and_shapeless_records_are_refused() -> None:
@@ -222,3 +229,213 @@ def test_cli_refuses_when_nothing_is_usable(
     junk.write_text(json.dumps({"a": 1}))
     assert main(["identify", str(junk), "--out", str(tmp_path / "r.csv"), "--quiet"]) == 2
     assert "no record could be used" in capsys.readouterr().err
+
+
+# ---- records from an independent simulator (tests/independent_joint.py, not the rig) -------
+
+
+@pytest.fixture(scope="module")
+def independent() -> dict[float, tuple[TrueJoint, dict[str, float]]]:
+    joints = {f: TrueJoint(frequency_hz=f) for f in (40.0, 100.0)}
+    return {f: (j, steady_truth(j)) for f, j in joints.items()}
+
+
+def test_the_independent_simulator_balances_its_energy(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]],
+) -> None:
+    for _, truth in independent.values():
+        # the exciter's work over a steady cycle is what friction and drag dissipate
+        assert truth["external_work_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=1e-6)
+        assert truth["amplitude_m"] > 0.5 * TrueJoint().clearance  # the contacts are reached
+
+
+def test_noise_free_independent_records_with_acceleration(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path
+) -> None:
+    for f, (joint, truth) in independent.items():
+        path = write_record(joint, tmp_path / f"{f}.csv", noise=0.0, cycles=12)
+        s = identify(read_record(path)).summary
+        for key in ("clearance_m", "compression_stiffness_n_per_m", "tension_stiffness_n_per_m"):
+            assert s[key] == pytest.approx(truth[key], rel=0.01), (f, key)
+        assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.05)
+        assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+KEYS = ("clearance_m", "compression_stiffness_n_per_m", "tension_stiffness_n_per_m")
+
+
+@pytest.mark.parametrize("frequency", [40.0, 100.0])
+def test_one_percent_noise_on_every_channel_with_acceleration(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path, frequency: float
+) -> None:
+    joint, truth = independent[frequency]
+    path = write_record(joint, tmp_path / "noisy.csv", noise=0.01, acceleration=True)
+    s = identify(read_record(path)).summary
+    assert s["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01)
+    for key in KEYS[1:]:
+        assert s[key] == pytest.approx(truth[key], rel=0.02), key
+    assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10)
+    assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+@pytest.mark.parametrize("frequency", [40.0, 100.0])
+def test_one_percent_noise_without_acceleration(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path, frequency: float
+) -> None:
+    joint, truth = independent[frequency]
+    path = write_record(joint, tmp_path / "noisy.csv", noise=0.01, acceleration=False)
+    result = identify(read_record(path))
+    s = result.summary
+    for key in KEYS[1:]:
+        assert s[key] == pytest.approx(truth[key], rel=0.02), key
+    assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+    if frequency == 40.0:  # at 100 Hz the free-play crossing is too short (docs)
+        assert s["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01)
+        assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10)
+    # every value carries a standard error
+    assert all(result.stderr[k] > 0 for k in KEYS)
+
+
+def test_force_control_without_a_mass_warns_and_estimates_it(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path
+) -> None:
+    joint, truth = independent[40.0]
+    path = write_record(joint, tmp_path / "nomass.csv", noise=0.01, mass_in_metadata=False)
+    result = identify(read_record(path))
+    assert len(result.warnings) == 1
+    assert "without a mass" in result.warnings[0]
+    assert "# mass = " in result.warnings[0]  # says how to add it
+    assert result.summary["mass_kg"] == pytest.approx(joint.mass, rel=0.02)
+    assert result.summary["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01)
+    flag, reason = result.flags["clearance_m"]
+    assert flag == "doubtful"
+    assert "mass" in reason
+    assert result.row()["flag"] == "doubtful"
+
+
+# ---- real records shipped with the tests ------------------------------------------------
+
+
+def elastic_plastic_energy(s: dict[str, float]) -> float:
+    """Loop area of an elastic-plastic friction loop with a gap: 2 F_f (2X - b - 2 F_f / k)."""
+    k = 0.5 * (s["compression_stiffness_n_per_m"] + s["tension_stiffness_n_per_m"])
+    f_f, x, b = s["friction_force_n"], s["amplitude_m"], s["clearance_m"]
+    return 2 * f_f * (2 * x - b - 2 * f_f / k)
+
+
+@pytest.mark.parametrize("tension", [0, 30, 36])
+def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
+    record = read_record(SHIPPED / f"2Hz{tension}lbtension0.5amplitude.json")
+    assert "band tension" in record.notes
+    result = identify(record)
+    s = result.summary
+    assert result.model == "damper"
+    assert result.cycles_used >= 3
+    # the device's backlash is a few millimetres (3.5 to 4.1 mm median per band tension over
+    # the 31 files, docs/identify.md)
+    assert 2e-3 < s["clearance_m"] < 6e-3
+    # the slip levels of both directions, with the friction force half their difference
+    up, down = s["friction_force_positive_n"], s["friction_force_negative_n"]
+    assert up > 0 > down
+    assert s["friction_force_n"] == pytest.approx(0.5 * (up - down))
+    assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
+
+
+# ---- the result object and the command line ---------------------------------------------
+
+
+def test_identification_repr_tables_and_plot() -> None:
+    result = identify(read_record(SHIPPED / "2Hz36lbtension0.5amplitude.json"))
+    text = repr(result)
+    assert text.startswith("Identification(")
+    assert "model='damper'" in text
+    assert len(text) < 400
+    assert "array" not in text
+    data = result.to_xarray()
+    assert data.sizes["cycle"] == result.cycles_used
+    assert data["clearance_m"].attrs["units"] == "m"
+    assert data["clearance_m"].attrs["estimate"] == result.summary["clearance_m"]
+    assert data["clearance_m"].attrs["flag"] in ("ok", "doubtful", "rejected")
+    # three cycles, three jackknife groups: the cycles' pseudo-values' spread over sqrt(3)
+    # is the standard error
+    values = data["clearance_m"].to_numpy()
+    assert values.size == 3
+    assert np.std(values, ddof=1) / np.sqrt(3) == pytest.approx(result.stderr["clearance_m"])
+    table = result.to_pandas()
+    assert table.loc["friction_force_n", "unit"] == "N"
+    assert set(table["flag"]) <= {"ok", "doubtful", "rejected"}
+    import matplotlib
+
+    matplotlib.use("Agg")
+    ax = result.plot()
+    assert ax.get_xlabel() == "displacement (mm)"
+    assert len(ax.lines) >= 1
+
+
+def test_cli_plot_flags_warnings_and_jobs(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    joint, _ = independent[40.0]
+    nomass = write_record(joint, tmp_path / "nomass.csv", noise=0.01, mass_in_metadata=False)
+    files = [str(p) for p in sorted(SHIPPED.glob("*.json"))] + [str(nomass)]
+    out, plot = tmp_path / "r.csv", tmp_path / "loops.png"
+    assert main(["identify", *files, "--out", str(out), "--plot", str(plot), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert "clearjoint identify: warning: " in err
+    assert "without a mass" in err
+    assert plot.stat().st_size > 0
+    with out.open() as handle:
+        table = list(csv.DictReader(handle))
+    assert {"flag", "flag_reason", "clearance_m_se"} <= set(table[0])
+    assert table[-1]["flag"] == "doubtful"
+    assert "mass" in table[-1]["flag_reason"]
+    # an existing plot is not overwritten without --force
+    assert main(["identify", *files, "--out", str(tmp_path / "s.csv"), "--plot", str(plot)]) == 2
+    assert "will not overwrite" in capsys.readouterr().err
+    # two processes give the serial results, in file order
+    serial, _ = identify_files(files)
+    parallel, _ = identify_files(files, jobs=2)
+    for (_, a), (_, b) in zip(serial, parallel, strict=True):
+        np.testing.assert_equal(a.row(), b.row())  # NaN equals NaN here
+
+
+def test_a_clearance_twice_the_median_of_the_device_is_flagged() -> None:
+    from dataclasses import replace
+
+    from clearjoint.identify import flag_outliers
+
+    base = identify(read_record(SHIPPED / "2Hz36lbtension0.5amplitude.json"))
+    assert base.joint_id == "BRFD"
+    c = base.summary["clearance_m"]
+    tests = [
+        replace(base, source=f"t{k}", summary={**base.summary, "clearance_m": c * factor})
+        for k, factor in enumerate((1.0, 1.1, 0.9, 2.5))
+    ]
+    flagged = flag_outliers(tests)
+    assert [t.flags["clearance_m"][0] for t in flagged[:3]] == [base.flags["clearance_m"][0]] * 3
+    flag, reason = flagged[3].flags["clearance_m"]
+    assert flag == "doubtful"
+    assert "more than twice the median" in reason
+    assert "BRFD" in reason
+    # another device's tests are not compared with these
+    other = replace(tests[3], joint_id="other")
+    assert flag_outliers([*tests[:3], other])[3].flags == other.flags
+
+
+def test_the_steady_cycle_rule_is_stated_where_a_record_is_refused() -> None:
+    from clearjoint.identify import steady_rule
+
+    t = np.arange(300) / 100.0
+    short = Record(
+        time=t,
+        force=np.sin(2 * np.pi * t),
+        displacement=np.sin(2 * np.pi * t),
+        control="displacement",
+        source="short",
+    )
+    with pytest.raises(IdentificationError) as refused:
+        identify(short, tolerance=0.05)
+    assert steady_rule(0.05) in str(refused.value)
+    assert "5%" in steady_rule(0.05)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -228,3 +229,119 @@ def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
     path.write_text(json.dumps({"data": [[0.0, 1.0]] * 20, "displacement units": "in"}))
     with pytest.raises(RecordError, match="must have 6 columns"):
         read_brfd(path)
+
+
+def test_fast_unit_factors_agree_with_pint() -> None:
+    from clearjoint.records import FAST_FACTORS, SI
+    from clearjoint.units import registry
+
+    for (channel, unit), factor in FAST_FACTORS.items():
+        exact = registry().Quantity(1.0, unit).to(SI[channel]).magnitude
+        assert factor == pytest.approx(exact, rel=1e-12), (channel, unit)
+
+
+def test_metadata_takes_units_or_a_unit_named_key_never_a_bare_number(tmp_path: Path) -> None:
+    times = [i / 100 for i in range(50)]
+    good = write_csv(tmp_path, CSV_MAGIC + "\n# frequency_hz = 10\n# clearance = \"0.1mm\"\n"
+                     + csv_body(times), "good.csv")  # fmt: skip
+    record = read_record(good)
+    assert (record.frequency_hz, record.clearance) == pytest.approx((10.0, 1e-4))
+    bad = write_csv(tmp_path, CSV_MAGIC + "\n# clearance = 0.1\n" + csv_body(times))
+    with pytest.raises(RecordError, match=r"clearance = 0\.1: give a unit"):
+        read_record(bad)
+
+
+# ---- issue 16: lab CSV files as labs write them (each file written here by hand) ------------
+
+RATE = 12000.0  # Hz, the issue's recorder
+N_LAB = 1200  # 0.1 s: five cycles at 50 Hz
+
+
+def lab_signals(i: int) -> tuple[float, float, float]:
+    """Exact time (s), force (kN) and displacement (mm) of sample i."""
+    t = i / RATE
+    return t, 1.5 * math.sin(2 * math.pi * 50 * t), 0.02 * math.cos(2 * math.pi * 50 * t)
+
+
+def check_lab_record(r: Record) -> None:
+    """The record holds the exact signals in SI, on the uniform 12 kHz clock.
+
+    The clock is fitted to stamps rounded to 1 us: it is found within 1 % of that.
+    """
+    i = np.arange(N_LAB)
+    np.testing.assert_allclose(r.time, i / RATE, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(r.force, 1500 * np.sin(2 * np.pi * 50 * i / RATE), atol=1e-3)
+    np.testing.assert_allclose(r.displacement, 2e-5 * np.cos(2 * np.pi * 50 * i / RATE), atol=1e-9)
+
+
+def test_lab_csv_semicolon_decimal_comma_key_value_preamble_units_row(tmp_path: Path) -> None:
+    lines = ["Device;Rig A", "Operator: J. Smith", "Sample rate = 12000 Hz", "",
+             "Time;Force;Displacement", "s;kN;mm"]  # fmt: skip
+    for i in range(N_LAB):
+        t, f, x = lab_signals(i)
+        lines.append(f"{t:.6f};{f:.6f};{x:.7f}".replace(".", ","))  # rounded to 1 us
+    path = tmp_path / "lab.csv"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    r = read_record(path)
+    check_lab_record(r)
+    assert r.units == {"time": "s", "force": "kN", "displacement": "mm"}
+    assert "Operator: J. Smith" in r.notes
+
+
+def test_lab_csv_tab_comment_preamble_units_in_parentheses(tmp_path: Path) -> None:
+    lines = ["# exported by DAQ 4.2", "// channel 3 unused", "% gain 10",
+             "time (ms)\tforce (N)\tdisplacement (um)"]  # fmt: skip
+    for i in range(N_LAB):
+        t, f, x = lab_signals(i)
+        lines.append(f"{t * 1e3:.3f}\t{f * 1e3:.4f}\t{x * 1e3:.4f}")  # ms to 1 us
+    path = tmp_path / "lab.txt"
+    path.write_text("\r\n".join(lines) + "\r\n", encoding="latin-1")
+    check_lab_record(read_record(path))
+
+
+def test_lab_csv_comma_with_a_bom_and_the_issue_rounding(tmp_path: Path) -> None:
+    """The issue's file: 12 kHz, times rounded to 1 us, refused before as uneven."""
+    body = "time [s],force [kN],displacement [mm]\n" + "".join(
+        "{:.6f},{:.6f},{:.7f}\n".format(*lab_signals(i)) for i in range(N_LAB)
+    )
+    path = tmp_path / "lab.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + body.encode())
+    check_lab_record(read_record(path))
+
+
+def test_lab_csv_tab_decimal_comma_trailing_delimiter(tmp_path: Path) -> None:
+    lines = ["time [s]\tforce [kN]\tdisplacement [mm]\t"]
+    for i in range(N_LAB):
+        t, f, x = lab_signals(i)
+        lines.append(f"{t:.6f}\t{f:.6f}\t{x:.7f}\t".replace(".", ","))
+    path = tmp_path / "lab.csv"
+    path.write_text("\n".join(lines) + "\n")
+    check_lab_record(read_record(path))
+
+
+def test_uneven_beyond_the_clock_resolution_is_still_refused(tmp_path: Path) -> None:
+    jitter = [0.0, 4e-6, -3e-6, 5e-6]  # up to 5 us on a clock written to 1 us
+    body = "time [s],force [kN],displacement [mm]\n" + "".join(
+        "{:.6f},{:.6f},{:.7f}\n".format(lab_signals(i)[0] + jitter[i % 4], *lab_signals(i)[1:])
+        for i in range(N_LAB)
+    )
+    path = write_csv(tmp_path, body)
+    with pytest.raises(RecordError, match="beyond their resolution 1e-06 s"):
+        read_record(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("Device;Rig A\nthis line is junk\ntime;force;displacement\ns;N;m\n", "line 2"),
+        ("time;force;displacement\n", "has no unit"),
+        ("time [s];force [N];displacement [m];velocity [m/s]\n", "names 4 columns"),
+        ("time [s];force [(];displacement [m]\n", "unknown unit '('"),  # pint asserted here
+    ],
+)
+def test_lab_csv_problems_are_named(tmp_path: Path, text: str, words: str) -> None:
+    path = write_csv(tmp_path, text + "".join(f"{i / 100};1;2\n" for i in range(50)))
+    with pytest.raises(RecordError) as info:
+        read_record(path)
+    assert words in str(info.value)
+    assert str(path) in str(info.value)

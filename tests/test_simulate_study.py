@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 from pathlib import Path
@@ -97,7 +98,10 @@ def test_cli_json_and_netcdf_match_the_library(
     assert result["energy_j"]["input"] == pytest.approx(direct.energy.input, rel=1e-12)
     assert result["balance_error"] < 1e-9
     with xr.open_dataset(out, engine="h5netcdf") as data:
-        np.testing.assert_allclose(data["displacement"].values, direct.displacement)
+        n = direct.time.size  # the exact orbit, repeated over [output] periods = 8
+        np.testing.assert_allclose(data["displacement"].values[:n], direct.displacement)
+        np.testing.assert_allclose(data["displacement"].values[n : 2 * n], direct.displacement)
+        assert data["time"].size == n * math.ceil(8 / direct.period_multiple)
         assert data["displacement"].attrs["units"] == "m"
         assert data.attrs["clearance_m"] == pytest.approx(0.106e-3)
         assert set(data["stage_name"].values) <= {"free-play", "compression", "tension"}
@@ -124,3 +128,89 @@ def test_cli_table_and_transient(tmp_path: Path, capsys: pytest.CaptureFixture[s
 def test_cli_bad_study_exit_code_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["simulate", str(tmp_path / "missing.toml")]) == 2
     assert "no such study file" in capsys.readouterr().err
+
+
+# ---- issue 16: units by dimension, bare numbers only where the key names the unit ----------
+
+
+@pytest.mark.parametrize(
+    ("frequency", "omega"),
+    [
+        ('frequency = "2513rad/s"', 2513.0),  # was run at 2513 Hz
+        ('frequency = "400rpm"', 2.0 * math.pi * 400.0 / 60.0),  # was run at 41.89 Hz
+        ('frequency = "0.4kHz"', 2.0 * math.pi * 400.0),
+        ("frequency_hz = 400", 2.0 * math.pi * 400.0),
+    ],
+)
+def test_study_frequencies_convert_by_dimension(
+    tmp_path: Path, frequency: str, omega: float
+) -> None:
+    study = load_study(write(tmp_path, MINIMAL.replace('frequency = "400Hz"', frequency)))
+    assert study.omega == pytest.approx(omega, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "words"),
+    [
+        ('mass = "2kg"', "mass = 2", '[joint] mass = 2: give a unit, e.g. "2kg"'),
+        ('mass = "2kg"', "mass = 2", "or name the SI unit in the key (mass_kg = 2)"),
+        ('"400Hz"', '"0.4m"', "is not a frequency"),
+        ('frequency = "400Hz"', 'frequency_hz = "400Hz"', "the key names its unit"),
+        ('frequency = "400Hz"', 'frequency = "400Hz"\nfrequency_hz = 400', "given twice"),
+    ],
+)
+def test_bare_numbers_only_where_the_key_names_the_unit(
+    tmp_path: Path, old: str, new: str, words: str
+) -> None:
+    path = write(tmp_path, MINIMAL.replace(old, new))
+    with pytest.raises(StudyError) as info:
+        load_study(path)
+    assert words in str(info.value)
+    assert len(str(info.value).splitlines()) == 1
+
+
+def test_unit_named_keys_and_dimensionless_bare_numbers(tmp_path: Path) -> None:
+    text = MINIMAL.replace('mass = "2kg"', "mass_kg = 2").replace(
+        'clearance = "0.106mm"', "clearance_m = 1.06e-4"
+    )
+    study = load_study(write(tmp_path, text))
+    assert (study.joint.mass, study.joint.clearance) == (2.0, 1.06e-4)
+    assert study.damping_ratio == 0.02  # a bare number: the key is dimensionless
+
+
+def test_simulate_output_is_a_record_that_identify_reads(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One netCDF layout: identify recovers the study's joint from simulate's file."""
+    from clearjoint.records import read_record
+
+    study_path = ROOT / "examples" / "study.toml"
+    out = tmp_path / "x.nc"
+    assert main(["simulate", str(study_path), "--out", str(out), "--json"]) == 0
+    ledger = json.loads(capsys.readouterr().out)["energy_j"]
+    record = read_record(out)
+    assert record.control == "force"
+    assert record.mass == 2.0
+    assert record.frequency_hz == pytest.approx(400.0)
+    results = tmp_path / "r.csv"
+    assert main(["identify", str(out), "--out", str(results), "--quiet"]) == 0
+    capsys.readouterr()
+    with results.open() as handle:
+        row = next(csv.DictReader(handle))
+    # identify sees only the record; the study's truth: c, k_c, k_t, mu_s P, input per cycle
+    assert float(row["clearance_m"]) == pytest.approx(0.106e-3, rel=1e-6)
+    assert float(row["compression_stiffness_n_per_m"]) == pytest.approx(8e7, rel=1e-6)
+    assert float(row["tension_stiffness_n_per_m"]) == pytest.approx(5e7, rel=1e-6)
+    assert float(row["friction_force_n"]) == pytest.approx(60.0, rel=1e-6)
+    assert float(row["energy_per_cycle_j"]) == pytest.approx(ledger["input"], rel=1e-3)
+
+
+def test_simulate_refuses_an_output_suffix_that_is_not_netcdf(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "result.csv"
+    assert main(["simulate", str(ROOT / "examples" / "study.toml"), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "simulate writes netCDF; name the file .nc" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not out.exists()

@@ -273,3 +273,71 @@ def test_equivalent_response_refuses_bad_input(kwargs: dict[str, object], words:
     args.update(kwargs)
     with pytest.raises(ParameterError, match=words):
         sk.equivalent_linear_response(joint(), **args)  # type: ignore[arg-type]
+
+
+# ---- StiffnessCurve: the c_d curve as a result ----------------------------------------------
+
+
+def _eq9(a: np.ndarray, clearance: float) -> np.ndarray:
+    """Eq 9 by hand for a symmetric joint with k0 = 0: (pi A / (pi A + c))^2."""
+    return (math.pi * a / (math.pi * a + clearance)) ** 2
+
+
+def test_stiffness_curve_matches_eq_9_and_the_single_functions() -> None:
+    j = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    a = np.array([1e-6, 5e-6, 20e-6, 100e-6])
+    curve = sk.stiffness_curve(j, a)
+    np.testing.assert_allclose(curve.stiffness_coefficient, _eq9(a, 0.106e-3), rtol=1e-12)
+    np.testing.assert_allclose(curve.dynamic_stiffness, 8e7 * _eq9(a, 0.106e-3), rtol=1e-12)
+    np.testing.assert_allclose(curve.natural_frequency, 2 * math.pi / curve.period, rtol=1e-15)
+    np.testing.assert_array_equal(curve.period, sk.period(j, a))
+
+
+def test_stiffness_curve_repr_is_short_and_names_the_range() -> None:
+    j = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    a = np.linspace(1e-6, 100e-6, 5000)
+    text = repr(sk.stiffness_curve(j, a))
+    assert len(text) < 250
+    assert "5000 amplitudes" in text
+    assert f"{_eq9(a, 0.106e-3).max():.4g}" in text  # the largest c_d, by hand
+    assert "0.106 mm" in text
+
+
+def test_stiffness_curve_to_xarray_and_pandas_round_trip_with_units() -> None:
+    j = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, gap_stiffness=1e6)
+    a = np.array([0.0, 2e-6, 30e-6])
+    curve = sk.stiffness_curve(j, a)
+    data = curve.to_xarray()
+    np.testing.assert_array_equal(data["amplitude"].values, a)
+    assert data["amplitude"].attrs["units"] == "m"
+    units = {"period": "s", "natural_frequency": "rad/s", "dynamic_stiffness": "N/m"}
+    for name, unit in units.items():
+        np.testing.assert_array_equal(data[name].values, getattr(curve, name))
+        assert data[name].attrs["units"] == unit
+    assert data.attrs["clearance_m"] == 0.106e-3
+    table = curve.to_pandas()
+    assert table.index.name == "amplitude_m"
+    np.testing.assert_array_equal(
+        table["stiffness_coefficient"].to_numpy(), curve.stiffness_coefficient
+    )
+    np.testing.assert_array_equal(table["period_s"].to_numpy(), curve.period)
+
+
+def test_stiffness_curve_plot_draws_c_d_against_amplitude_in_um() -> None:
+    from matplotlib.figure import Figure
+
+    j = Joint(mass=2.0, clearance=0.196e-3, compression_stiffness=8e7)
+    a = np.linspace(0.0, 300e-6, 50)
+    ax = Figure().add_subplot()
+    returned = sk.stiffness_curve(j, a).plot(ax)
+    assert returned is ax
+    line = ax.lines[-1]
+    np.testing.assert_allclose(line.get_xdata(), a * 1e6)
+    np.testing.assert_allclose(line.get_ydata(), _eq9(a, 0.196e-3), rtol=1e-12)
+
+
+def test_stiffness_curve_refuses_a_grid_as_a_table() -> None:
+    j = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    curve = sk.stiffness_curve(j, np.full((2, 3), 1e-5))
+    with pytest.raises(ParameterError, match="1-D amplitude"):
+        curve.to_xarray()

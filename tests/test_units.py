@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 
+from clearjoint import Friction, Joint, Pin, stiffness
 from clearjoint.errors import ParameterError
-from clearjoint.units import parse_quantity, parse_quantity_list
+from clearjoint.simulate import steady_state
+from clearjoint.units import parse_quantity, parse_quantity_list, registry, to_si
 
 
 @pytest.mark.parametrize(
@@ -19,11 +24,17 @@ from clearjoint.units import parse_quantity, parse_quantity_list
         ("80 kN/mm", "stiffness", 8e7),
         ("1.5kg", "mass", 1.5),
         ("20Hz", "frequency", 20.0),
-        ("3", "length", 3.0),
+        ("0", "length", 0.0),  # zero needs no unit
     ],
 )
 def test_parses_to_si(text: str, kind: str, si: float) -> None:
     assert parse_quantity(text, kind, name="--x") == pytest.approx(si, rel=1e-12)
+
+
+def test_bare_numbers_are_si_only_when_asked() -> None:
+    assert parse_quantity("3", "length", name="x", bare="si") == 3.0
+    with pytest.raises(ParameterError, match="give a unit"):
+        parse_quantity("3", "length", name="x")
 
 
 def test_wrong_dimension_names_the_option() -> None:
@@ -37,3 +48,88 @@ def test_list() -> None:
     )
     with pytest.raises(ParameterError, match="empty entry"):
         parse_quantity_list("1um,", "length", name="--a")
+
+
+# ---- issue 16: every quantity by its dimension, bare numbers refused where asked ----------
+
+
+@pytest.mark.parametrize(
+    ("text", "hz"),
+    [
+        ("2513rad/s", 2513.0 / (2.0 * math.pi)),  # 399.96 Hz, not 2513 Hz
+        ("400rpm", 400.0 / 60.0),  # 6.667 Hz, not 41.89 Hz
+        ("360deg/s", 1.0),
+        ("12kHz", 12000.0),
+        ("50 1/s", 50.0),
+    ],
+)
+def test_frequencies_keep_their_two_pi(text: str, hz: float) -> None:
+    assert parse_quantity(text, "frequency", name="frequency") == pytest.approx(hz, rel=1e-12)
+    omega = parse_quantity(text, "angular_frequency", name="omega")
+    assert omega == pytest.approx(2.0 * math.pi * hz, rel=1e-12)
+
+
+@pytest.mark.parametrize("text", ["0.1m", "2kg", "3rad"])
+def test_a_non_frequency_is_refused_where_a_frequency_is_expected(text: str) -> None:
+    with pytest.raises(ParameterError, match="is not a frequency"):
+        parse_quantity(text, "frequency", name="--frequency")
+
+
+def test_bare_number_refused_with_the_way_to_write_it() -> None:
+    with pytest.raises(ParameterError) as info:
+        parse_quantity("0.106", "length", name="--clearance", bare="refuse")
+    assert str(info.value) == "--clearance 0.106: give a unit, e.g. 0.106mm"
+    # dimensionless quantities take bare numbers everywhere
+    assert parse_quantity("0.3", "dimensionless", name="--x", bare="refuse") == 0.3
+
+
+def test_to_si_takes_pint_quantities_strings_and_leaves_floats() -> None:
+    ureg = registry()
+    assert to_si(ureg.Quantity(0.106, "mm"), "m", name="c") == pytest.approx(1.06e-4)
+    assert to_si("400rpm", "rad/s", name="w") == pytest.approx(400.0 * 2 * math.pi / 60.0)
+    np.testing.assert_allclose(to_si(ureg.Quantity([1.0, 5.0], "um"), "m", name="a"), [1e-6, 5e-6])
+    assert to_si(2.5, "m", name="c") == 2.5  # a bare float is SI, untouched
+    with pytest.raises(ParameterError, match="is not a length"):
+        to_si(ureg.Quantity(2.0, "kg"), "m", name="clearance")
+
+
+def test_the_python_api_takes_units_wherever_it_takes_floats() -> None:
+    ureg = registry()
+    joint = Joint(mass="2kg", clearance=ureg.Quantity(0.106, "mm"), compression_stiffness="80kN/mm")
+    assert (joint.mass, joint.clearance, joint.compression_stiffness) == pytest.approx(
+        (2.0, 0.106e-3, 8e7)
+    )
+    assert joint.tension_stiffness == pytest.approx(8e7)
+    friction = Friction(0.2, "300N")
+    assert friction.force == pytest.approx(60.0)
+    pin = Pin.for_clearance("5mm", "0.106mm", "25mm", youngs_modulus="206GPa")
+    assert pin.hole_radius == pytest.approx(5e-3 + 0.053e-3)
+    assert pin.youngs_modulus == pytest.approx(2.06e11)
+    bare = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    assert stiffness.period(joint, "20um") == pytest.approx(stiffness.period(bare, 20e-6))
+    with pytest.raises(ParameterError, match="mass"):
+        Joint(mass="2mm", clearance=1e-4, compression_stiffness=8e7)
+
+
+def test_the_simulator_takes_a_frequency_in_hz_for_omega() -> None:
+    joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    si = steady_state(joint, 1000.0, 2.0 * math.pi * 400.0, damping_ratio=0.02)
+    united = steady_state(joint, "1kN", "400Hz", damping_ratio=0.02)
+    assert united.amplitude == pytest.approx(si.amplitude, rel=1e-12)
+
+
+def test_sweeps_and_records_take_units_too() -> None:
+    from clearjoint.records import Record
+    from clearjoint.simulate import frequency_sweep
+
+    joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    hz = registry().Quantity(np.array([390.0, 400.0]), "Hz")
+    united = frequency_sweep(joint, "1kN", hz, damping_ratio=0.02, direction="up")
+    si = frequency_sweep(
+        joint, 1000.0, 2 * math.pi * np.array([390.0, 400.0]), damping_ratio=0.02, direction="up"
+    )
+    np.testing.assert_allclose(united.omega, si.omega, rtol=1e-12)
+    np.testing.assert_allclose(united.amplitude_up, si.amplitude_up, rtol=1e-12)
+    t = np.arange(100) / 100.0
+    record = Record(time=t, force=t, displacement=t, clearance="0.1mm", mass="1500g")
+    assert (record.clearance, record.mass) == pytest.approx((1e-4, 1.5))

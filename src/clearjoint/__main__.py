@@ -2,4 +2,5 @@
 
 from clearjoint.cli import main
 
-raise SystemExit(main())
+if __name__ == "__main__":  # not when a tool or a spawned Dask worker merely imports it
+    raise SystemExit(main())

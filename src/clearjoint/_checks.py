@@ -1,4 +1,9 @@
-"""Input checks shared by every module: one clear message per bad value."""
+"""Input checks shared by every module: one clear message per bad value.
+
+Every check also takes a pint Quantity or a unit string ("2kg", "400Hz") and
+converts it to the SI ``unit`` it is given (through :func:`clearjoint.units.to_si`);
+a bare number is SI.
+"""
 
 from __future__ import annotations
 
@@ -12,10 +17,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.errors import OutputExistsError, ParameterError, ParameterTypeError
+from clearjoint.units import to_si
 
 
 def real_scalar(name: str, value: Any, *, unit: str = "") -> float:
     """Return ``value`` as a finite float, or raise an error naming ``name``."""
+    value = to_si(value, unit, name=name)
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
         raise ParameterTypeError(
             f"{name} must be a real number{_in(unit)}, got {value!r} of type {type(value).__name__}"
@@ -44,6 +51,7 @@ def non_negative(name: str, value: Any, *, unit: str = "") -> float:
 
 def non_negative_array(name: str, value: Any, *, unit: str = "") -> NDArray[np.float64]:
     """Return ``value`` as a float array with every entry finite and >= 0."""
+    value = to_si(value, unit, name=name)
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:

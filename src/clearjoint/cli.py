@@ -1,23 +1,29 @@
 """The ``clearjoint`` command line: parses, calls the library, prints. No physics here.
 
-Quantities take units (``0.106mm``, ``5um``, ``8e7N/m``; SI when none) and
-frequencies are in Hz. Bad input ends with exit code 2 and one line on stderr
-that says what is wrong.
+Quantities take units (``0.106mm``, ``5um``, ``8e7N/m``, ``400Hz``): a bare
+number for a dimensional quantity is refused with the way to write it, since
+"0.106" meant in mm would silently be 106 mm in SI. Frequencies are in Hz.
+Options given beside ``--study`` override the study. Bad input, including a
+file that is missing, a folder, empty, binary or of the wrong kind, ends with
+exit code 2 and one line on stderr that says what is wrong and where.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
 import numpy as np
 
 from clearjoint import __version__
-from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.errors import ClearjointError, OutputExistsError, ParameterError
 
 EXIT_BAD_INPUT = 2
 
@@ -36,12 +42,13 @@ def _stiffness_parser(sub: Any) -> None:
         description=(
             "Exact period, natural frequency, dynamic stiffness k_d = m w_n^2 and stiffness "
             "coefficient c_d = k_d / k_inf of a joint with clearance, at one or several "
-            "amplitudes A beyond the compression gap edge. Units may be given "
-            "(0.106mm, 5um, 8e7N/m); a bare number is SI."
+            "amplitudes A beyond the compression gap edge. Every dimensional value takes "
+            "a unit (0.106mm, 5um, 8e7N/m); a bare number is refused."
         ),
     )
     _add_joint_options(p, required=True)
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    _add_plot_option(p, force=True)
 
 
 def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
@@ -49,10 +56,13 @@ def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
     p.add_argument(
         "--stiffness", required=required, help="compression contact stiffness, e.g. 8e7N/m"
     )
-    p.add_argument("--tension-stiffness", help="tension contact stiffness (default: --stiffness)")
-    p.add_argument("--gap-stiffness", default="0", help="stiffness inside the gap k0 (default 0)")
+    p.add_argument(
+        "--tension-stiffness",
+        help="tension contact stiffness (default: the study's, or --stiffness)",
+    )
+    p.add_argument("--gap-stiffness", help="stiffness inside the gap k0 (default 0)")
     p.add_argument("--clearance", required=required, help="total axial clearance, e.g. 0.106mm")
-    p.add_argument("--gap-offset", default="0", help="offset of the gap centre (default 0)")
+    p.add_argument("--gap-offset", help="offset of the gap centre (default 0)")
     p.add_argument(
         "--amplitude", required=True, help="penetration(s) beyond the gap edge, e.g. 1um,5um,20um"
     )
@@ -83,6 +93,7 @@ def _dissipation_parser(sub: Any) -> None:
     p.add_argument("--poisson-ratio", help="Poisson's ratio of pin and hole (default 0.3)")
     p.add_argument("--contact-friction-coefficient", help="friction coefficient on the pin mu_c")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    _add_plot_option(p, force=True)
 
 
 def _reproduce_parser(sub: Any) -> None:
@@ -91,8 +102,10 @@ def _reproduce_parser(sub: Any) -> None:
         help="run the paper's whole study on the virtual rig and write a report",
         description=(
             "Run the default campaign of the virtual rig (or --campaign), identify every "
-            "record, fit eq 19-22, draw Figs. 7-13 and write DIR/report.html, "
-            "DIR/results.json, DIR/results.csv, DIR/fits.csv and DIR/records/."
+            "record, fit eq 19-22, re-run the campaign without the rig's installation "
+            "sensitivity as the findings' control, draw Figs. 7-13 and write "
+            "DIR/report.html (opening with the findings table), DIR/results.json, "
+            "DIR/results.csv, DIR/fits.csv and DIR/records/."
         ),
     )
     p.add_argument("--out", default="clearjoint-reproduction", help="output folder")
@@ -126,9 +139,12 @@ def _simulate_parser(sub: Any) -> None:
         ),
     )
     p.add_argument("study", help="study file (TOML)")
-    p.add_argument("--out", help="write the result to this netCDF file (.nc)")
+    p.add_argument(
+        "--out", help="write the motion as a test record to this netCDF file (.nc; see records)"
+    )
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
-    p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
+    p.add_argument("--force", action="store_true", help="overwrite --out or --plot if it exists")
+    _add_plot_option(p, force=False)
 
 
 def _rig_parser(sub: Any) -> None:
@@ -162,6 +178,14 @@ def _identify_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="results file, .csv or .nc")
     p.add_argument("--figures", help="write two figures per test into this folder")
     p.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="draw every identified loop with its flag into one figure (.png, .pdf or .svg)",
+    )
+    p.add_argument(
+        "--jobs", type=int, default=1, help="processes over the files (default 1; same results)"
+    )
+    p.add_argument(
         "--resample", action="store_true", help="interpolate records that are not uniformly sampled"
     )
     p.add_argument(
@@ -170,8 +194,74 @@ def _identify_parser(sub: Any) -> None:
         default=0.03,
         help="steady-cycle amplitude tolerance (default 0.03)",
     )
-    p.add_argument("--force", action="store_true", help="overwrite existing output")
+    p.add_argument("--force", action="store_true", help="overwrite existing output and --plot")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+#: Figure formats ``--plot`` writes (matplotlib picks the format from the suffix).
+PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+def _add_plot_option(p: argparse.ArgumentParser, *, force: bool) -> None:
+    p.add_argument(
+        "--plot", metavar="FILE.png", help="draw the result into this figure (.png, .pdf or .svg)"
+    )
+    if force:
+        p.add_argument("--force", action="store_true", help="overwrite --plot if it exists")
+
+
+def _plot_target(args: argparse.Namespace) -> Path | None:
+    """The --plot file, checked before any work: a figure suffix, not overwritten unasked."""
+    if args.plot is None:
+        return None
+    path = Path(args.plot)
+    if path.suffix.lower() not in PLOT_SUFFIXES:
+        raise ParameterError(
+            f"--plot must end in {', '.join(PLOT_SUFFIXES)}, got {path.name!r}; "
+            "e.g. --plot result.png"
+        )
+    if path.is_dir():
+        raise ParameterError(f"--plot {path} is a folder; give a file name such as {path}/plot.png")
+    if path.exists() and not args.force:
+        raise OutputExistsError(
+            f"will not overwrite {path}; choose another --plot file or pass --force"
+        )
+    return path
+
+
+def _save_plot(result: Any, path: Path | None, *, quiet: bool) -> None:
+    """Draw ``result.plot(ax)`` on a new figure and save it to ``path`` (nothing if None)."""
+    if path is None:
+        return
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
+    result.plot(fig.add_subplot())
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    if not quiet:
+        print(f"wrote {path}")
+
+
+def _sweep_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "sweep",
+        help="parameter study or tolerance Monte Carlo from a sweep file, on Dask",
+        description=(
+            "Run the task of SWEEP.toml at every point of its grid axes and Monte Carlo "
+            "draws (see docs/sweep.md), on a local Dask cluster or on a running scheduler, "
+            "writing --out (a zarr store) chunk by chunk. With --plot STORE VAR: draw one "
+            "output (a map, a line or a histogram) to --out (PNG)."
+        ),
+    )
+    p.add_argument("sweep", nargs="?", help="sweep file (TOML)")
+    p.add_argument("--out", help="zarr store to write (.zarr); with --plot, the PNG")
+    p.add_argument("--scheduler", help="a running Dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--workers", type=int, help="local cluster's worker processes (default: cores)")
+    p.add_argument("--resume", action="store_true", help="finish an interrupted --out store")
+    p.add_argument("--force", action="store_true", help="replace an existing --out")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--plot", nargs=2, metavar=("STORE", "VAR"), help="draw VAR of a store")
 
 
 def _structure_parser(sub: Any) -> None:
@@ -204,30 +294,58 @@ def build_parser() -> argparse.ArgumentParser:
     _identify_parser(sub)
     _reproduce_parser(sub)
     _report_parser(sub)
+    _sweep_parser(sub)
     _structure_parser(sub)
     return parser
 
 
-def _joint_from(args: argparse.Namespace) -> Any:
-    from clearjoint.joint import Joint
+def _option(args: argparse.Namespace, option: str, kind: str) -> float | None:
+    """The value of ``--option`` in SI, None when not given; a bare number is refused."""
     from clearjoint.units import parse_quantity
 
-    for option in ("mass", "stiffness", "clearance"):
-        if getattr(args, option) is None:
-            raise ParameterError(f"--{option} is required (or give a --study file)")
-    stiffness = parse_quantity(args.stiffness, "stiffness", name="--stiffness")
-    return Joint(
-        mass=parse_quantity(args.mass, "mass", name="--mass"),
-        clearance=parse_quantity(args.clearance, "length", name="--clearance"),
-        compression_stiffness=stiffness,
-        tension_stiffness=(
-            stiffness
-            if args.tension_stiffness is None
-            else parse_quantity(args.tension_stiffness, "stiffness", name="--tension-stiffness")
-        ),
-        gap_stiffness=parse_quantity(args.gap_stiffness, "stiffness", name="--gap-stiffness"),
-        gap_offset=parse_quantity(args.gap_offset, "length", name="--gap-offset"),
-    )
+    text = getattr(args, option.replace("-", "_"))
+    if text is None:
+        return None
+    return parse_quantity(text, kind, name=f"--{option}", bare="refuse")
+
+
+def _missing(option: str) -> ParameterError:
+    return ParameterError(f"--{option} is missing: give --{option} or put it in the study file")
+
+
+#: Joint options: (option, kind, Joint field).
+_JOINT_OPTIONS = (
+    ("mass", "mass", "mass"),
+    ("clearance", "length", "clearance"),
+    ("stiffness", "stiffness", "compression_stiffness"),
+    ("tension-stiffness", "stiffness", "tension_stiffness"),
+    ("gap-stiffness", "stiffness", "gap_stiffness"),
+    ("gap-offset", "length", "gap_offset"),
+)
+
+
+def _joint_from(args: argparse.Namespace, base: Any | None = None) -> Any:
+    """The joint from the options, each over the study joint ``base`` (if any).
+
+    A tension stiffness that the study left equal to the compression one follows
+    ``--stiffness``; one the study set on its own is kept unless overridden.
+    """
+    from clearjoint.joint import Joint
+
+    given = {field: _option(args, option, kind) for option, kind, field in _JOINT_OPTIONS}
+    values: dict[str, float] = {}
+    for option, _kind, field in _JOINT_OPTIONS:
+        value = given[field]
+        if value is None and base is not None:
+            value = getattr(base, field)
+        if value is None and field in ("mass", "clearance", "compression_stiffness"):
+            raise _missing(option)
+        if value is not None:
+            values[field] = value
+    follows = base is None or base.tension_stiffness == base.compression_stiffness
+    if given["tension_stiffness"] is None and follows:
+        values["tension_stiffness"] = values["compression_stiffness"]
+    return Joint(**values)
 
 
 def _json_value(values: np.ndarray, several: bool) -> Any:
@@ -238,10 +356,11 @@ def _json_value(values: np.ndarray, several: bool) -> Any:
 
 def _run_stiffness(args: argparse.Namespace) -> int:
     from clearjoint import stiffness
-    from clearjoint.units import parse_quantity_list
 
     joint = _joint_from(args)
-    amplitudes = np.array(parse_quantity_list(args.amplitude, "length", name="--amplitude"))
+    amplitudes = _amplitudes(args)
+    plot = _plot_target(args)
+    _save_plot(stiffness.stiffness_curve(joint, amplitudes), plot, quiet=args.json)
     period = stiffness.period(joint, amplitudes)
     with np.errstate(divide="ignore"):
         frequency_hz = 1.0 / period
@@ -271,32 +390,74 @@ def _run_stiffness(args: argparse.Namespace) -> int:
     return 0
 
 
-def _losses_from(args: argparse.Namespace, base: Any | None) -> dict[str, Any]:
+def _amplitudes(args: argparse.Namespace) -> Any:
+    from clearjoint.units import parse_quantity_list
+
+    values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
+    return np.array(values)
+
+
+_PIN_OPTIONS = ("pin-radius", "pin-length", "hole-radius", "youngs-modulus", "poisson-ratio")
+
+
+def _pin_from(args: argparse.Namespace, base: Any | None, clearance: float) -> Any:
+    """The pin from the options, each over the study's pin; None when neither gives one.
+
+    A hole radius the study left at its default (pin radius + clearance / 2)
+    follows an overridden pin radius or clearance.
+    """
+    from clearjoint.joint import Pin
+
+    base_pin = base.pin if base is not None else None
+    given = any(getattr(args, o.replace("-", "_")) is not None for o in _PIN_OPTIONS)
+    if not given and (base_pin is None or args.clearance is None):
+        return base_pin
+
+    def value(option: str, kind: str, field: str, default: float | None) -> float:
+        number = _option(args, option, kind)
+        if number is None:
+            number = getattr(base_pin, field) if base_pin is not None else default
+        if number is None:
+            raise ParameterError(
+                f"--{option} is missing: a pin needs --pin-radius and --pin-length "
+                "(or a [pin] table in the study file)"
+            )
+        return number
+
+    radius = value("pin-radius", "length", "radius", None)
+    length = value("pin-length", "length", "length", None)
+    hole = _option(args, "hole-radius", "length")
+    if hole is None:
+        default_hole = (
+            base is not None
+            and base_pin is not None
+            and math.isclose(
+                base_pin.hole_radius, base_pin.radius + 0.5 * base.joint.clearance, rel_tol=1e-12
+            )
+        )
+        hole = base_pin.hole_radius if base_pin and not default_hole else radius + 0.5 * clearance
+    return Pin(
+        radius=radius,
+        hole_radius=hole,
+        length=length,
+        youngs_modulus=value("youngs-modulus", "pressure", "youngs_modulus", 2.06e11),
+        poisson_ratio=value("poisson-ratio", "dimensionless", "poisson_ratio", 0.3),
+    )
+
+
+def _losses_from(args: argparse.Namespace, base: Any | None, joint: Any) -> dict[str, Any]:
     """Friction, restitution, damping, pin and mu_c from options, over a study's values."""
-    from clearjoint.joint import Friction, Pin
-    from clearjoint.units import parse_quantity
+    from clearjoint.joint import Friction
 
     def number(option: str, kind: str, default: float) -> float:
-        text = getattr(args, option.replace("-", "_"))
-        return default if text is None else parse_quantity(text, kind, name=f"--{option}")
+        value = _option(args, option, kind)
+        return default if value is None else value
 
     friction = base.friction if base is not None else None
     mu_s = number("friction-coefficient", "dimensionless", friction.coefficient if friction else 0)
     load = number("lateral-load", "force", friction.lateral_load if friction else 0.0)
     region = args.friction_region or (friction.region if friction else "everywhere")
-    pin = base.pin if base is not None else None
-    if args.pin_radius is not None or args.pin_length is not None:
-        if args.pin_radius is None or args.pin_length is None:
-            raise ParameterError("give both --pin-radius and --pin-length for a pin")
-        radius = number("pin-radius", "length", 0.0)
-        clearance = number("clearance", "length", base.joint.clearance if base else 0.0)
-        pin = Pin(
-            radius=radius,
-            hole_radius=number("hole-radius", "length", radius + 0.5 * clearance),
-            length=number("pin-length", "length", 0.0),
-            youngs_modulus=number("youngs-modulus", "pressure", 2.06e11),
-            poisson_ratio=number("poisson-ratio", "dimensionless", 0.3),
-        )
+    pin = _pin_from(args, base, joint.clearance)
     return {
         "friction": Friction(mu_s, load, region) if mu_s > 0 and load > 0 else None,
         "restitution": number("restitution", "dimensionless", base.restitution if base else 1.0),
@@ -314,17 +475,18 @@ def _losses_from(args: argparse.Namespace, base: Any | None) -> dict[str, Any]:
 
 def _run_dissipation(args: argparse.Namespace) -> int:
     from clearjoint import dissipation
-    from clearjoint.units import parse_quantity_list
 
     base = None
     if args.study:
         from clearjoint.simulate.study import load_study
 
         base = load_study(args.study)
-    joint = base.joint if base is not None and args.mass is None else _joint_from(args)
-    losses = _losses_from(args, base)
-    amplitudes = np.array(parse_quantity_list(args.amplitude, "length", name="--amplitude"))
+    joint = _joint_from(args, base.joint if base is not None else None)
+    losses = _losses_from(args, base, joint)
+    amplitudes = _amplitudes(args)
+    plot = _plot_target(args)
     values = dissipation.energies(joint, amplitudes, **losses)
+    _save_plot(values, plot, quiet=args.json)
     several = amplitudes.size > 1
     if args.json:
         out = {"amplitude_m": _json_value(amplitudes, several)}
@@ -397,11 +559,14 @@ def _run_identify(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .csv or .nc, got {out.name!r}")
     if not 0.0 < args.tolerance < 1.0:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
+    if args.jobs < 1:
+        raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    plot = _plot_target(args)  # a figure suffix, not overwritten unless --force
     refuse_to_overwrite([out], force=args.force)
+    out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
+    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
     if args.quiet:
-        results, failures = identify_files(
-            args.files, resample=args.resample, tolerance=args.tolerance
-        )
+        results, failures = identify_files(args.files, **options)
     else:
         from rich.progress import Progress
 
@@ -409,12 +574,16 @@ def _run_identify(args: argparse.Namespace) -> int:
             task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
             results, failures = identify_files(
                 args.files,
-                resample=args.resample,
-                tolerance=args.tolerance,
+                **options,
                 progress=lambda done, _total: bar.update(task, completed=done),
             )
+    if not results and len(failures) == 1:
+        raise ParameterError(f"no record could be used: {failures[0]}")  # one file, one line
     for line in failures:
         print(f"not used: {line}", file=sys.stderr)
+    for _, ident in results:
+        for warning in ident.warnings:
+            print(f"clearjoint identify: warning: {warning}", file=sys.stderr)
     if not results:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -422,7 +591,17 @@ def _run_identify(args: argparse.Namespace) -> int:
     _write_rows(rows, out)
     if args.figures:
         _identify_figures(results, Path(args.figures), force=args.force)
-    print(f"identified {len(results)} of {len(args.files)} records; wrote {out}")
+    if plot is not None:
+        from clearjoint.identify import identifications_figure
+
+        plot.parent.mkdir(parents=True, exist_ok=True)
+        identifications_figure([ident for _, ident in results]).savefig(plot, dpi=100)
+        print(f"wrote {plot}")
+    flagged = sum(ident.flag != "ok" for _, ident in results)
+    print(
+        f"identified {len(results)} of {len(args.files)} records ({flagged} flagged, see the "
+        f"flag and flag_reason columns); wrote {out}"
+    )
     return 0
 
 
@@ -459,7 +638,8 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
         first = ident.cycles[0]
         span = slice(first.start, ident.cycles[-1].stop)
         runs = ident.stage_runs(record.time)
-        fig = displacement_stages_figure(record.time, record.displacement, runs, title=stem)
+        title = f"{stem} [{ident.flag}]"  # the credibility flag on every figure
+        fig = displacement_stages_figure(record.time, record.displacement, runs, title=title)
         fig.savefig(targets[0], dpi=100)
         fig = identified_loop_figure(
             record.displacement[span],
@@ -467,7 +647,7 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
             ident.stage[span],
             (first.upper_edge, first.lower_edge),
             first.lines,
-            title=stem,
+            title=title,
         )
         fig.savefig(targets[1], dpi=100)
 
@@ -479,8 +659,15 @@ def _run_simulate(args: argparse.Namespace) -> int:
     if args.out:
         from clearjoint._checks import refuse_to_overwrite
 
+        if Path(args.out).suffix.lower() != ".nc":
+            raise ParameterError(
+                f"--out {args.out}: simulate writes netCDF; name the file .nc, e.g. result.nc"
+            )
         refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    plot = _plot_target(args)
     motion = run_study(study)
+    _save_plot(motion, plot, quiet=args.json)
     result = summary(study, motion)
     if args.out:
         write_netcdf(study, motion, args.out, force=args.force)
@@ -516,7 +703,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
 def _run_reproduce(args: argparse.Namespace) -> int:
     import time
 
-    from clearjoint.report import reproduce
+    from clearjoint.reproduction import reproduce
 
     start = time.perf_counter()
     written = reproduce(
@@ -528,13 +715,31 @@ def _run_reproduce(args: argparse.Namespace) -> int:
     )
     for path in written:
         print(f"wrote {path}")
+    _print_findings(Path(args.out) / "results.json")
     print(f"done in {time.perf_counter() - start:.0f} s")
     return 0
 
 
-def _run_report(args: argparse.Namespace) -> int:
-    from clearjoint.report import report_records
+def _print_findings(results: Path) -> None:
+    """Print the findings table of a written report, one row per paper finding."""
+    import json
 
+    rows = json.loads(results.read_text(encoding="utf-8"))["findings"]
+    print("the paper's findings (reproduced, source): see report.html for the evidence")
+    for row in rows:
+        mark = "yes" if row["reproduced"] else "NO "
+        print(f"  {mark}  {row['source']:<9}  {row['finding']}")
+
+
+def _run_report(args: argparse.Namespace) -> int:
+    from clearjoint.records import RecordError
+    from clearjoint.reproduction import report_records
+
+    folder = Path(args.records)
+    if not folder.exists():
+        raise RecordError(f"{folder}: no such folder; give --records a folder of record files")
+    if not folder.is_dir():
+        raise RecordError(f"{folder}: not a folder; give --records a folder of record files")
     written = report_records(
         Path(args.records),
         Path(args.out),
@@ -543,6 +748,101 @@ def _run_report(args: argparse.Namespace) -> int:
     )
     for path in written:
         print(f"wrote {path}")
+    _print_findings(Path(args.out) / "results.json")
+    return 0
+
+
+def _warning_printer(command: str) -> Callable[..., None]:
+    """A warnings.showwarning that prints one line, without the source file and line."""
+
+    def show(message: Warning | str, category: type[Warning], *_: Any, **__: Any) -> None:
+        print(f"clearjoint {command}: warning: {message}", file=sys.stderr)
+
+    return show
+
+
+def _run_sweep(args: argparse.Namespace) -> int:
+    import contextlib
+    import time
+
+    if args.plot:
+        return _plot_sweep(args)
+    from clearjoint.parallel import dask_client
+    from clearjoint.sweep import Sweep, run_sweep
+
+    if args.sweep is None or args.out is None:
+        raise ParameterError("give a sweep file and --out results.zarr (or --plot STORE VAR)")
+    if Path(args.out).suffix != ".zarr":
+        raise ParameterError(f"--out must end in .zarr, got {args.out!r}")
+    if args.scheduler and args.workers is not None:
+        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    start = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        if args.scheduler:  # an unreachable scheduler is said first, within seconds
+            client = stack.enter_context(dask_client(args.scheduler))
+        sweep = Sweep.from_toml(args.sweep)
+        if not args.scheduler:  # a bad sweep file is said before a cluster starts
+            client = stack.enter_context(dask_client(workers=args.workers))
+        already: list[int] = []  # points found in the store on --resume
+        bar: Any = None
+        if not args.quiet and sys.stderr.isatty():
+            from rich.progress import Progress, TimeRemainingColumn
+
+            bar = stack.enter_context(
+                Progress(
+                    *Progress.get_default_columns()[:-1], TimeRemainingColumn(), transient=True
+                )
+            )
+            task = bar.add_task(f"{sweep.n_points} points", total=sweep.n_points)
+
+        def progress(done: int, _total: int) -> None:
+            if not already:
+                already.append(done)
+            if bar is not None:
+                bar.update(task, completed=done)
+
+        try:
+            results = run_sweep(
+                sweep,
+                client=client,
+                out=args.out,
+                resume=args.resume,
+                force=args.force,
+                progress=progress,
+            )
+        except KeyboardInterrupt:
+            print(
+                f"clearjoint sweep: interrupted; finished chunks are in {args.out}: "
+                f"run again with --resume to compute only the rest",
+                file=sys.stderr,
+            )
+            return 130
+    failed = results.attrs["points_failed"]
+    kept = f", {already[0]} of them kept from the store" if already and already[0] else ""
+    print(
+        f"wrote {results.attrs['points']} points{kept} ({failed} failed: see `status`) "
+        f"to {args.out} in {time.perf_counter() - start:.1f} s"
+    )
+    return 0
+
+
+def _plot_sweep(args: argparse.Namespace) -> int:
+    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.sweep import open_sweep
+    from clearjoint.sweep.plot import plot_sweep
+
+    store, variable = args.plot
+    if args.sweep is not None:
+        raise ParameterError("--plot STORE VAR takes no sweep file")
+    out = (
+        Path(args.out) if args.out else Path(store).with_name(f"{Path(store).stem}_{variable}.png")
+    )
+    if out.suffix.lower() != ".png":
+        raise ParameterError(f"with --plot, --out is the picture and must end in .png, got {out}")
+    refuse_to_overwrite([out], force=args.force)
+    ax = plot_sweep(open_sweep(store), variable)
+    ax.figure.savefig(out, dpi=110)
+    print(f"wrote {out}")
     return 0
 
 
@@ -639,10 +939,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         "identify": _run_identify,
         "reproduce": _run_reproduce,
         "report": _run_report,
+        "sweep": _run_sweep,
         "structure": _run_structure,
     }
     try:
-        return runners[args.command](args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _warning_printer(args.command)
+            return runners[args.command](args)
+    except BrokenPipeError:  # the reader stopped early (| head): not an error of ours
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so the exit's flush does not raise again
+        return 0
     except ClearjointError as exc:
         print(f"clearjoint {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except OSError as exc:  # a path the readers and writers did not check themselves
+        where = f"{exc.filename}: " if exc.filename else ""
+        reason = exc.strerror or str(exc)
+        print(
+            f"clearjoint {args.command}: error: {where}{reason.lower()}; check the path",
+            file=sys.stderr,
+        )
         return EXIT_BAD_INPUT

@@ -9,7 +9,7 @@ of radius R_h, over a length L_p:
 
 and the friction power of tangential slip v sin(theta) over the arc (small angles) is
 
-    P_C = (4 mu_c / (3 pi)) (b / R_p) F_n |v| = (4 mu_c beta_H / (3 pi R_p)) F_n^(3/2) |v|,
+    P_C = (4 mu_c / (3 pi)) (b / R_p) F_n abs(v) = (4 mu_c beta_H / (3 pi R_p)) F_n^(3/2) abs(v),
 
 with b = beta_H sqrt(F_n), beta_H = sqrt(4 R* / (pi L_p E*)).
 
@@ -106,8 +106,8 @@ def contact_friction_power(
 ) -> FloatArray:
     """Return the friction power on the contact arc, W (MODEL.md eq 12, 14).
 
-    P_C = (4 mu_c beta_H / (3 pi R_p)) F_n^(3/2) |v|, the arc integral of
-    mu_c p |v sin(theta)| L_p R_p dtheta for a Hertz pressure at small angles.
+    P_C = (4 mu_c beta_H / (3 pi R_p)) F_n^(3/2) abs(v), the arc integral of
+    mu_c p abs(v sin(theta)) L_p R_p dtheta for a Hertz pressure at small angles.
     """
     mu = _checks.non_negative("contact friction coefficient", friction_coefficient)
     force = np.maximum(np.asarray(normal_force, dtype=np.float64), 0.0)

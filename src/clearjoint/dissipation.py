@@ -23,8 +23,9 @@ Mechanisms, per cycle:
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -35,6 +36,11 @@ from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
 from clearjoint.simulate import SteadyState, steady_state
 from clearjoint.stiffness import FreeOrbit, free_orbit, viscous_coefficient
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+    from matplotlib.axes import Axes
 
 FloatArray = NDArray[np.float64]
 
@@ -221,7 +227,7 @@ def energies(
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
     losses: Losses | None = None,
-) -> dict[str, FloatArray]:
+) -> Energies:
     """Return every energy per free cycle at penetration A, keyed as ``ENERGY_KEYS`` (SI).
 
     ``total_j`` uses the exact sliding-friction form; ``sliding_friction_paper_j``
@@ -253,17 +259,184 @@ def energies(
         width = hertz_contact(pin, peak).half_width
     else:
         width = zero
-    return {
-        "sliding_friction_j": slide,
-        "sliding_friction_paper_j": slide_paper,
-        "contact_friction_j": contact,
-        "impact_j": hits,
-        "viscous_j": loss,
-        "total_j": everything,
-        "loss_factor": eta,
-        "equivalent_damping_ratio": 0.5 * eta,
-        "hertz_half_width_m": width,
-    }
+    return Energies(
+        amplitude=np.asarray(amplitude, dtype=np.float64) + zero,
+        sliding_friction_j=slide,
+        sliding_friction_paper_j=slide_paper,
+        contact_friction_j=contact,
+        impact_j=hits,
+        viscous_j=loss,
+        total_j=everything,
+        loss_factor=eta,
+        equivalent_damping_ratio=0.5 * eta,
+        hertz_half_width_m=width,
+    )
+
+
+#: Units of the keys of :data:`ENERGY_KEYS`, for tables and netCDF attributes.
+ENERGY_UNITS = {
+    key: ("J" if key.endswith("_j") else "m" if key.endswith("_m") else "1") for key in ENERGY_KEYS
+}
+
+#: The mechanisms :meth:`Energies.plot` draws, with their legend labels.
+_PLOTTED = {
+    "sliding_friction_j": "sliding friction E_P",
+    "contact_friction_j": "contact friction E_C",
+    "impact_j": "impact E_I",
+    "viscous_j": "viscous",
+    "total_j": "total E_Z",
+}
+
+
+@dataclass(frozen=True, eq=False)
+class Energies(Mapping[str, FloatArray]):
+    """Every energy per free cycle at penetration A: what :func:`energies` returns (SI).
+
+    A read-only mapping keyed as :data:`ENERGY_KEYS` (``values["total_j"]``), whose
+    entries are also attributes (``values.total_j``); every array is shaped like
+    ``amplitude``.
+
+    Attributes
+    ----------
+    amplitude : ndarray
+        Penetration A beyond the compression gap edge, m.
+    sliding_friction_j, sliding_friction_paper_j : ndarray
+        Sliding friction per cycle, exact and in the paper's viscous form, J (eq 10).
+    contact_friction_j, impact_j, viscous_j : ndarray
+        Contact friction on the pin (eq 15), impact (eq 16) and viscous loss per cycle, J.
+    total_j : ndarray
+        Their total E_Z, J (eq 17, with the exact sliding friction).
+    loss_factor, equivalent_damping_ratio : ndarray
+        eta = E_Z / (2 pi U_max) and eta / 2.
+    hertz_half_width_m : ndarray
+        Hertz half-width at the cycle's largest contact force, m (0 without a pin).
+    """
+
+    amplitude: FloatArray
+    sliding_friction_j: FloatArray
+    sliding_friction_paper_j: FloatArray
+    contact_friction_j: FloatArray
+    impact_j: FloatArray
+    viscous_j: FloatArray
+    total_j: FloatArray
+    loss_factor: FloatArray
+    equivalent_damping_ratio: FloatArray
+    hertz_half_width_m: FloatArray
+
+    def __getitem__(self, key: str) -> FloatArray:
+        if key not in ENERGY_UNITS:
+            raise KeyError(key)
+        value: FloatArray = getattr(self, key)
+        return value
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(ENERGY_KEYS)
+
+    def __len__(self) -> int:
+        return len(ENERGY_KEYS)
+
+    def __repr__(self) -> str:
+        a = np.atleast_1d(self.amplitude)
+        e = np.atleast_1d(self.total_j)
+        eta = np.atleast_1d(self.loss_factor)
+
+        def span(values: FloatArray, scale: float) -> str:
+            low, high = float(np.nanmin(values)) * scale, float(np.nanmax(values)) * scale
+            return f"{low:.4g}" if low == high else f"{low:.4g} to {high:.4g}"
+
+        return (
+            f"Energies({a.size} amplitude{'s' if a.size != 1 else ''}, "
+            f"A = {span(a, 1e6)} um: total {span(e, 1e3)} mJ per cycle, "
+            f"loss factor {span(eta, 1.0) if np.any(np.isfinite(eta)) else 'nan'})"
+        )
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the energies as an ``xarray.Dataset`` on ``amplitude``, units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinate ``amplitude`` (N,) in m; one variable (N,) per key of
+            :data:`ENERGY_KEYS`, each with ``attrs["units"]`` (J, m or 1).
+
+        Raises
+        ------
+        ParameterError
+            The energies were computed on a grid of more than one dimension.
+        """
+        import xarray as xr
+
+        from clearjoint._plotting import one_dimensional
+
+        a = one_dimensional("amplitude", self.amplitude)
+        return xr.Dataset(
+            {
+                key: ("amplitude", np.broadcast_to(self[key], a.shape).copy(), {"units": unit})
+                for key, unit in ENERGY_UNITS.items()
+            },
+            coords={"amplitude": ("amplitude", a, {"units": "m"})},
+            attrs={"title": "clearjoint energies per free cycle"},
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the energies as a ``pandas.DataFrame``: index ``amplitude_m``, one column a key.
+
+        Returns
+        -------
+        pandas.DataFrame
+            (N, 9): the keys of :data:`ENERGY_KEYS` as columns (their names carry the unit).
+        """
+        import pandas as pd
+
+        from clearjoint._plotting import one_dimensional
+
+        a = one_dimensional("amplitude", self.amplitude)
+        return pd.DataFrame(
+            {key: np.broadcast_to(self[key], a.shape) for key in ENERGY_KEYS},
+            index=pd.Index(a, name="amplitude_m"),
+        )
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw each mechanism's energy per cycle (mJ) against A (um), log-log; return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            One line per mechanism that dissipates anything, labelled as in the
+            legend (``"total E_Z"`` last, thicker).
+        """
+        from clearjoint._plotting import axes_or_new, one_dimensional
+
+        axes: Axes = axes_or_new(ax)
+        a = one_dimensional("amplitude", self.amplitude)
+        styles = ["--", "-.", ":", (0, (5, 1, 1, 1))]
+        few = a.size < 20
+        for i, (key, label) in enumerate(_PLOTTED.items()):
+            energy = np.broadcast_to(self[key], a.shape)
+            if key != "total_j" and not np.any(energy > 0.0):
+                continue
+            axes.plot(
+                a * 1e6,
+                energy * 1e3,
+                linestyle="-" if key == "total_j" else styles[i % len(styles)],
+                lw=2.2 if key == "total_j" else 1.3,
+                color="black",
+                marker="o" if few else None,
+                label=label,
+            )
+        if np.all(a > 0.0):
+            axes.set_xscale("log")
+        if np.all(np.broadcast_to(self.total_j, a.shape) > 0.0):
+            axes.set_yscale("log")
+        axes.set_xlabel("amplitude beyond the gap edge A (µm)")
+        axes.set_ylabel("energy per cycle (mJ)")
+        axes.legend(frameon=False, fontsize="small")
+        return axes
 
 
 # ---- closed form against the exact steady cycle --------------------------------------------
@@ -389,6 +562,36 @@ class AgreementMap:
     gap: dict[str, FloatArray]
 
 
+def _agreement_row(
+    args: tuple[Joint, float, FloatArray, dict[str, Any], int],
+) -> tuple[FloatArray, dict[str, FloatArray]]:
+    """One frequency of :func:`agreement_map`: the forces stepped upward from rest."""
+    from clearjoint.simulate import SimulationError
+
+    joint, omega, f, losses, max_periods = args
+    penetration = np.full(f.size, np.nan)
+    gaps: dict[str, FloatArray] = {}
+    initial: tuple[float, float, int, int] | None = None
+    for n, force in enumerate(f):
+        try:
+            result = compare(
+                joint,
+                float(force),
+                omega,
+                **losses,
+                initial=initial,
+                samples_per_period=128,
+                max_periods=max_periods,
+            )
+        except SimulationError:
+            continue
+        initial = result.cycle.initial_state
+        penetration[n] = result.penetration
+        for key, value in result.gap.items():
+            gaps.setdefault(key, np.full(f.size, np.nan))[n] = value
+    return penetration, gaps
+
+
 def agreement_map(
     joint: Joint,
     omegas: ArrayLike,
@@ -400,6 +603,7 @@ def agreement_map(
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
     max_periods: int = 2000,
+    executor: Any = None,
     losses: Losses | None = None,
 ) -> AgreementMap:
     """Return the closed-form-to-exact gap of every energy over a grid of (omega, F0).
@@ -407,37 +611,33 @@ def agreement_map(
     At each frequency the forces are stepped upward, each step starting from the
     last steady state (as a test rig would), so every point is an exact steady
     cycle compared with the closed forms at its own penetration (:func:`compare`).
+    Frequencies run one after the other here, or side by side on ``executor`` (a
+    concurrent.futures Executor or a dask.distributed Client: clearjoint.parallel),
+    with the same result.
     """
     damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
         losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
     )
-    from clearjoint.simulate import SimulationError
+    from clearjoint.parallel import run_ordered
 
     w = np.atleast_1d(np.asarray(omegas, dtype=np.float64))
     f = np.sort(np.atleast_1d(np.asarray(forces, dtype=np.float64)))
+    loss_keywords: dict[str, Any] = {
+        "friction": friction,
+        "pin": pin,
+        "contact_friction_coefficient": contact_friction_coefficient,
+        "restitution": restitution,
+        "damping_ratio": damping_ratio,
+    }
+    rows = run_ordered(
+        _agreement_row,
+        [(joint, float(omega), f, loss_keywords, max_periods) for omega in w],
+        executor,
+    )
     penetration = np.full((w.size, f.size), np.nan)
     gaps: dict[str, FloatArray] = {}
-    for i, omega in enumerate(w):
-        initial: tuple[float, float, int, int] | None = None
-        for n, force in enumerate(f):
-            try:
-                result = compare(
-                    joint,
-                    float(force),
-                    float(omega),
-                    friction=friction,
-                    pin=pin,
-                    contact_friction_coefficient=contact_friction_coefficient,
-                    restitution=restitution,
-                    damping_ratio=damping_ratio,
-                    initial=initial,
-                    samples_per_period=128,
-                    max_periods=max_periods,
-                )
-            except SimulationError:
-                continue
-            initial = result.cycle.initial_state
-            penetration[i, n] = result.penetration
-            for key, value in result.gap.items():
-                gaps.setdefault(key, np.full((w.size, f.size), np.nan))[i, n] = value
+    for i, (row_penetration, row_gaps) in enumerate(rows):
+        penetration[i] = row_penetration
+        for key, value in row_gaps.items():
+            gaps.setdefault(key, np.full((w.size, f.size), np.nan))[i] = value
     return AgreementMap(omega=w, force=f, penetration=penetration, gap=gaps)

@@ -9,11 +9,15 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
+
+from clearjoint import fit
+from clearjoint.analysis import Analysis, side_data, tests_of
 
 #: Line styles that stay apart in grey print, cycled per curve.
 _STYLES: tuple[tuple[Any, str], ...] = (
@@ -200,7 +204,7 @@ def agreement_map_figure(
     tolerance: float = 0.05,
     title: str | None = None,
 ) -> Figure:
-    """Return the map of where |closed / exact - 1| <= tolerance over frequency (Hz) and force.
+    """Return the map of where abs(closed / exact - 1) <= tolerance over frequency (Hz) and force.
 
     Grey: within tolerance; white: outside; hatched: no periodic orbit. Contours
     give the exact cycle's penetration A in um.
@@ -418,9 +422,18 @@ def law_versus_measured_figure(
     law: NDArray[np.float64],
     model: NDArray[np.float64] | None = None,
     groups: NDArray[np.str_] | None = None,
+    *,
+    reference: str = "measured",
 ) -> Figure:
-    """Return Fig. 13: eq 22 (and the section-2 model) against the measured energy."""
-    fig = Figure(figsize=(5.2, 4.6), layout="constrained")
+    """Return Fig. 13: eq 22 (and the section-2 model) against the reference energy.
+
+    ``reference`` names the x axis: "measured" for real records, "virtual rig" where
+    the energies were simulated. The 1:1 line is in the legend; tick labels are
+    thinned (1, 2, 5 per decade, minor ticks unlabelled) so they never overlap.
+    """
+    from matplotlib.ticker import LogLocator, NullFormatter
+
+    fig = Figure(figsize=(5.6, 4.8), layout="constrained")
     ax = fig.add_subplot()
     names = sorted(set(groups.tolist())) if groups is not None else [""]
     for n, name in enumerate(names):
@@ -443,11 +456,202 @@ def law_versus_measured_figure(
                 ms=4,
                 label=f"section 2 model {name}".strip(),
             )
-    span = np.array([np.nanmin(measured), np.nanmax(measured)])
-    ax.plot(span, span, color="0.6", lw=0.8)
+    values = [measured, law] + ([model] if model is not None else [])
+    finite = np.concatenate([v[np.isfinite(v) & (v > 0)] for v in values])
+    span = np.array([finite.min(), finite.max()]) if finite.size else np.array([1e-3, 1.0])
+    ax.plot(span, span, color="0.6", lw=0.8, label="1:1")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("measured energy per cycle (J)")
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0), numticks=12))
+        axis.set_minor_formatter(NullFormatter())
+    ax.tick_params(axis="x", labelrotation=35)
+    ax.set_xlabel(f"{reference} energy per cycle (J)")
     ax.set_ylabel("predicted energy per cycle (J)")
     ax.legend(frameon=False, fontsize="small")
     return fig
+
+
+def identification_accuracy_figure(accuracy: Sequence[dict[str, Any]]) -> Figure:
+    """Return the identification's relative error per test against the rig's truth, in %.
+
+    One column of points per quantity (clearance, contact stiffness per side, energy
+    per cycle), with the +-1 % band shaded.
+    """
+    keys = (
+        ("clearance_error", "clearance"),
+        ("compression_stiffness_error", "k_c (slope)"),
+        ("tension_stiffness_error", "k_t (slope)"),
+        ("energy_error", "energy per cycle"),
+    )
+    fig = Figure(figsize=(6.0, 3.4), layout="constrained")
+    ax = fig.add_subplot()
+    ax.axhspan(-1.0, 1.0, color="0.92", lw=0, label="±1 %")
+    for n, (key, _) in enumerate(keys):
+        values = np.array([a[key] for a in accuracy if key in a], dtype=np.float64) * 100
+        jitter = np.linspace(-0.25, 0.25, values.size) if values.size > 1 else np.zeros(1)
+        ax.plot(n + jitter[: values.size], values, "o", color="0.2", mfc="white", ms=3.5)
+    ax.axhline(0.0, color="black", lw=0.6)
+    ax.set_xticks(range(len(keys)), [label for _, label in keys])
+    ax.set_ylabel("identified / true - 1 (%)")
+    ax.legend(frameon=False, fontsize="small", loc="upper right")
+    return fig
+
+
+# ---- the report's figures from an analysis ------------------------------------------------
+
+
+#: Below this R^2 a figure's caption warns that its law does not describe the data.
+POOR_R_SQUARED = 0.5
+
+
+def _warning(laws: dict[str, fit.LinearFit]) -> str:
+    poor = [
+        f"{label} (R² = {law.r_squared:.2f})"
+        for label, law in laws.items()
+        if law.r_squared < POOR_R_SQUARED
+    ]
+    if not poor:
+        return ""
+    return (
+        f" WARNING: R² below {POOR_R_SQUARED:g} for "
+        + "; ".join(poor)
+        + ": that law does not describe these data."
+    )
+
+
+def report_figures(
+    analysis: Analysis,
+    model_energy: Sequence[float] | None,
+    stiffness_curves: Sequence[Curve],
+    *,
+    measured: bool = True,
+) -> dict[str, Figure]:
+    """Return the report's figures (paper Figs. 7-13) by caption, from an analysis.
+
+    A figure whose law has R² below ``POOR_R_SQUARED`` says so in its caption.
+
+    Parameters
+    ----------
+    analysis : Analysis
+        The identified tests and their fitted laws.
+    model_energy : sequence of float, optional
+        Section 2's energy at each jointed test (J), drawn in Fig. 13 when given.
+    stiffness_curves : sequence of Curve
+        Fig. 12's c_d curves (none: Fig. 12 is left out).
+    measured : bool
+        True for real records ("measured"), False for the virtual rig's ("virtual rig").
+    """
+    rows = analysis.rows
+    out: dict[str, Figure] = {}
+    # Fig. 7: the first jointed record with its stages
+    for record, ident in analysis.identifications:
+        if ident.model != "line":
+            first = ident.cycles[-3] if len(ident.cycles) >= 3 else ident.cycles[0]
+            span = slice(first.start, ident.cycles[-1].stop)
+            runs = [
+                r
+                for r in ident.stage_runs(record.time)
+                if r[2] >= record.time[span.start] and r[1] <= record.time[span.stop - 1]
+            ]
+            how = (
+                " (a damper: free play where the force is near zero, after each reversal)"
+                if ident.model == "damper"
+                else ""
+            )
+            out[f"Fig. 7: stages of {Path(ident.source).name}{how}"] = displacement_stages_figure(
+                record.time[span], record.displacement[span], runs
+            )
+            break
+    for laws, caption, ylabel in (
+        (
+            analysis.stiffness_laws,
+            "Fig. 8: per-side dynamic stiffness k_d,s with the eq 19 planes.",
+            "dynamic stiffness k_d,s (MN/m)",
+        ),
+        (
+            analysis.contact_laws,
+            "Contact slopes k_s,meas with their eq 19 planes (not a paper figure).",
+            "contact slope (MN/m)",
+        ),
+    ):
+        panels = []
+        column = (
+            "dynamic_stiffness_n_per_m" if laws is analysis.stiffness_laws else "stiffness_n_per_m"
+        )
+        for label, law in laws.items():
+            name, side = label.rsplit(", ", 1)
+            sel = tests_of(rows, name)
+            freq = np.array([r["test_frequency_hz"] for r in sel], dtype=np.float64)
+            _, amp, k = side_data(sel, side, column)
+            freq = freq[np.isfinite([r[f"{side}_{column}"] for r in sel])]
+            grid = np.linspace(amp.min(), amp.max(), 20)
+            lines = {
+                f: (grid, fit.evaluate_stiffness_law(law, 2 * math.pi * f, grid))
+                for f in sorted(set(freq.tolist()))
+            }
+            panels.append(StiffnessPanel(label, freq, amp, k, lines))
+        if panels:
+            out[caption + _warning(laws)] = stiffness_panels_figure(panels, ylabel=ylabel)
+    if analysis.normalised:
+        labels = list(analysis.normalised)
+        out["Fig. 9: normalised eq 19 coefficients"] = coefficient_bars_figure(
+            labels,
+            [v[0] for v in analysis.normalised.values()],
+            [v[1] for v in analysis.normalised.values()],
+        )
+    panels = []
+    for label, js in analysis.joint_stiffness.items():
+        freq = js.omega / (2 * math.pi)
+        panels.append(StiffnessPanel(label, freq, js.amplitude, js.value, {}, js.error))
+    if panels:
+        out["Fig. 10: the joint's own dynamic stiffness k_dj, eq 20 on k_d,s"] = (
+            stiffness_panels_figure(panels, ylabel="joint stiffness k_dj (MN/m)")
+        )
+    energy_panels = []
+    for name in sorted({r["structure"] for r in rows if r["jointed"]}):
+        sel = tests_of(rows, name)
+        freq = np.array([r["test_frequency_hz"] for r in sel])
+        amp = np.array([r["mean_amplitude_m"] for r in sel])
+        energy = np.array([r["energy_per_cycle_j"] for r in sel])
+        curves = {}
+        for f in sorted(set(freq.tolist())):
+            exponential = analysis.exponential_laws.get(f"{name}, {f:g} Hz")
+            if exponential is not None:
+                grid = np.linspace(amp[freq == f].min(), amp[freq == f].max(), 20)
+                curves[f] = (grid, fit.evaluate_exponential_law(exponential, grid))
+        energy_panels.append(EnergyLawPanel(name, freq, amp, energy, curves))
+    if energy_panels:
+        caption = "Fig. 11: energy per cycle with the eq 21 laws." + _warning(
+            analysis.exponential_laws
+        )
+        out[caption] = energy_law_figure(energy_panels)
+    if stiffness_curves:
+        out[
+            "Fig. 12: stiffness coefficient c_d against amplitude, for "
+            + ", ".join(sorted({c.label.split(",")[0] for c in stiffness_curves}))
+        ] = stiffness_coefficient_figure(stiffness_curves)
+    general = analysis.dissipation_law
+    if general is not None:
+        jointed = [r for r in rows if r["jointed"]]
+        energy = np.array([r["energy_per_cycle_j"] for r in jointed])
+        predicted = fit.evaluate_dissipation_law(
+            general,
+            [r["omega"] for r in jointed],
+            [r["nominal_clearance_m"] for r in jointed],
+            [r["mean_amplitude_m"] for r in jointed],
+        )
+        model = np.array(model_energy) if model_energy is not None else None
+        reference = "measured" if measured else "virtual rig"
+        what = "eq 22 and the section-2 model" if model is not None else "eq 22"
+        caption = f"Fig. 13: {what} against the {reference} energy per cycle." + _warning(
+            {"eq 22": general}
+        )
+        out[caption] = law_versus_measured_figure(
+            energy,
+            predicted,
+            model,
+            np.array([r["structure"] for r in jointed]),
+            reference=reference,
+        )
+    return out

@@ -8,7 +8,13 @@
   (``uncertainties``, with the coefficients' correlations);
 * eq 21: E = c1 exp(c2 A) per joint and frequency, fitted on ln E;
 * eq 22: one law for all tests, ln E = (d0 + d1 w + d2 c) + (e0 + e1 w + e2 c) A,
-  compared by AIC with a power-law alternative, ln E = g0 + g1 ln w + g2 ln A + g3 c.
+  compared by AIC with a power-law alternative, ln E = g0 + g1 ln w + g2 ln A + g3 c;
+* a quadratic check, y = q0 + q1 u + q2 u^2 + q3 v, for "rises and saturates" and
+  "first falls" (the sign of the curvature and of the slope at one end).
+
+Each law has its design matrix (``*_design``) and its evaluator (``evaluate_*``), so a
+law is fitted and evaluated through the same columns. :func:`slope` gives a linear
+combination of a law's coefficients (a derivative at a point) with its standard error.
 
 Units: w in rad/s, A and c in m, k in N/m, E in J. Every fit refuses too few points or a
 singular design with a :class:`FitError` that says which.
@@ -113,14 +119,20 @@ def linear_fit(
 # ---- eq 19 and Fig. 9 ---------------------------------------------------------------------
 
 
+def stiffness_design(omega: ArrayLike, amplitude: ArrayLike) -> FloatArray:
+    """Return eq 19's design matrix, (n, 3) columns w, A, 1."""
+    w = np.asarray(omega, dtype=np.float64)
+    a = np.asarray(amplitude, dtype=np.float64)
+    w, a = np.broadcast_arrays(w, a)
+    return np.column_stack((w, a, np.ones_like(w)))
+
+
 def stiffness_law(
     omega: ArrayLike, amplitude: ArrayLike, stiffness: ArrayLike, *, what: str = "eq 19"
 ) -> LinearFit:
     """Return eq 19, k = a1 w + a2 A + a3, fitted by least squares (w rad/s, A m, k N/m)."""
-    w = np.asarray(omega, dtype=np.float64)
-    a = np.asarray(amplitude, dtype=np.float64)
     return linear_fit(
-        np.column_stack((w, a, np.ones_like(w))),
+        stiffness_design(omega, amplitude),
         stiffness,
         ("a1", "a2", "a3"),
         ("N s/(m rad)", "N/m^2", "N/m"),
@@ -139,11 +151,13 @@ def normalised_coefficients(
     )
 
 
-def predict(law: LinearFit, omega: ArrayLike, amplitude: ArrayLike) -> FloatArray:
-    """Evaluate eq 19 at (w, A)."""
-    w = np.asarray(omega, dtype=np.float64)
-    a = np.asarray(amplitude, dtype=np.float64)
-    return np.asarray(law.values[0] * w + law.values[1] * a + law.values[2], dtype=np.float64)
+def evaluate_stiffness_law(law: LinearFit, omega: ArrayLike, amplitude: ArrayLike) -> FloatArray:
+    """Return eq 19's k at (w, A), N/m, shaped like the broadcast of ``omega`` and ``amplitude``."""
+    return np.asarray(stiffness_design(omega, amplitude) @ law.values, dtype=np.float64)
+
+
+#: The former name of :func:`evaluate_stiffness_law`.
+predict = evaluate_stiffness_law
 
 
 # ---- eq 20 --------------------------------------------------------------------------------
@@ -189,14 +203,19 @@ def joint_stiffness(
 # ---- eq 21 and 22 -------------------------------------------------------------------------
 
 
+def exponential_design(amplitude: ArrayLike) -> FloatArray:
+    """Return eq 21's design matrix for ln E, (n, 2) columns 1, A."""
+    a = np.atleast_1d(np.asarray(amplitude, dtype=np.float64))
+    return np.column_stack((np.ones_like(a), a))
+
+
 def exponential_law(amplitude: ArrayLike, energy: ArrayLike, *, what: str = "eq 21") -> LinearFit:
     """Return eq 21, E = c1 exp(c2 A), fitted on ln E = ln c1 + c2 A (A m, E J)."""
-    a = np.asarray(amplitude, dtype=np.float64)
     e = np.asarray(energy, dtype=np.float64)
     if np.any(e <= 0):
         raise FitError(f"{what}: energies must be > 0 to fit on ln E")
     return linear_fit(
-        np.column_stack((np.ones_like(a), a)),
+        exponential_design(amplitude),
         np.log(e),
         ("ln_c1", "c2"),
         ("ln J", "1/m"),
@@ -214,19 +233,57 @@ def _energy_data(
     return w, c, a, e
 
 
+def evaluate_exponential_law(law: LinearFit, amplitude: ArrayLike) -> FloatArray:
+    """Return eq 21's E = c1 exp(c2 A) at A, J, shape (n,)."""
+    return np.asarray(np.exp(exponential_design(amplitude) @ law.values), dtype=np.float64)
+
+
+def _columns(*values: ArrayLike) -> list[FloatArray]:
+    arrays = np.broadcast_arrays(*(np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in values))
+    return [np.asarray(a, dtype=np.float64) for a in arrays]
+
+
+def dissipation_design(omega: ArrayLike, clearance: ArrayLike, amplitude: ArrayLike) -> FloatArray:
+    """Return eq 22's design matrix for ln E, (n, 6) columns 1, w, c, A, w A, c A."""
+    w, c, a = _columns(omega, clearance, amplitude)
+    return np.column_stack((np.ones_like(w), w, c, a, w * a, c * a))
+
+
 def dissipation_law(
-    omega: ArrayLike, clearance: ArrayLike, amplitude: ArrayLike, energy: ArrayLike
+    omega: ArrayLike,
+    clearance: ArrayLike,
+    amplitude: ArrayLike,
+    energy: ArrayLike,
+    *,
+    what: str = "eq 22",
 ) -> LinearFit:
-    """Return eq 22, ln E = (d0 + d1 w + d2 c) + (e0 + e1 w + e2 c) A, for all tests."""
-    w, c, a, e = _energy_data("eq 22", omega, clearance, amplitude, energy)
-    design = np.column_stack((np.ones_like(w), w, c, a, w * a, c * a))
+    """Return eq 22, ln E = (d0 + d1 w + d2 c) + (e0 + e1 w + e2 c) A, for all tests.
+
+    ``amplitude`` is whichever amplitude the caller chose (MODEL.md section 3: the
+    penetration Abar = X - c/2, or the total amplitude X a displacement sensor reads).
+    """
+    w, c, a, e = _energy_data(what, omega, clearance, amplitude, energy)
     return linear_fit(
-        design,
+        dissipation_design(w, c, a),
         np.log(e),
         ("d0", "d1", "d2", "e0", "e1", "e2"),
         ("ln J", "s/rad", "1/m", "1/m", "s/(rad m)", "1/m^2"),
-        what="eq 22",
+        what=what,
     )
+
+
+def evaluate_dissipation_law(
+    law: LinearFit, omega: ArrayLike, clearance: ArrayLike, amplitude: ArrayLike
+) -> FloatArray:
+    """Return E from eq 22's coefficients at (w, c, A), J, shape (n,)."""
+    design = dissipation_design(omega, clearance, amplitude)
+    return np.asarray(np.exp(design @ law.values), dtype=np.float64)
+
+
+def power_design(omega: ArrayLike, clearance: ArrayLike, amplitude: ArrayLike) -> FloatArray:
+    """Return the power law's design matrix for ln E, (n, 4) columns 1, ln w, ln A, c."""
+    w, c, a = _columns(omega, clearance, amplitude)
+    return np.column_stack((np.ones_like(w), np.log(w), np.log(a), c))
 
 
 def power_law(
@@ -236,18 +293,56 @@ def power_law(
     w, c, a, e = _energy_data("power law", omega, clearance, amplitude, energy)
     if np.any(a <= 0):
         raise FitError("power law: amplitudes must be > 0 to fit on ln A")
-    design = np.column_stack((np.ones_like(w), np.log(w), np.log(a), c))
     return linear_fit(
-        design, np.log(e), ("g0", "g1", "g2", "g3"), ("ln J", "1", "1", "1/m"), what="power law"
+        power_design(w, c, a),
+        np.log(e),
+        ("g0", "g1", "g2", "g3"),
+        ("ln J", "1", "1", "1/m"),
+        what="power law",
     )
 
 
-def evaluate_dissipation_law(
+def evaluate_power_law(
     law: LinearFit, omega: ArrayLike, clearance: ArrayLike, amplitude: ArrayLike
 ) -> FloatArray:
-    """E from eq 22's coefficients at (w, c, A), J."""
-    w = np.asarray(omega, dtype=np.float64)
-    c = np.asarray(clearance, dtype=np.float64)
-    a = np.asarray(amplitude, dtype=np.float64)
-    d0, d1, d2, e0, e1, e2 = law.values
-    return np.asarray(np.exp(d0 + d1 * w + d2 * c + (e0 + e1 * w + e2 * c) * a), dtype=np.float64)
+    """Return E from the power law at (w, c, A), J, shape (n,)."""
+    return np.asarray(np.exp(power_design(omega, clearance, amplitude) @ law.values))
+
+
+# ---- trends: a slope with its standard error, and a curvature check ------------------------
+
+
+def slope(law: LinearFit, weights: ArrayLike) -> tuple[float, float]:
+    """Return (g . b, its standard error sqrt(g C g)) for a weight vector g over the coefficients.
+
+    A derivative of a law linear in its coefficients is such a combination: for eq 22,
+    d ln E / dc at (w, A) has g = (0, 0, 1, 0, 0, A).
+    """
+    g = np.asarray(weights, dtype=np.float64)
+    if g.shape != law.values.shape:
+        raise FitError(f"slope: {g.size} weights for a law of {law.values.size} coefficients")
+    return float(g @ law.values), float(np.sqrt(max(float(g @ law.covariance @ g), 0.0)))
+
+
+def quadratic_design(main: ArrayLike, other: ArrayLike) -> FloatArray:
+    """Return the quadratic check's design matrix, (n, 4) columns 1, u, u^2, v."""
+    u, v = _columns(main, other)
+    return np.column_stack((np.ones_like(u), u, u * u, v))
+
+
+def quadratic_law(
+    main: ArrayLike, other: ArrayLike, y: ArrayLike, *, what: str = "quadratic check"
+) -> LinearFit:
+    """Return y = q0 + q1 u + q2 u^2 + q3 v fitted by least squares (u the variable studied).
+
+    q2 < 0 with q1 + 2 q2 u > 0 over the data says "rises and saturates" (the rate of
+    increase falls); q1 + 2 q2 u_min < 0 says "first falls". Units are the caller's.
+    """
+    return linear_fit(
+        quadratic_design(main, other), y, ("q0", "q1", "q2", "q3"), ("", "", "", ""), what=what
+    )
+
+
+def evaluate_quadratic_law(law: LinearFit, main: ArrayLike, other: ArrayLike) -> FloatArray:
+    """Return the quadratic check's y at (u, v), shape (n,)."""
+    return np.asarray(quadratic_design(main, other) @ law.values, dtype=np.float64)

@@ -213,12 +213,16 @@ class Joint:
         Stiffness k0 inside the gap (free-play), N/m, >= 0. Default 0 (the paper's choice).
     gap_offset : float, optional
         Position d of the gap's centre relative to x = 0 (the rest position of the
-        k0 spring), m, positive toward compression, with |d| <= c/2. Default 0.
+        k0 spring), m, positive toward compression, with abs(d) <= c/2. Default 0.
+
+    Every value may also be a pint Quantity or a unit string (``mass="2kg"``,
+    ``clearance="0.106mm"``): it is converted to SI; a bare number is SI.
 
     Raises
     ------
     ParameterError
-        A value is NaN, infinite or outside its range; the message names the field.
+        A value is NaN, infinite or outside its range, or its unit is not of the
+        field's dimension; the message names the field.
     """
 
     mass: float
@@ -375,7 +379,8 @@ class Pin:
     ) -> Pin:
         """A pin whose hole carries the joint's whole axial clearance: R_h = R_p + c/2."""
         c = _checks.positive("clearance", clearance, unit="m")
-        return cls(radius=radius, hole_radius=radius + 0.5 * c, length=length, **materials)
+        r_p = _checks.positive("pin radius", radius, unit="m")
+        return cls(radius=r_p, hole_radius=r_p + 0.5 * c, length=length, **materials)
 
 
 def _poisson(name: str, value: float) -> float:

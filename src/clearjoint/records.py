@@ -21,7 +21,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -31,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError
-from clearjoint.units import SI_UNITS, registry
+from clearjoint.units import SI_UNITS, registry, to_si
 
 FloatArray = NDArray[np.float64]
 
@@ -43,6 +42,14 @@ UNIFORM_TOLERANCE = 1e-4
 #: Cycles a record must span when its frequency is known.
 MIN_CYCLES = 3
 MIN_SAMPLES = 16
+#: The SI unit of each metadata quantity (a pint Quantity or "0.1mm" is converted to it).
+_META_SI = {
+    "clearance": "m",
+    "force_amplitude": "N",
+    "displacement_amplitude": "m",
+    "frequency_hz": "Hz",
+    "mass": "kg",
+}
 
 
 class RecordError(ClearjointError, ValueError):
@@ -142,7 +149,10 @@ class Record:
             value = getattr(self, name)
             if value is None:
                 continue
-            number = float(value)
+            try:
+                number = float(to_si(value, _META_SI[name], name=f"{where}: {name}"))
+            except (TypeError, ValueError) as exc:
+                raise RecordError(f"{where}: {name} must be a number, got {value!r}") from exc
             if not math.isfinite(number) or number < 0.0:
                 raise RecordError(f"{where}: {name} must be finite and >= 0, got {value!r}")
             set_(self, name, number)
@@ -208,8 +218,28 @@ def resample(
 # ---- units --------------------------------------------------------------------------------
 
 
+#: Exact factors of the units most files use, so that reading them does not build pint's
+#: registry (a second or two); tests/test_records.py checks each against pint.
+FAST_FACTORS = {
+    ("time", "s"): 1.0,
+    ("force", "N"): 1.0,
+    ("force", "kN"): 1e3,
+    ("force", "kip"): 4448.2216152605,
+    ("displacement", "m"): 1.0,
+    ("displacement", "mm"): 1e-3,
+    ("displacement", "um"): 1e-6,
+    ("displacement", "in"): 0.0254,
+    ("velocity", "m/s"): 1.0,
+    ("velocity", "in/s"): 0.0254,
+    ("acceleration", "m/s^2"): 1.0,
+}
+
+
 def _factor(where: str, channel: str, unit: str) -> float:
     """The factor that takes ``channel`` in ``unit`` to SI; errors name the file and channel."""
+    fast = FAST_FACTORS.get((channel, unit.strip()))
+    if fast is not None:
+        return fast
     import pint
 
     target = SI[channel]
@@ -220,7 +250,7 @@ def _factor(where: str, channel: str, unit: str) -> float:
             f"{where}: {channel} is in {unit!r}, which is not a unit of {target}; "
             "fix the unit in the file"
         ) from None
-    except (pint.errors.PintError, ValueError, AttributeError, TypeError):
+    except Exception:  # pint's parser raises many types on odd text ("(", "[")
         raise RecordError(
             f"{where}: unknown unit {unit!r} for {channel}; write a unit such as {target}"
         ) from None
@@ -231,6 +261,8 @@ def _factor(where: str, channel: str, unit: str) -> float:
 _COLUMN = re.compile(r"^\s*(?P<name>[A-Za-z_]+)\s*\[(?P<unit>[^\]]+)\]\s*$")
 
 #: Metadata keys of the CSV header and sidecar, with the kind of quantity (or text).
+#: A quantity takes its unit (``clearance = "0.106mm"``), or a bare number in a key that
+#: names the SI unit (``clearance_m = 1.06e-4``, ``frequency_hz = 20``).
 _META_KINDS = {
     "joint_id": "text",
     "control": "text",
@@ -241,83 +273,284 @@ _META_KINDS = {
     "frequency": "frequency",
     "mass": "mass",
 }
+_SUFFIX = {
+    "clearance": "m",
+    "force_amplitude": "n",
+    "displacement_amplitude": "m",
+    "frequency": "hz",
+    "mass": "kg",
+}
 
 
 def _metadata_from_toml(where: str, table: dict[str, Any]) -> dict[str, Any]:
-    from clearjoint.units import parse_quantity
+    """Record metadata from a header block or sidecar, in SI (io_toml: units or unit keys)."""
+    from clearjoint.io_toml import read_table
 
-    unknown = sorted(set(table) - set(_META_KINDS))
+    unknown = sorted(set(table) - set(_META_KINDS) - {f"{k}_{_SUFFIX[k]}" for k in _SUFFIX})
     if unknown:
         raise RecordError(f"{where}: unknown metadata {unknown}; known: {sorted(_META_KINDS)}")
-    meta: dict[str, Any] = {}
-    for key, value in table.items():
-        kind = _META_KINDS[key]
-        target = "frequency_hz" if key == "frequency" else key
-        if kind == "text":
-            meta[target] = str(value)
-        elif isinstance(value, int | float) and not isinstance(value, bool):
-            meta[target] = float(value)
-        else:
-            try:
-                meta[target] = parse_quantity(str(value), kind, name=f"{where}: {key}")
-            except ClearjointError as exc:
-                raise RecordError(str(exc)) from None
-    return meta
+    values = read_table(table, _META_KINDS, where=where, section="", error=RecordError)
+    return {("frequency_hz" if key == "frequency" else key): val for key, val in values.items()}
+
+
+_DELIMITERS = ("\t", ";", ",")
+_COMMENT = re.compile(r"^\s*(#|//|;|%|!)")
+_KEY_VALUE = re.compile(r"^\s*(?P<key>[^:=,;\t]+?)\s*[:=,;\t]\s*(?P<value>.*)$")
+_NAME_UNIT = re.compile(
+    r"^\s*(?P<name>[A-Za-z][A-Za-z _]*?)\s*(?:[\[(](?P<unit>[^\])]*)[\])])?\s*$"
+)
+#: Rows a block must hold to count as the data (and not a preamble line of numbers).
+_DATA_ROWS = 4
+#: The data must start within this many lines (a DAQ preamble is a few dozen).
+_PREAMBLE_LINES = 1000
+
+
+def _decode(where: str, data: bytes) -> str:
+    """A lab file's text: UTF-8 (with or without a BOM), else Latin-1 (Windows DAQ software)."""
+    if b"\x00" in data[:4096]:
+        raise RecordError(f"{where}: a binary file of unknown format; not a record")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
+def _fields(line: str, delimiter: str) -> list[str]:
+    """The cells of one line, unquoted; a trailing delimiter (common in DAQ exports) ignored."""
+    cells = [cell.strip().strip('"').strip() for cell in line.rstrip("\r\n").split(delimiter)]
+    return cells[:-1] if len(cells) > 1 and not cells[-1] else cells
+
+
+def _numbers(fields: list[str], decimal_comma: bool) -> bool:
+    try:
+        for field in fields:
+            float(field.replace(",", ".") if decimal_comma else field)
+    except ValueError:
+        return False
+    return True
+
+
+def _data_start(lines: list[str], delimiter: str) -> tuple[int, int] | None:
+    """Index of the first line of the numeric block under ``delimiter`` and its width."""
+    comma = delimiter != ","
+    for i, line in enumerate(lines[:_PREAMBLE_LINES]):
+        if delimiter not in line:
+            continue
+        fields = _fields(line, delimiter)
+        if len(fields) < 2 or not _numbers(fields, comma):
+            continue
+        following = [x for x in lines[i : i + 3 * _DATA_ROWS] if x.strip()][:_DATA_ROWS]
+        rows = [_fields(x, delimiter) for x in following]
+        if all(len(r) == len(fields) and _numbers(r, comma) for r in rows):
+            return i, len(fields)
+    return None
+
+
+def _units_row(fields: list[str]) -> bool:
+    """True when every field reads as a unit and none as a channel name."""
+
+    ureg = registry()
+    for cell in fields:
+        text = cell.strip("[]() ")
+        if text.lower() in SI:
+            return False
+        try:
+            ureg.Unit(text)
+        except Exception:  # pint's parser raises many types on odd text
+            return False
+    return True
+
+
+def _resolution(texts: list[str]) -> float:
+    """The clock's resolution implied by how time stamps are written: 10^-decimals."""
+    decimals = 0
+    for text in texts:
+        mantissa, _, exponent = text.lower().replace(",", ".").partition("e")
+        places = len(mantissa.partition(".")[2]) - (int(exponent) if exponent else 0)
+        decimals = max(decimals, places)
+    return 10.0 ** (-decimals)
+
+
+def regular_time(time: FloatArray, resolution: float) -> tuple[FloatArray, float]:
+    """A uniform clock t0 + i dt fitted to time stamps rounded to ``resolution``.
+
+    Stamps of a uniform clock rounded to its resolution (12 kHz written to 1 us)
+    have steps that differ by up to the resolution: that is rounding, not uneven
+    sampling. Returns the fitted uniform times and the largest distance of a stamp
+    from them; the caller accepts the fit only when that distance is within the
+    resolution.
+    """
+    index = np.arange(time.size, dtype=np.float64)
+    slope, intercept = np.polyfit(index, time, 1)
+    uniform = intercept + slope * index
+    return uniform, float(np.max(np.abs(time - uniform)))
 
 
 def _read_csv(path: Path, resample_: bool) -> Record:
-    import pandas as pd
+    """Read a CSV record: clearjoint's own layout or a lab file (docs/records.md).
 
+    Tolerated: the delimiter (comma, semicolon, tab; sniffed), a decimal comma (with a
+    semicolon or tab delimiter), a preamble of comment or key-value lines above the
+    column names, units in the names (``time [s]``, ``Force (kN)``) or in a row under
+    them, and time stamps rounded to the clock's resolution.
+    """
     where = str(path)
-    header: list[str] = []
-    with path.open(encoding="utf-8") as handle:
-        first = handle.readline()
-        if first.strip() == CSV_MAGIC:
-            for line in handle:
-                if not line.startswith("#"):
-                    break
-                header.append(line[1:].strip())
-    skip = len(header) + 1 if header else 0
-    if header:
-        try:
-            meta = _metadata_from_toml(where, tomllib.loads("\n".join(header)))
-        except tomllib.TOMLDecodeError as exc:
-            raise RecordError(
-                f"{where}: the header block is not key = value lines ({exc})"
-            ) from None
+    lines = _decode(where, path.read_bytes()).splitlines()
+    meta: dict[str, Any] = {}
+    body = 0
+    if lines and lines[0].strip() == CSV_MAGIC:
+        body = 1
+        while body < len(lines) and lines[body].startswith("#"):
+            body += 1
+        block = [line[1:].strip() for line in lines[1:body]]
+        from clearjoint.io_toml import parse_toml
+
+        table = parse_toml("\n".join(block), where=where, what="record header", error=RecordError)
+        meta = _metadata_from_toml(where, table)
     else:
         sidecar = path.with_suffix(".toml")
-        if not sidecar.exists():
-            meta = {}
-        else:
-            try:
-                table = tomllib.loads(sidecar.read_text(encoding="utf-8"))
-            except tomllib.TOMLDecodeError as exc:
-                raise RecordError(f"{sidecar}: not valid TOML ({exc})") from None
+        if sidecar.exists():
+            from clearjoint.io_toml import read_toml
+
+            table = read_toml(sidecar, what="record metadata", error=RecordError)
             meta = _metadata_from_toml(str(sidecar), table.get("record", table))
-    try:
-        frame = pd.read_csv(path, skiprows=skip, skipinitialspace=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise RecordError(f"{where}: not a readable CSV file ({exc})") from None
-    columns: dict[str, FloatArray] = {}
-    units: dict[str, str] = {}
-    for column in frame.columns:
-        match = _COLUMN.match(str(column))
-        if not match:
+    found = {d: _data_start(lines[body:], d) for d in _DELIMITERS}
+    candidates = [(hit[1], d) for d, hit in found.items() if hit is not None]
+    if not candidates:
+        _no_numbers(where, lines[body:], body)
+        raise RecordError(
+            f"{where}: no block of numbers found; a CSV record has columns time, force and "
+            "displacement separated by commas, semicolons or tabs"
+        )
+    _, delimiter = max(candidates)
+    start, width = found[delimiter]  # type: ignore[misc]
+    start += body
+    above = [i for i in range(body, start) if lines[i].strip()]
+    if not above:
+        raise RecordError(
+            f"{where}: no column names above the numbers; name them like "
+            "'time [s]', 'force [N]', 'displacement [mm]'"
+        )
+    header_at = above.pop()
+    unit_fields: list[str] | None = None
+    if _units_row(_fields(lines[header_at], delimiter)) and above:
+        unit_fields = _fields(lines[header_at], delimiter)
+        header_at = above.pop()
+    names = _fields(lines[header_at], delimiter)
+    if len(names) != width or (unit_fields is not None and len(unit_fields) != width):
+        raise RecordError(
+            f"{where}: line {header_at + 1} names {len(names)} columns but the numbers under "
+            f"it have {width}; check the delimiter {delimiter!r} and the column names"
+        )
+    notes = []
+    for i in above:
+        line = lines[i]
+        if _COMMENT.match(line):
+            continue
+        pair = _KEY_VALUE.match(line)
+        if not pair or not pair["value"].strip():
             raise RecordError(
-                f"{where}: column {column!r} has no unit; name columns like "
-                "'time [s]', 'force [N]', 'displacement [mm]'"
+                f"{where}: line {i + 1} ({line.strip()[:40]!r}) above the column names is "
+                "neither a comment (#, //) nor a key and value; remove it or comment it out"
             )
-        name, unit = match["name"].lower(), match["unit"]
+        notes.append(f"{pair['key'].strip()}: {pair['value'].strip().strip(chr(34))}")
+    if notes:
+        preamble = "; ".join(notes)
+        meta["notes"] = f"{meta['notes']}; {preamble}" if meta.get("notes") else preamble
+    channels: list[tuple[str, str]] = []
+    for k, name_text in enumerate(names):
+        match = _NAME_UNIT.match(name_text)
+        if not match:
+            raise RecordError(f"{where}: cannot read the column name {name_text!r}")
+        name = match["name"].strip().lower().replace(" ", "_")
+        unit = (match["unit"] or "").strip()
+        if unit_fields is not None and not unit:
+            unit = unit_fields[k].strip("[]() ")
         if name not in SI:
             raise RecordError(f"{where}: unknown column {name!r}; known: {', '.join(SI)}")
-        try:
-            values = frame[column].to_numpy(dtype=np.float64)
-        except (TypeError, ValueError):
-            raise RecordError(f"{where}: column {column!r} is not numeric") from None
-        columns[name] = values * _factor(where, name, unit)
+        if not unit:
+            raise RecordError(
+                f"{where}: column {name_text!r} has no unit; name columns like "
+                "'time [s]', 'force [N]', 'displacement [mm]', or put a row of units under them"
+            )
+        channels.append((name, unit))
+    import io
+
+    import pandas as pd
+
+    rows = lines[start:]
+    try:
+        frame = pd.read_csv(
+            io.StringIO("\n".join(rows)),
+            sep=delimiter,
+            header=None,
+            decimal="," if delimiter != "," and any("," in r for r in rows[:100]) else ".",
+            skipinitialspace=True,
+            dtype=np.float64,
+        )
+    except (ValueError, pd.errors.ParserError) as exc:
+        raise RecordError(f"{where}: a column is not numeric ({exc})") from None
+    if frame.shape[1] == width + 1 and frame.iloc[:, -1].isna().all():
+        frame = frame.iloc[:, :-1]  # the empty cell after a trailing delimiter
+    table_ = frame.to_numpy(dtype=np.float64)
+    if table_.shape[1] != width:
+        raise RecordError(f"{where}: rows of {table_.shape[1]} values under {width} column names")
+    columns: dict[str, FloatArray] = {}
+    units: dict[str, str] = {}
+    for k, (name, unit) in enumerate(channels):
+        columns[name] = table_[:, k] * _factor(where, name, unit)
         units[name] = unit
+    if "time" in columns:
+        columns["time"] = _clock(where, columns["time"], rows, delimiter, channels, resample_)
     return _assemble(where, columns, units, meta, resample_)
+
+
+def _no_numbers(where: str, lines: list[str], offset: int) -> None:
+    """Raise the error for column names over rows that are not all numbers, if so."""
+    for delimiter in _DELIMITERS:
+        for i, line in enumerate(lines[:_PREAMBLE_LINES]):
+            fields = _fields(line, delimiter)
+            matches = [_NAME_UNIT.match(f) for f in fields]
+            if len(fields) >= 2 and all(m and m["name"].strip().lower() in SI for m in matches):
+                below = [(j, x) for j, x in enumerate(lines[i + 1 :], start=i + 1) if x.strip()]
+                if below:
+                    j, row = below[0]
+                    if _units_row(_fields(row, delimiter)) and len(below) > 1:
+                        j, row = below[1]
+                    raise RecordError(
+                        f"{where}: the rows under the column names are not numeric "
+                        f"(line {offset + j + 1}: {row.strip()[:40]!r})"
+                    )
+
+
+def _clock(
+    where: str,
+    time: FloatArray,
+    rows: list[str],
+    delimiter: str,
+    channels: list[tuple[str, str]],
+    resample_: bool,
+) -> FloatArray:
+    """The time column, made uniform when its steps differ only by the stamps' rounding."""
+    step = np.diff(time)
+    if step.size == 0 or np.any(step <= 0.0):
+        return time
+    if np.ptp(step) <= UNIFORM_TOLERANCE * np.mean(step):
+        return time
+    k = [name for name, _ in channels].index("time")
+    factor = _factor(where, "time", channels[k][1])
+    stamps = [_fields(row, delimiter)[k] for row in rows if row.strip()]
+    resolution = _resolution(stamps) * factor
+    uniform, stray = regular_time(time, resolution)
+    if stray <= resolution:
+        return uniform
+    if resample_:
+        return time  # uneven beyond the rounding: _assemble interpolates it
+    raise RecordError(
+        f"{where}: not uniformly sampled: time stamps stray up to {stray:.3g} s from a uniform "
+        f"clock, beyond their resolution {resolution:.3g} s; read it with resample=True "
+        "(--resample) to interpolate onto a uniform grid"
+    )
 
 
 def _assemble(
@@ -416,23 +649,50 @@ def _text(value: Any) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _write_netcdf(record: Record, path: Path) -> None:
+def record_dataset(time: ArrayLike, channels: dict[str, Any], metadata: dict[str, Any]) -> Any:
+    """Return the one netCDF layout of a time record, as an xarray Dataset (not validated).
+
+    Every time record the package writes (``write_record``, ``clearjoint simulate
+    --out``) goes through here, so that ``read_record`` and ``clearjoint identify``
+    read them all.
+
+    Parameters
+    ----------
+    time : (N,) array_like
+        Sample times, s.
+    channels : dict
+        Channel name of :data:`CHANNELS` -> (N,) array in SI (None: not measured).
+    metadata : dict
+        Record metadata by field name (``clearance``, ``mass``, ``frequency_hz``...).
+
+    Returns
+    -------
+    xarray.Dataset
+        Variables ``force``, ``displacement``... on ``time``, each with ``units``;
+        metadata as global attributes ``clearance_m``, ``mass_kg``... Callers may add
+        variables on other dimensions (a simulation adds its stages and impacts).
+    """
     import xarray as xr
 
+    unknown = sorted(set(channels) - set(CHANNELS))
+    if unknown:
+        raise RecordError(f"unknown channel(s) {unknown}; a record has {', '.join(CHANNELS)}")
     variables = {
-        name: ("time", getattr(record, name), {"units": SI[name]})
+        name: ("time", np.asarray(channels[name], dtype=np.float64), {"units": SI[name]})
         for name in CHANNELS
-        if getattr(record, name) is not None
+        if channels.get(name) is not None
     }
     attrs: dict[str, Any] = {"clearjoint_record": 1}
-    meta = record.metadata()
     for attr, key in _NC_META.items():
-        if meta.get(key) not in (None, ""):
-            attrs[attr] = meta[key]
-    data = xr.Dataset(
-        variables, coords={"time": ("time", record.time, {"units": "s"})}, attrs=attrs
-    )
-    data.to_netcdf(path, engine="h5netcdf")
+        if metadata.get(key) not in (None, ""):
+            attrs[attr] = metadata[key]
+    coords = {"time": ("time", np.asarray(time, dtype=np.float64), {"units": "s"})}
+    return xr.Dataset(variables, coords=coords, attrs=attrs)
+
+
+def _write_netcdf(record: Record, path: Path) -> None:
+    channels = {name: getattr(record, name) for name in CHANNELS}
+    record_dataset(record.time, channels, record.metadata()).to_netcdf(path, engine="h5netcdf")
 
 
 # ---- the BRFD data set --------------------------------------------------------------------
@@ -545,6 +805,8 @@ def sniff(path: str | Path) -> str:
         raise RecordError(f"{where}: no such file") from None
     except IsADirectoryError:
         raise RecordError(f"{where}: is a folder, not a record file") from None
+    except OSError as exc:
+        raise RecordError(f"{where}: cannot read it ({exc.strerror})") from None
     if not head:
         raise RecordError(f"{where}: empty file")
     if head.startswith(_HDF5):
@@ -576,11 +838,14 @@ def read_record(path: str | Path, *, resample: bool = False) -> Record:
     """
     path = Path(path)
     kind = sniff(path)
-    if kind == "netcdf":
-        return _read_netcdf(path, resample)
-    if kind == "json":
-        return read_brfd(path, resample=resample)
-    return _read_csv(path, resample)
+    try:
+        if kind == "netcdf":
+            return _read_netcdf(path, resample)
+        if kind == "json":
+            return read_brfd(path, resample=resample)
+        return _read_csv(path, resample)
+    except OSError as exc:  # truncated, or gone or locked between the sniff and the read
+        raise RecordError(f"{path}: cannot read it ({exc.strerror or exc})") from None
 
 
 def write_record(record: Record, path: str | Path, *, force: bool = False) -> Path:

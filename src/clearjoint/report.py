@@ -1,11 +1,15 @@
-"""The paper's study from records to a report: identification, fitted laws, figures, HTML.
+"""Render a study to files: report.html, results.json, results.csv and fits.csv.
 
-``reproduce`` runs the whole study on the virtual rig's default campaign;
-``report_records`` runs the same analysis on a folder of a user's own records.
-Both write one self-contained HTML file (figures embedded, no external
+No analysis and no physics here: :func:`write_report` takes a :class:`Study` (the
+analysis, the findings table, the figures, and for the virtual rig the checks against
+its truth) and writes one self-contained HTML file (figures embedded, no external
 resources), ``results.json`` with every number, ``results.csv`` (one row per
-identified record) and ``fits.csv`` (every fitted coefficient with its standard
-error). MODEL.md section 3 and 4.
+identified record) and ``fits.csv`` (every fitted coefficient with its standard error).
+The page opens with a summary: what was run, the findings table, the identification
+against the truth, and what to distrust; long tables fold away in ``<details>`` and
+speak engineering units (um, MN/m, mJ) with the unit in the header. Files keep SI with
+the unit in each column's name. Record paths are relative to the records folder.
+MODEL.md section 4.
 """
 
 from __future__ import annotations
@@ -16,8 +20,8 @@ import html
 import io
 import json
 import math
-import warnings
-from collections.abc import Callable, Sequence
+import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,30 +29,10 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from clearjoint import fit, stiffness
+from clearjoint import fit
 from clearjoint._checks import refuse_to_overwrite
-from clearjoint.contact import HertzValidityWarning
-from clearjoint.dissipation import compare, energies
-from clearjoint.figures import (
-    Curve,
-    EnergyLawPanel,
-    StiffnessPanel,
-    coefficient_bars_figure,
-    displacement_stages_figure,
-    energy_law_figure,
-    law_versus_measured_figure,
-    stiffness_coefficient_figure,
-    stiffness_panels_figure,
-)
-from clearjoint.identify import Identification, identify_files
-from clearjoint.joint import Friction, Joint
-from clearjoint.records import Record
-from clearjoint.simulate import SteadyState, steady_state
-
-Progress = Callable[[str], None]
-
-#: The paper's two joints (c = 0.106 mm and 0.196 mm).
-PAPER_CLEARANCES: tuple[float, ...] = (0.106e-3, 0.196e-3)
+from clearjoint.analysis import Analysis
+from clearjoint.findings import Finding, Timing
 
 #: What the study assumes, stated in every report.
 ASSUMPTIONS: tuple[str, ...] = (
@@ -60,151 +44,41 @@ ASSUMPTIONS: tuple[str, ...] = (
     " a1 mean(w)/mean(k) and a2 mean(A)/mean(k).",
     "Eq 20 puts the non-jointed structure and the joint in series, k_dj = k_d k_dn/(k_dn - k_d),"
     " with k_dn from the non-jointed eq 19 law at the same w and A.",
-    "Eq 21 and 22 use Abar = X - c/2 and are fitted on ln E; eq 22 is compared with a power law"
-    " by AIC. With only two clearances the law's linearity in c cannot be tested.",
+    "Figs. 8-10 and eq 19-20 use the per-side dynamic stiffness k_d,s = m (pi / tau_s)^2 of"
+    " MODEL.md section 3 (contact time of side s plus one free-play crossing, section 1's exact"
+    " times from the identified slopes, A_s and c; gap centred); the contact slopes have their"
+    " own eq 19 and figure.",
+    "Eq 21 and 22 are fitted on ln E with A = Abar = X - c/2; eq 22 also with A = X, and is"
+    " compared with a power law by AIC. With only two clearances the law's linearity in c"
+    " cannot be tested.",
     "Sliding friction acts over the whole path; contact friction on the pin is evaluated along"
     " the motion without feedback on it.",
     "The virtual rig's dimensions (the paper's Fig. 6 was lost) are in docs/rig.md.",
 )
 
 
-# ---- the analysis -------------------------------------------------------------------------
-
-
 @dataclass
-class Analysis:
-    """Identified tests, the fitted laws, and the reasons for any law not fitted."""
+class Study:
+    """What a report shows: the analysis, its findings and figures, and the rig's checks.
 
-    rows: list[dict[str, Any]]
-    identifications: list[tuple[Record, Identification]]
-    failures: list[str]
-    stiffness_laws: dict[str, fit.LinearFit] = field(default_factory=dict)
-    normalised: dict[str, tuple[float, float]] = field(default_factory=dict)
-    joint_stiffness: dict[str, fit.JointStiffness] = field(default_factory=dict)
-    exponential_laws: dict[str, fit.LinearFit] = field(default_factory=dict)
-    dissipation_law: fit.LinearFit | None = None
-    alternative_law: fit.LinearFit | None = None
-    not_fitted: list[str] = field(default_factory=list)
-
-
-def _group(record: Record, ident: Identification) -> str:
-    """A structure's name: its joint id (and nominal clearance), or 'beam' when it has none."""
-    if ident.model == "line":
-        return record.joint_id or "no clearance"
-    return record.joint_id or f"c = {ident.summary['clearance_m'] * 1e3:.3f} mm"
-
-
-def _study_rows(results: list[tuple[Record, Identification]]) -> list[dict[str, Any]]:
-    rows = []
-    for record, ident in results:
-        row = ident.row()
-        c_nominal = record.clearance if record.clearance else row["clearance_m"]
-        nominal = record.frequency_hz or float(f"{row['frequency_hz']:.4g}")
-        row.update(
-            test_frequency_hz=nominal,
-            structure=_group(record, ident),
-            jointed=ident.model != "line",
-            nominal_clearance_m=c_nominal,
-            omega=2.0 * math.pi * nominal,
-            mean_amplitude_m=row["amplitude_m"] - 0.5 * row["clearance_m"],
-            force_amplitude_n=record.force_amplitude,
-        )
-        rows.append(row)
-    return rows
-
-
-def _tests_of(rows: list[dict[str, Any]], name: str) -> list[dict[str, Any]]:
-    """A structure's tests; for a jointed one, only those whose loop showed its clearance.
-
-    A test of a jointed structure identified as a straight line (its stages not found)
-    carries no contact stiffness of the joint, so it stays out of its laws.
+    ``accuracy``, ``worst`` and ``comparisons`` are the identification against the
+    virtual rig's truth and section 2's closed form against the exact cycle (None for
+    a user's records); ``truth_figures`` are drawn in the summary.
     """
-    tests = [r for r in rows if r["structure"] == name]
-    jointed = [r for r in tests if r["jointed"]]
-    return jointed or tests
 
-
-def _attempt(
-    analysis: Analysis, title: str, law: Callable[..., fit.LinearFit], *args: Any, **kwargs: Any
-) -> fit.LinearFit | None:
-    """Fit one law, or note why it could not be fitted."""
-    try:
-        return law(*args, **kwargs)
-    except fit.FitError as exc:
-        text = str(exc)
-        analysis.not_fitted.append(text if text.startswith(title) else f"{title}: {text}")
-        return None
-
-
-def analyse(results: list[tuple[Record, Identification]], failures: list[str]) -> Analysis:
-    """Fit eq 19-22 to identified tests (each law that cannot be fitted says why)."""
-    rows = _study_rows(results)
-    analysis = Analysis(rows=rows, identifications=results, failures=failures)
-    structures = sorted({r["structure"] for r in rows})
-    beams = [s for s in structures if not any(r["jointed"] for r in rows if r["structure"] == s)]
-    for name in structures:
-        sel = _tests_of(rows, name)
-        for side, key_a in (
-            ("compression", "compression_penetration_m"),
-            ("tension", "tension_penetration_m"),
-        ):
-            w = np.array([r["omega"] for r in sel])
-            a = np.array([r[key_a] if r["jointed"] else r["amplitude_m"] for r in sel])
-            k = np.array([r[f"{side}_stiffness_n_per_m"] for r in sel])
-            label = f"{name}, {side}"
-            law = _attempt(
-                analysis, f"eq 19 {label}", fit.stiffness_law, w, a, k, what=f"eq 19 {label}"
-            )
-            if law is not None:
-                analysis.stiffness_laws[label] = law
-                analysis.normalised[label] = fit.normalised_coefficients(law, w, a, k)
-    for name in structures:
-        if name in beams:
-            continue
-        for side in ("compression", "tension"):
-            label = f"{name}, {side}"
-            beam_label = f"{beams[0]}, {side}" if beams else None
-            if label not in analysis.stiffness_laws or beam_label not in analysis.stiffness_laws:
-                analysis.not_fitted.append(
-                    f"eq 20 {label}: needs eq 19 for it and for a structure without clearance"
-                )
-                continue
-            sel = _tests_of(rows, name)
-            key_a = f"{side}_penetration_m"
-            analysis.joint_stiffness[label] = fit.joint_stiffness(
-                analysis.stiffness_laws[label],
-                analysis.stiffness_laws[beam_label],
-                [r["omega"] for r in sel],
-                [r[key_a] for r in sel],
-            )
-    jointed = [r for r in rows if r["jointed"]]
-    for name in sorted({r["structure"] for r in jointed}):
-        for f in sorted({r["test_frequency_hz"] for r in jointed if r["structure"] == name}):
-            sel = [r for r in jointed if r["structure"] == name and r["test_frequency_hz"] == f]
-            label = f"{name}, {f:g} Hz"
-            law = _attempt(
-                analysis,
-                f"eq 21 {label}",
-                fit.exponential_law,
-                [r["mean_amplitude_m"] for r in sel],
-                [r["energy_per_cycle_j"] for r in sel],
-                what=f"eq 21 {label}",
-            )
-            if law is not None:
-                analysis.exponential_laws[label] = law
-    if jointed:
-        args = (
-            [r["omega"] for r in jointed],
-            [r["nominal_clearance_m"] for r in jointed],
-            [r["mean_amplitude_m"] for r in jointed],
-            [r["energy_per_cycle_j"] for r in jointed],
-        )
-        analysis.dissipation_law = _attempt(analysis, "eq 22", fit.dissipation_law, *args)
-        analysis.alternative_law = _attempt(analysis, "power law", fit.power_law, *args)
-    return analysis
-
-
-# ---- figures ------------------------------------------------------------------------------
+    title: str
+    what_was_run: list[str]
+    analysis: Analysis
+    findings: list[Finding]
+    figures: dict[str, Figure]
+    records_folder: Path
+    truth_figures: dict[str, Figure] = field(default_factory=dict)
+    accuracy: list[dict[str, Any]] | None = None
+    worst: dict[str, float] | None = None
+    comparisons: list[dict[str, Any]] | None = None
+    control: str = ""
+    control_analysis: Analysis | None = None
+    timing: Timing | None = None
 
 
 def _png(fig: Figure) -> bytes:
@@ -213,159 +87,19 @@ def _png(fig: Figure) -> bytes:
     return buffer.getvalue()
 
 
-def stiffness_study(
-    clearances: Sequence[float] = PAPER_CLEARANCES,
-    *,
-    gap_stiffness_ratio: float = 0.05,
-    tension_ratio: float = 0.7,
-    max_amplitude: float = 0.5e-3,
-    points: int = 300,
-) -> list[Curve]:
-    """Fig. 12's curves: eq 9 (k0 = 0) and the exact c_d for k0 > 0, k_t < k_c, per clearance."""
-    a = np.linspace(0.0, max_amplitude, points)
-    curves = []
-    for c in clearances:
-        joint = Joint(mass=2.0, clearance=c, compression_stiffness=8e7)
-        curves.append(
-            Curve(
-                a, stiffness.stiffness_coefficient(joint, a), f"c = {c * 1e3:.3f} mm, eq 9 (k0 = 0)"
-            )
-        )
-    for c in clearances:
-        joint = Joint(
-            mass=2.0,
-            clearance=c,
-            compression_stiffness=8e7,
-            tension_stiffness=tension_ratio * 8e7,
-            gap_stiffness=gap_stiffness_ratio * 8e7,
-        )
-        curves.append(
-            Curve(
-                a,
-                stiffness.stiffness_coefficient(joint, a),
-                f"c = {c * 1e3:.3f} mm, exact, k0 = {gap_stiffness_ratio:g} k_c, "
-                f"k_t = {tension_ratio:g} k_c",
-            )
-        )
-    return curves
-
-
-def example_cycle() -> SteadyState:
-    """The exact steady cycle of the c = 0.106 mm joint at 1 kN, 400 Hz (examples/study.toml)."""
-    joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, tension_stiffness=5e7)
-    return steady_state(
-        joint,
-        1000.0,
-        2.0 * np.pi * 400.0,
-        damping_ratio=0.01,
-        restitution=0.8,
-        friction=Friction(0.2, 300.0),
-        samples_per_period=512,
-    )
-
-
-def _figures(analysis: Analysis, model_energy: Sequence[float] | None) -> dict[str, bytes]:
-    rows = analysis.rows
-    out: dict[str, bytes] = {}
-    # Fig. 7: the first jointed record with its stages
-    for record, ident in analysis.identifications:
-        if ident.model != "line":
-            first = ident.cycles[-3] if len(ident.cycles) >= 3 else ident.cycles[0]
-            span = slice(first.start, ident.cycles[-1].stop)
-            runs = [
-                r
-                for r in ident.stage_runs(record.time)
-                if r[2] >= record.time[span.start] and r[1] <= record.time[span.stop - 1]
-            ]
-            out[f"Fig. 7: stages of {Path(ident.source).name}"] = _png(
-                displacement_stages_figure(record.time[span], record.displacement[span], runs)
-            )
-            break
-    panels = []
-    for label, law in analysis.stiffness_laws.items():
-        name, side = label.rsplit(", ", 1)
-        sel = _tests_of(rows, name)
-        key_a = f"{side}_penetration_m" if sel and sel[0]["jointed"] else "amplitude_m"
-        freq = np.array([r["test_frequency_hz"] for r in sel])
-        amp = np.array([r[key_a] for r in sel])
-        k = np.array([r[f"{side}_stiffness_n_per_m"] for r in sel])
-        grid = np.linspace(amp.min(), amp.max(), 20)
-        lines = {
-            f: (grid, fit.predict(law, 2 * math.pi * f * np.ones_like(grid), grid))
-            for f in sorted(set(freq.tolist()))
-        }
-        panels.append(StiffnessPanel(label, freq, amp, k, lines))
-    if panels:
-        out["Fig. 8: stiffness with the eq 19 planes"] = _png(
-            stiffness_panels_figure(panels, ylabel="stiffness (MN/m)")
-        )
-    if analysis.normalised:
-        labels = list(analysis.normalised)
-        out["Fig. 9: normalised eq 19 coefficients"] = _png(
-            coefficient_bars_figure(
-                labels,
-                [v[0] for v in analysis.normalised.values()],
-                [v[1] for v in analysis.normalised.values()],
-            )
-        )
-    panels = []
-    for label, js in analysis.joint_stiffness.items():
-        freq = js.omega / (2 * math.pi)
-        panels.append(StiffnessPanel(label, freq, js.amplitude, js.value, {}, js.error))
-    if panels:
-        out["Fig. 10: the joint's own stiffness, eq 20"] = _png(
-            stiffness_panels_figure(panels, ylabel="joint stiffness k_dj (MN/m)")
-        )
-    energy_panels = []
-    for name in sorted({r["structure"] for r in rows if r["jointed"]}):
-        sel = _tests_of(rows, name)
-        freq = np.array([r["test_frequency_hz"] for r in sel])
-        amp = np.array([r["mean_amplitude_m"] for r in sel])
-        energy = np.array([r["energy_per_cycle_j"] for r in sel])
-        curves = {}
-        for f in sorted(set(freq.tolist())):
-            exponential = analysis.exponential_laws.get(f"{name}, {f:g} Hz")
-            if exponential is not None:
-                grid = np.linspace(amp[freq == f].min(), amp[freq == f].max(), 20)
-                curves[f] = (grid, np.exp(exponential.values[0] + exponential.values[1] * grid))
-        energy_panels.append(EnergyLawPanel(name, freq, amp, energy, curves))
-    if energy_panels:
-        out["Fig. 11: energy per cycle with the eq 21 laws"] = _png(
-            energy_law_figure(energy_panels)
-        )
-    out["Fig. 12: stiffness coefficient c_d against amplitude"] = _png(
-        stiffness_coefficient_figure(stiffness_study())
-    )
-    general = analysis.dissipation_law
-    if general is not None:
-        jointed = [r for r in rows if r["jointed"]]
-        measured = np.array([r["energy_per_cycle_j"] for r in jointed])
-        predicted = fit.evaluate_dissipation_law(
-            general,
-            [r["omega"] for r in jointed],
-            [r["nominal_clearance_m"] for r in jointed],
-            [r["mean_amplitude_m"] for r in jointed],
-        )
-        model = np.array(model_energy) if model_energy is not None else None
-        out["Fig. 13: eq 22 and the section-2 model against the measured energy"] = _png(
-            law_versus_measured_figure(
-                measured, predicted, model, np.array([r["structure"] for r in jointed])
-            )
-        )
-    return out
-
-
-# ---- writing ------------------------------------------------------------------------------
+# ---- tables -----------------------------------------------------------------------------------
 
 
 def _fit_rows(analysis: Analysis) -> list[dict[str, Any]]:
     out: list[dict[str, Any]] = []
     groups: list[tuple[str, dict[str, fit.LinearFit]]] = [
         ("eq 19", analysis.stiffness_laws),
+        ("eq 19 slopes", analysis.contact_laws),
         ("eq 21", analysis.exponential_laws),
     ]
     for law_name, single in (
         ("eq 22", analysis.dissipation_law),
+        ("eq 22 (A = X)", analysis.dissipation_law_total),
         ("power law", analysis.alternative_law),
     ):
         if single is not None:
@@ -386,13 +120,45 @@ def _fit_rows(analysis: Analysis) -> list[dict[str, Any]]:
     return out
 
 
-def _html_table(rows: list[dict[str, Any]], columns: Sequence[str]) -> str:
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
+#: The identified tests as the page shows them: (header with unit, row key, scale).
+TEST_COLUMNS: tuple[tuple[str, str, float], ...] = (
+    ("file", "file", 1.0),
+    ("structure", "structure", 1.0),
+    ("f (Hz)", "frequency_hz", 1.0),
+    ("X (µm)", "amplitude_m", 1e6),
+    ("c (µm)", "clearance_m", 1e6),
+    ("A_c (µm)", "compression_penetration_m", 1e6),
+    ("A_t (µm)", "tension_penetration_m", 1e6),
+    ("k_c,meas (MN/m)", "compression_stiffness_n_per_m", 1e-6),
+    ("k_t,meas (MN/m)", "tension_stiffness_n_per_m", 1e-6),
+    ("k_d,c (MN/m)", "compression_dynamic_stiffness_n_per_m", 1e-6),
+    ("k_d,t (MN/m)", "tension_dynamic_stiffness_n_per_m", 1e-6),
+    ("friction (N)", "friction_force_n", 1.0),
+    ("E per cycle (mJ)", "energy_per_cycle_j", 1e3),
+    ("cycles used", "cycles_used", 1.0),
+    ("model", "model", 1.0),
+)
+
+
+def html_table(
+    rows: Sequence[dict[str, Any]], columns: Sequence[str | tuple[str, str, float]]
+) -> str:
+    """An HTML table; a column is a row key, or (header, row key, scale to the header's unit)."""
+    spec = [(c, c, 1.0) if isinstance(c, str) else c for c in columns]
+    head = "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in spec)
     body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(_fmt(row.get(c)))}</td>" for c in columns) + "</tr>"
+        "<tr>"
+        + "".join(f"<td>{html.escape(_fmt(_scaled(row.get(k), f)))}</td>" for _, k, f in spec)
+        + "</tr>"
         for row in rows
     )
     return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _scaled(value: Any, factor: float) -> Any:
+    if factor != 1.0 and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value) * factor
+    return value
 
 
 def _items(values: Sequence[str]) -> str:
@@ -405,34 +171,103 @@ def _fmt(value: Any) -> str:
     return "" if value is None else str(value)
 
 
-def _html(analysis: Analysis, figures: dict[str, bytes], extra: dict[str, str], title: str) -> str:
-    images = "".join(
-        f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,'
-        f'{base64.b64encode(data).decode("ascii")}"><figcaption>{html.escape(name)}'
+def _details(summary: str, content: str, *, open_: bool = False) -> str:
+    flag = " open" if open_ else ""
+    return f"<details{flag}><summary>{html.escape(summary)}</summary>{content}</details>"
+
+
+def _figure(caption: str, data: bytes) -> str:
+    return (
+        f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,'
+        f'{base64.b64encode(data).decode("ascii")}"><figcaption>{html.escape(caption)}'
         "</figcaption></figure>"
-        for name, data in figures.items()
     )
-    fits = _html_table(
+
+
+def _relative(path: str, folder: Path) -> str:
+    try:
+        return os.path.relpath(path, folder)
+    except ValueError:  # another drive
+        return Path(path).name
+
+
+# ---- the page ---------------------------------------------------------------------------------
+
+
+def findings_html(findings: Sequence[Finding]) -> str:
+    """The findings table: one row per paper finding, reproduced and source first."""
+    head = "<tr><th>paper finding</th><th>reproduced</th><th>source</th><th>evidence</th></tr>"
+    body = "".join(
+        f'<tr class="{"yes" if f.reproduced else "no"}"><td><b>{html.escape(f.finding)}</b><br>'
+        f"<small>{html.escape(f.paper)}</small></td>"
+        f"<td>{'yes' if f.reproduced else 'NO'}</td><td>{html.escape(f.source)}</td>"
+        f"<td><small>{html.escape(f.evidence)}</small><br><i>{html.escape(f.why)}</i></td></tr>"
+        for f in findings
+    )
+    return f'<table id="findings">{head}{body}</table>'
+
+
+def distrust(study: Study) -> list[str]:
+    """What a reader should not take at face value, from the study's own numbers."""
+    out = []
+    analysis = study.analysis
+    given = [f.finding for f in study.findings if f.reproduced and f.source == "rig input"]
+    if given:
+        out.append(
+            "Reproduced only because the test article was given it (rig input): "
+            + "; ".join(given)
+            + "."
+        )
+    missing = [f.finding for f in study.findings if not f.reproduced]
+    if missing:
+        out.append("Not reproduced (see the evidence): " + "; ".join(missing) + ".")
+    poor = sorted(
+        {
+            f"{r['law']} {r['group']} (R^2 = {r['r_squared']:.2f})"
+            for r in _fit_rows(analysis)
+            if r["r_squared"] < 0.5
+        }
+    )
+    if poor:
+        out.append("Laws with R^2 below 0.5, which do not describe their data: " + "; ".join(poor))
+    if analysis.not_fitted:
+        out.append(f"{len(analysis.not_fitted)} law(s) could not be fitted (listed below).")
+    if analysis.failures:
+        out.append(f"{len(analysis.failures)} record(s) were not used (listed below).")
+    if study.comparisons:
+        gaps = [abs(c["gap"]) for c in study.comparisons if math.isfinite(c["gap"])]
+        if gaps and max(gaps) > 0.1:
+            out.append(
+                f"Section 2's closed form is up to {max(gaps):.0%} off the exact cycle on these"
+                " forced tests (Fig. 13's grey points): use it for trends, not for numbers."
+            )
+    clearances = {r["nominal_clearance_m"] for r in analysis.rows if r["jointed"]}
+    if len(clearances) == 2:
+        out.append(
+            "With two clearances eq 22's dependence on c is a straight line through two points:"
+            " its linearity in c cannot be tested."
+        )
+    return out
+
+
+def _html(study: Study) -> str:
+    analysis = study.analysis
+    rows = _display_rows(analysis.rows, study.records_folder)
+    figures = "".join(_figure(c, _png(f)) for c, f in study.figures.items())
+    truth = ""
+    if study.worst is not None:
+        truth = (
+            "<h3>Identification against the virtual rig's truth</h3><p>Largest relative errors "
+            "over all tests: "
+            + html.escape(
+                ", ".join(f"{k.replace('_', ' ')} {v:.2%}" for k, v in study.worst.items())
+            )
+            + ". Contact stiffness is compared with k0 + k_s, the slope a record shows.</p>"
+            + "".join(_figure(c, _png(f)) for c, f in study.truth_figures.items())
+        )
+    fits = html_table(
         _fit_rows(analysis),
         ("law", "group", "name", "value", "std_error", "unit", "r_squared", "n"),
-    )
-    tests = _html_table(
-        analysis.rows,
-        (
-            "file",
-            "structure",
-            "frequency_hz",
-            "amplitude_m",
-            "clearance_m",
-            "clearance_m_std",
-            "compression_stiffness_n_per_m",
-            "tension_stiffness_n_per_m",
-            "friction_force_n",
-            "energy_per_cycle_j",
-            "energy_per_cycle_j_std",
-            "cycles_used",
-            "model",
-        ),
     )
     comparison = ""
     if analysis.dissipation_law is not None and analysis.alternative_law is not None:
@@ -448,87 +283,191 @@ def _html(analysis: Analysis, figures: dict[str, bytes], extra: dict[str, str], 
             f"(R<sup>2</sup> {analysis.alternative_law.r_squared:.4f}). {better} is preferred."
             "</p>"
         )
-    joint_rows = []
-    for label, js in analysis.joint_stiffness.items():
+    joint_rows = _joint_rows(analysis.joint_stiffness)
+    joint = html_table(
+        joint_rows,
+        (
+            "group",
+            ("f (Hz)", "frequency_hz", 1.0),
+            ("A_s (µm)", "amplitude_m", 1e6),
+            ("k_dj (MN/m)", "k_dj_n_per_m", 1e-6),
+            ("std error (MN/m)", "k_dj_std_error_n_per_m", 1e-6),
+        ),
+    )
+    sections = [
+        _details(
+            f"Fitted coefficients (eq 19, 21, 22), SI units as listed ({len(_fit_rows(analysis))}"
+            " rows)",
+            fits + comparison,
+        ),
+        _details(f"The joint's own dynamic stiffness, eq 20 ({len(joint_rows)} rows)", joint),
+        _details(f"Identified tests ({len(rows)})", html_table(rows, TEST_COLUMNS)),
+    ]
+    if study.comparisons:
+        sections.append(
+            _details(
+                f"Dissipation: closed form (section 2) against the exact cycle "
+                f"({len(study.comparisons)} tests)",
+                "<p>The closed forms on the free cycle at each test's penetration, against the "
+                "energy integrated over the exact steady cycle (the simulator's ledger); "
+                "see docs/dissipation.md for where the closed form holds.</p>"
+                + html_table(
+                    study.comparisons,
+                    (
+                        "file",
+                        ("A (µm)", "penetration_m", 1e6),
+                        ("closed form (mJ)", "closed_total_j", 1e3),
+                        ("exact cycle (mJ)", "exact_total_j", 1e3),
+                        ("relative gap", "gap", 1.0),
+                        ("integration (ms)", "integration_s", 1e3),
+                    ),
+                ),
+            )
+        )
+    sections += [
+        _details(
+            f"Laws not fitted ({len(analysis.not_fitted)})",
+            f"<ul>{_items(analysis.not_fitted) or '<li>none</li>'}</ul>",
+        ),
+        _details(
+            f"Records not used ({len(analysis.failures)})",
+            "<ul>"
+            + (
+                _items(
+                    [f.replace(f"{study.records_folder}{os.sep}", "") for f in analysis.failures]
+                )
+                or "<li>none</li>"
+            )
+            + "</ul>",
+        ),
+        _details("What was assumed", f"<ul>{_items(ASSUMPTIONS)}</ul>"),
+    ]
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{html.escape(study.title)}</title>
+<style>body{{font-family:sans-serif;max-width:72em;margin:1em auto;line-height:1.35}}
+h1{{font-size:1.4em;margin:0.3em 0}}
+table{{border-collapse:collapse;font-size:0.85em;margin:0.5em 0;display:block;overflow-x:auto}}
+td,th{{border:1px solid #999;padding:0.15em 0.4em;vertical-align:top}}img{{max-width:100%}}
+#findings{{font-size:0.8em}}#findings tr.no td:nth-child(2){{font-weight:bold}}
+details{{margin:0.4em 0}}summary{{cursor:pointer;font-weight:bold}}</style>
+</head><body>
+<h1>{html.escape(study.title)}</h1>
+<p>{_items_inline(study.what_was_run)} Paper: Li et al., Shock and Vibration (2013),
+doi:10.1155/2013/583030; equations as rebuilt in MODEL.md.</p>
+<h2>Findings of the paper, against these data</h2>
+{findings_html(study.findings)}
+<p><small>Reproduced: the fitted slope has the paper's sign by more than two standard errors
+for every joint and side. Source "model": it also holds in the control ({
+        html.escape(study.control)
+    }); "rig input": it was given to the test article. Every number is in
+results.json (key <code>findings</code>).</small></p>
+<h2>What to distrust</h2><ul>{_items(distrust(study))}</ul>
+{truth}
+<h2>Figures</h2>
+<p>Figs. 8-10 and eq 19-20 show the per-side dynamic stiffness k_d,s of MODEL.md section 3
+(contact time plus one free-play crossing, from the identified slopes, A_s and c), which
+includes the clearance's softening; the contact slopes, which earlier reports showed there,
+have their own figure and their own eq 19 and 20 (law "eq 19 slopes", key
+<code>contact_joint_stiffness</code>).</p>{figures}
+<h2>Tables</h2>{"".join(sections)}
+</body></html>
+"""
+
+
+def _items_inline(values: Sequence[str]) -> str:
+    return " ".join(html.escape(v) for v in values)
+
+
+def _display_rows(rows: Sequence[dict[str, Any]], folder: Path) -> list[dict[str, Any]]:
+    return [{**row, "file": _relative(row["file"], folder)} for row in rows]
+
+
+def _joint_rows(laws: dict[str, fit.JointStiffness]) -> list[dict[str, Any]]:
+    out = []
+    for label, js in laws.items():
         for w, a, v, e in zip(js.omega, js.amplitude, js.value, js.error, strict=True):
-            joint_rows.append(
+            out.append(
                 {
                     "group": label,
                     "frequency_hz": w / (2 * math.pi),
                     "amplitude_m": a,
                     "k_dj_n_per_m": v,
-                    "std_error": e,
+                    "k_dj_std_error_n_per_m": e,
                 }
             )
-    joint = _html_table(
-        joint_rows, ("group", "frequency_hz", "amplitude_m", "k_dj_n_per_m", "std_error")
-    )
-    sections = "".join(f"<h2>{html.escape(k)}</h2>{v}" for k, v in extra.items())
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
-<style>body{{font-family:sans-serif;max-width:70em;margin:2em auto;line-height:1.4}}
-table{{border-collapse:collapse;font-size:0.85em;margin:1em 0;display:block;overflow-x:auto}}
-td,th{{border:1px solid #999;padding:0.15em 0.4em}}img{{max-width:100%}}</style>
-</head><body>
-<h1>{html.escape(title)}</h1>
-<p>Li et al., Shock and Vibration (2013), doi:10.1155/2013/583030, reproduced with clearjoint;
-equations as rebuilt in MODEL.md.</p>
-<h2>Figures</h2>{images}
-<h2>Fitted coefficients (eq 19, 21, 22) with standard errors</h2>{fits}{comparison}
-<h2>The joint's own stiffness (eq 20)</h2>{joint}
-<h2>Laws not fitted</h2><ul>{_items(analysis.not_fitted) or "<li>none</li>"}</ul>
-{sections}
-<h2>Identified tests</h2>{tests}
-<h2>Records not used</h2><ul>{_items(analysis.failures) or "<li>none</li>"}</ul>
-<h2>What was assumed</h2><ul>{_items(ASSUMPTIONS)}</ul>
-</body></html>
-"""
+    return out
 
 
-def _write(
-    out_dir: Path,
-    analysis: Analysis,
-    figures: dict[str, bytes],
-    extra_html: dict[str, str],
-    extra_json: dict[str, Any],
-    title: str,
-    force: bool,
-) -> list[Path]:
+# ---- writing ------------------------------------------------------------------------------
+
+
+def write_report(out_dir: Path, study: Study, *, force: bool = False) -> list[Path]:
+    """Write report.html, results.json, results.csv and fits.csv into ``out_dir``; return them.
+
+    Nothing is overwritten unless ``force``.
+    """
+    analysis = study.analysis
     targets = {
         name: out_dir / name for name in ("report.html", "results.json", "results.csv", "fits.csv")
     }
     refuse_to_overwrite(targets.values(), force=force)
     out_dir.mkdir(parents=True, exist_ok=True)
-    targets["report.html"].write_text(_html(analysis, figures, extra_html, title), encoding="utf-8")
+    targets["report.html"].write_text(_html(study), encoding="utf-8")
     fits_rows = _fit_rows(analysis)
-    payload = {
-        "tests": analysis.rows,
+    rows = _display_rows(analysis.rows, study.records_folder)
+    folder = f"{study.records_folder}{os.sep}"
+    failures = [line.replace(folder, "") for line in analysis.failures]
+    payload: dict[str, Any] = {
+        "what_was_run": study.what_was_run,
+        "findings": [f.as_dict() for f in study.findings],
+        "control": study.control,
+        "tests": rows,
         "fits": fits_rows,
-        "joint_stiffness": {
-            label: {
-                "frequency_hz": (js.omega / (2 * math.pi)).tolist(),
-                "amplitude_m": js.amplitude.tolist(),
-                "k_dj_n_per_m": js.value.tolist(),
-                "std_error": js.error.tolist(),
-            }
-            for label, js in analysis.joint_stiffness.items()
-        },
+        "joint_stiffness": _joint_json(analysis.joint_stiffness),
+        "contact_joint_stiffness": _joint_json(analysis.contact_joint_stiffness),
         "normalised_coefficients": {k: list(v) for k, v in analysis.normalised.items()},
         "not_fitted": analysis.not_fitted,
-        "records_not_used": analysis.failures,
+        "records_not_used": failures,
         "assumptions": list(ASSUMPTIONS),
-        **extra_json,
+        "distrust": distrust(study),
     }
+    if study.control_analysis is not None:
+        control = study.control_analysis
+        payload["control_tests"] = _display_rows(control.rows, study.records_folder)
+        payload["control_fits"] = _fit_rows(control)
+        payload["control_joint_stiffness"] = _joint_json(control.joint_stiffness)
+    if study.timing is not None:
+        payload["timing"] = {
+            "law_s_per_test": study.timing.law_s,
+            "integration_s_per_test": study.timing.integration_s,
+            "law_median_error": study.timing.median_error,
+        }
+    if study.accuracy is not None:
+        payload["identification_accuracy"] = study.accuracy
+        payload["worst_errors"] = study.worst
+        payload["model_comparison"] = study.comparisons
     targets["results.json"].write_text(
         json.dumps(payload, indent=1, default=_json_default), encoding="utf-8"
     )
-    for name, rows in (("results.csv", analysis.rows), ("fits.csv", fits_rows)):
+    for name, table in (("results.csv", rows), ("fits.csv", fits_rows)):
         with targets[name].open("w", newline="", encoding="utf-8") as handle:
-            if rows:
-                writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+            if table:
+                writer = csv.DictWriter(handle, fieldnames=list(table[0]))
                 writer.writeheader()
-                writer.writerows(rows)
+                writer.writerows(table)
     return list(targets.values())
+
+
+def _joint_json(laws: dict[str, fit.JointStiffness]) -> dict[str, dict[str, list[float]]]:
+    return {
+        label: {
+            "frequency_hz": (js.omega / (2 * math.pi)).tolist(),
+            "amplitude_m": js.amplitude.tolist(),
+            "k_dj_n_per_m": js.value.tolist(),
+            "k_dj_std_error_n_per_m": js.error.tolist(),
+        }
+        for label, js in laws.items()
+    }
 
 
 def _json_default(value: Any) -> Any:
@@ -537,172 +476,21 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"not JSON: {value!r}")
 
 
-# ---- the two entry points -----------------------------------------------------------------
+#: Names that lived here before report.py was split, and where they live now.
+_MOVED = {
+    "reproduce": "clearjoint.reproduction",
+    "report_records": "clearjoint.reproduction",
+    "analyse": "clearjoint.analysis",
+    "stiffness_study": "clearjoint.verification",
+    "example_cycle": "clearjoint.verification",
+    "PAPER_CLEARANCES": "clearjoint.verification",
+}
 
 
-def report_records(
-    folder: Path, out_dir: Path, *, force: bool = False, progress: Progress | None = None
-) -> list[Path]:
-    """Identify every record in ``folder``, fit the laws and write the report to ``out_dir``."""
-    say = progress or (lambda _m: None)
-    folder = Path(folder)
-    files = sorted(
-        str(p)
-        for p in folder.iterdir()
-        if p.is_file()
-        and p.suffix.lower() in (".nc", ".csv", ".json", ".h5")
-        and p.name != "manifest.csv"
-    )
-    if not files:
-        from clearjoint.records import RecordError
+def __getattr__(name: str) -> Any:
+    """Keep ``from clearjoint.report import reproduce`` (and the other moved names) working."""
+    if name in _MOVED:
+        import importlib
 
-        raise RecordError(f"{folder}: no record files (.nc, .csv, .json) in it")
-    say(f"identifying {len(files)} records")
-    results, failures = identify_files(files)
-    if not results:
-        from clearjoint.identify import IdentificationError
-
-        raise IdentificationError(f"{folder}: no record could be identified")
-    say("fitting the laws")
-    analysis = analyse(results, failures)
-    say("drawing the figures")
-    figures = _figures(analysis, None)
-    return _write(
-        Path(out_dir), analysis, figures, {}, {}, f"clearjoint report: {folder.name}", force
-    )
-
-
-def reproduce(
-    out_dir: Path,
-    *,
-    force: bool = False,
-    progress: Progress | None = None,
-    campaign_path: Path | None = None,
-    jobs: int | None = None,
-) -> list[Path]:
-    """Run the paper's whole study on the virtual rig and write the report into ``out_dir``.
-
-    The default campaign (or ``campaign_path``) is simulated into ``out_dir/records``;
-    every record is identified; eq 19-22 are fitted; the figures and the report follow,
-    with the identification checked against the rig's truth and the dissipation model
-    of section 2 set against the exact cycles.
-    """
-    from clearjoint.rig import load_campaign, run_campaign, structure_under_test
-
-    say = progress or (lambda _m: None)
-    out_dir = Path(out_dir)
-    refuse_to_overwrite([out_dir / n for n in ("report.html", "results.json")], force=force)
-    campaign = load_campaign(campaign_path)
-    say(f"virtual rig: {len(campaign.tests)} tests")
-    manifest = run_campaign(campaign, out_dir / "records", jobs=jobs, force=force)
-    with manifest.open() as handle:
-        truth = {row["file"]: row for row in csv.DictReader(handle)}
-    say("identifying the records")
-    files = [str(manifest.parent / name) for name in truth]
-    results, failures = identify_files(files)
-    say("fitting the laws")
-    analysis = analyse(results, failures)
-    # identification against the truth
-    accuracy = []
-    for row in analysis.rows:
-        t = truth[Path(row["file"]).name]
-        k0 = float(t["gap_stiffness_n_per_m"])
-        entry = {
-            "file": Path(row["file"]).name,
-            "energy_error": row["energy_per_cycle_j"] / float(t["energy_per_cycle_j"]) - 1,
-        }
-        if row["jointed"]:
-            entry["clearance_error"] = row["clearance_m"] / float(t["clearance_m"]) - 1
-            entry["compression_stiffness_error"] = (
-                row["compression_stiffness_n_per_m"]
-                / (float(t["compression_stiffness_n_per_m"]) + k0)
-                - 1
-            )
-            entry["tension_stiffness_error"] = (
-                row["tension_stiffness_n_per_m"] / (float(t["tension_stiffness_n_per_m"]) + k0) - 1
-            )
-        accuracy.append(entry)
-    say("the section-2 model against the exact cycles")
-    model_energy, comparisons = _model_checks(campaign, analysis, structure_under_test)
-    say("drawing the figures")
-    figures = _figures(analysis, model_energy)
-    worst = {
-        key: max(abs(a[key]) for a in accuracy if key in a)
-        for key in (
-            "clearance_error",
-            "compression_stiffness_error",
-            "tension_stiffness_error",
-            "energy_error",
-        )
-    }
-    extra_html = {
-        "Identification against the rig's truth": (
-            "<p>Largest relative errors over all tests: "
-            + ", ".join(f"{k.replace('_', ' ')} {v:.2%}" for k, v in worst.items())
-            + ". Contact stiffness is compared with k0 + k_s, the slope a record shows.</p>"
-        ),
-        "Dissipation: closed form (section 2) against the exact cycle": (
-            "<p>The closed forms on the free cycle at each test's penetration, against the "
-            "energy integrated over the exact steady cycle (the simulator's ledger); "
-            "see docs/dissipation.md for where the closed form holds.</p>"
-            + _html_table(
-                comparisons, ("file", "penetration_m", "closed_total_j", "exact_total_j", "gap")
-            )
-        ),
-    }
-    return _write(
-        out_dir,
-        analysis,
-        figures,
-        extra_html,
-        {
-            "identification_accuracy": accuracy,
-            "worst_errors": worst,
-            "model_comparison": comparisons,
-        },
-        "clearjoint: reproduction of the clearance-joint study",
-        force,
-    )
-
-
-def _model_checks(
-    campaign: Any, analysis: Analysis, structure_under_test: Any
-) -> tuple[list[float], list[dict[str, Any]]]:
-    """Section 2's closed-form energy at each jointed test, and compare() on a few tests."""
-    rig = campaign.rig
-    specs = {spec.file_stem: spec for spec in campaign.tests}
-    model: list[float] = []
-    comparisons: list[dict[str, Any]] = []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", HertzValidityWarning)
-        jointed = [r for r in analysis.rows if r["jointed"]]
-        for n, row in enumerate(jointed):
-            spec = specs[Path(row["file"]).stem]
-            joint, pin, _ = structure_under_test(rig, spec)
-            losses = {
-                "friction": rig.bearing_friction,
-                "restitution": rig.restitution,
-                "damping_ratio": rig.damping_ratio,
-                "pin": pin,
-                "contact_friction_coefficient": rig.contact_friction_coefficient,
-            }
-            a = max(row["compression_penetration_m"], 0.0)
-            model.append(float(energies(joint, a, **losses)["total_j"]))
-            if n % 10 == 0:
-                result = compare(
-                    joint,
-                    spec.force_amplitude,
-                    2 * math.pi * spec.frequency_hz,
-                    samples_per_period=256,
-                    **losses,
-                )
-                comparisons.append(
-                    {
-                        "file": Path(row["file"]).name,
-                        "penetration_m": result.penetration,
-                        "closed_total_j": result.closed["total_j"],
-                        "exact_total_j": result.exact["total_j"],
-                        "gap": result.gap["total_j"],
-                    }
-                )
-    return model, comparisons
+        return getattr(importlib.import_module(_MOVED[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

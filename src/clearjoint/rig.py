@@ -18,12 +18,10 @@ simulator's ledger) goes to ``manifest.csv`` beside the records.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import math
-import os
-import tomllib
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -35,10 +33,11 @@ from scipy import signal
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.io_toml import quantity, read_toml
 from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.parallel import process_pool, run_ordered
 from clearjoint.records import Record, write_record
 from clearjoint.simulate import SimulationError, steady_state, time_response
-from clearjoint.units import parse_quantity
 
 FloatArray = NDArray[np.float64]
 
@@ -217,17 +216,10 @@ def _merge(base: dict[str, Any], given: dict[str, Any], where: str, prefix: str 
 
 
 def _quantity(where: str, key: str, value: Any) -> float:
-    kind = _KINDS.get(key)
-    if isinstance(value, bool):
-        raise CampaignError(f"{where}: {key} must be a number, got {value!r}")
-    if isinstance(value, int | float):
-        return float(value)
-    if kind is None or not isinstance(value, str):
-        raise CampaignError(f"{where}: {key} must be a number, got {value!r}")
-    try:
-        return parse_quantity(value, kind, name=f"{where}: {key}")
-    except ClearjointError as exc:
-        raise CampaignError(str(exc)) from None
+    value = quantity(
+        value, _KINDS.get(key, "dimensionless"), name=f"{where}: {key}", error=CampaignError
+    )
+    return float(value)
 
 
 def load_campaign(path: str | Path | None = None) -> Campaign:
@@ -239,17 +231,11 @@ def load_campaign(path: str | Path | None = None) -> Campaign:
         The file is missing or not TOML, a key is unknown, or a value is invalid.
     """
     default_path = default_campaign_path()
-    values = tomllib.loads(default_path.read_text(encoding="utf-8"))
+    values = read_toml(default_path, what="campaign", error=CampaignError)
     where = str(default_path)
     if path is not None:
-        path = Path(path)
         where = str(path)
-        try:
-            given = tomllib.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise CampaignError(f"{where}: no such campaign file") from None
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise CampaignError(f"{where}: not valid TOML ({exc})") from None
+        given = read_toml(path, what="campaign", error=CampaignError)
         structures = given.pop("structures", None)
         _merge(values, given, where)
         if structures is not None:
@@ -511,13 +497,16 @@ def run_campaign(
     jobs: int | None = None,
     force: bool = False,
     progress: Callable[[int, int], None] | None = None,
+    executor: Any = None,
 ) -> Path:
     """Run every test of ``campaign`` and write its records and ``manifest.csv`` to ``out_dir``.
 
-    Tests run in parallel over ``jobs`` processes (default: every core). Each test
-    has its own seed drawn from the campaign's, so the output is the same bit for
-    bit whatever the order the processes finish in. ``progress(done, total)`` is
-    called after each test. Returns the manifest's path.
+    Tests run in parallel over ``jobs`` processes (default: every core), or on
+    ``executor`` when given (a concurrent.futures Executor or a dask.distributed
+    Client whose workers see ``out_dir``: clearjoint.parallel). Each test has its
+    own seed drawn from the campaign's, so the output is the same bit for bit
+    whatever the order the workers finish in. ``progress(done, total)`` is called
+    after each test. Returns the manifest's path.
 
     Raises
     ------
@@ -530,21 +519,10 @@ def run_campaign(
     tasks = list(_tasks(campaign, out_dir, force))
     refuse_to_overwrite([out_dir / "manifest.csv", *(Path(t[4]) for t in tasks)], force=force)
     out_dir.mkdir(parents=True, exist_ok=True)
-    rows: dict[int, dict[str, Any]] = {}
-    total = len(tasks)
-    workers = jobs or os.cpu_count() or 1
-    if workers == 1:
-        for task in tasks:
-            rows[task[1].index] = _run_one(task)
-            if progress:
-                progress(len(rows), total)
-    else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            futures = {pool.submit(_run_one, task): task[1].index for task in tasks}
-            for future in as_completed(futures):
-                rows[futures[future]] = future.result()
-                if progress:
-                    progress(len(rows), total)
+    with contextlib.ExitStack() as stack:
+        runner = executor if executor is not None else stack.enter_context(process_pool(jobs))
+        truths = run_ordered(_run_one, tasks, runner, progress=progress)
+    rows = {task[1].index: truth for task, truth in zip(tasks, truths, strict=True)}
     manifest = out_dir / "manifest.csv"
     with manifest.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=MANIFEST_COLUMNS)

@@ -18,21 +18,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 
 from clearjoint import _checks
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Joint
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+    from matplotlib.axes import Axes
 
 FloatArray = NDArray[np.float64]
 
 __all__ = [
     "FreeOrbit",
     "ResponseBranch",
+    "StiffnessCurve",
     "describing_stiffness",
     "dynamic_stiffness",
     "equivalent_linear_response",
@@ -40,6 +45,7 @@ __all__ = [
     "natural_frequency",
     "period",
     "stiffness_coefficient",
+    "stiffness_curve",
     "viscous_coefficient",
 ]
 
@@ -462,6 +468,8 @@ def equivalent_linear_response(
     grid = s_low + offsets
     values = residual(grid)
     signs = np.sign(values)
+    from scipy.optimize import brentq  # here, not at the top: it costs most of the start-up
+
     for i in np.nonzero(signs[:-1] * signs[1:] < 0.0)[0]:
         a, b = float(grid[i]), float(grid[i + 1])
         root = brentq(lambda s: float(residual(np.array([s]))[0]), a, b, xtol=1e-300, rtol=1e-15)
@@ -478,3 +486,185 @@ def equivalent_linear_response(
             )
         )
     return tuple(sorted(branches, key=lambda b: b.displacement_amplitude))
+
+
+# ---- the c_d curve as a result a user can tabulate and draw --------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class StiffnessCurve:
+    """A joint's dynamic stiffness against amplitude: T, w_n, k_d and c_d (MODEL.md eq 5-9).
+
+    What ``clearjoint stiffness`` prints, as one object; every array is shaped
+    like ``amplitude``.
+
+    Attributes
+    ----------
+    joint : Joint
+    amplitude : ndarray
+        Penetration A beyond the compression gap edge, m.
+    period : ndarray
+        Exact period of free vibration T, s (eq 5).
+    natural_frequency : ndarray
+        w_n = 2 pi / T, rad/s (eq 6).
+    dynamic_stiffness : ndarray
+        k_d = m w_n^2, N/m (eq 8).
+    stiffness_coefficient : ndarray
+        c_d = k_d / k_inf (eq 9).
+    """
+
+    joint: Joint
+    amplitude: FloatArray
+    period: FloatArray
+    natural_frequency: FloatArray
+    dynamic_stiffness: FloatArray
+    stiffness_coefficient: FloatArray
+
+    def __repr__(self) -> str:
+        a = np.atleast_1d(self.amplitude) * 1e6
+        c_d = np.atleast_1d(self.stiffness_coefficient)
+        j = self.joint
+        amplitudes = (
+            f"A = {a.min():.4g} um" if a.size == 1 else f"A = {a.min():.4g}-{a.max():.4g} um"
+        )
+        return (
+            f"StiffnessCurve({a.size} amplitude{'s' if a.size != 1 else ''}, {amplitudes}: "
+            f"c_d = {c_d.min():.4g} to {c_d.max():.4g}; joint m = {j.mass:g} kg, "
+            f"c = {j.clearance * 1e3:g} mm, k_inf = {j.large_amplitude_stiffness:.4g} N/m)"
+        )
+
+    def _columns(self) -> dict[str, tuple[FloatArray, str]]:
+        return {
+            "period": (self.period, "s"),
+            "natural_frequency": (self.natural_frequency, "rad/s"),
+            "dynamic_stiffness": (self.dynamic_stiffness, "N/m"),
+            "stiffness_coefficient": (self.stiffness_coefficient, "1"),
+        }
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the curve as an ``xarray.Dataset`` on ``amplitude``, units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinate ``amplitude`` (N,) in m; variables ``period`` (s),
+            ``natural_frequency`` (rad/s), ``dynamic_stiffness`` (N/m) and
+            ``stiffness_coefficient`` (1), each (N,) with ``attrs["units"]``; the
+            joint's parameters as attrs (SI, the unit in each name).
+        """
+        import xarray as xr
+
+        from clearjoint._plotting import one_dimensional
+
+        a = one_dimensional("amplitude", self.amplitude)
+        j = self.joint
+        return xr.Dataset(
+            {
+                name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
+                for name, (values, unit) in self._columns().items()
+            },
+            coords={"amplitude": ("amplitude", a, {"units": "m"})},
+            attrs={
+                "title": "clearjoint dynamic stiffness against amplitude",
+                "mass_kg": j.mass,
+                "clearance_m": j.clearance,
+                "compression_stiffness_n_per_m": j.compression_stiffness,
+                "tension_stiffness_n_per_m": j.tension_stiffness,
+                "gap_stiffness_n_per_m": j.gap_stiffness,
+                "gap_offset_m": j.gap_offset,
+            },
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the curve as a ``pandas.DataFrame``, one row per amplitude.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index ``amplitude_m`` (N,); columns ``period_s``,
+            ``natural_frequency_rad_per_s``, ``dynamic_stiffness_n_per_m``,
+            ``stiffness_coefficient``.
+        """
+        import pandas as pd
+
+        from clearjoint._plotting import one_dimensional
+
+        a = one_dimensional("amplitude", self.amplitude)
+        names = {
+            "period": "period_s",
+            "natural_frequency": "natural_frequency_rad_per_s",
+            "dynamic_stiffness": "dynamic_stiffness_n_per_m",
+            "stiffness_coefficient": "stiffness_coefficient",
+        }
+        return pd.DataFrame(
+            {names[key]: np.broadcast_to(v, a.shape) for key, (v, _) in self._columns().items()},
+            index=pd.Index(a, name="amplitude_m"),
+        )
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw c_d against A (um), as the paper's Fig. 12 does; return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            Its last line is c_d against A in um, labelled with the clearance.
+        """
+        from clearjoint._plotting import axes_or_new, one_dimensional
+
+        axes: Axes = axes_or_new(ax)
+        a = one_dimensional("amplitude", self.amplitude)
+        axes.axhline(1.0, color="0.6", lw=0.8)
+        axes.plot(
+            a * 1e6,
+            np.broadcast_to(self.stiffness_coefficient, a.shape),
+            color="black",
+            lw=1.6,
+            marker="o" if a.size < 20 else None,
+            label=f"c = {self.joint.clearance * 1e3:.4g} mm",
+        )
+        axes.set_xlabel("amplitude beyond the gap edge A (µm)")
+        axes.set_ylabel("stiffness coefficient $c_d = k_d / k_\\infty$")
+        axes.set_ylim(0.0, 1.05)
+        axes.grid(True, color="0.85", lw=0.6)
+        axes.legend(frameon=False)
+        return axes
+
+
+def stiffness_curve(joint: Joint, amplitude: ArrayLike) -> StiffnessCurve:
+    """Return the period, w_n, k_d and c_d of ``joint`` at penetrations A, as one result (eq 5-9).
+
+    Parameters
+    ----------
+    joint : Joint
+    amplitude : float or array_like
+        Penetration A >= 0 beyond the compression gap edge, m.
+
+    Returns
+    -------
+    StiffnessCurve
+        Arrays shaped like ``amplitude``; ``.plot()`` draws c_d against A.
+
+    Examples
+    --------
+    >>> j = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
+    >>> curve = stiffness_curve(j, [1e-6, 20e-6])
+    >>> float(curve.stiffness_coefficient[1])  # eq 9: (pi A / (pi A + c))^2
+    0.1385...
+    """
+    a = _amplitude(amplitude)
+    t = _period(joint, a)
+    omega_n = (2.0 * math.pi) / t
+    k_d = joint.mass * omega_n * omega_n
+    return StiffnessCurve(
+        joint=joint,
+        amplitude=a,
+        period=t,
+        natural_frequency=omega_n,
+        dynamic_stiffness=k_d,
+        stiffness_coefficient=k_d / joint.large_amplitude_stiffness,
+    )

@@ -1,13 +1,20 @@
-"""Engineering units at the edges: parse "0.106mm", "5um", "8e7N/m" into SI floats (pint).
+"""Engineering units at the edges: "0.106mm", "5um", "2513rad/s", "400rpm" into SI floats (pint).
 
-Only the command line and file readers use this module; the physics never
-sees a unit. A bare number is taken as SI.
+The command line, the file readers and the Python API's checks (``_checks``) use
+this module; the physics never sees a unit. Every quantity is converted by its
+dimension. Frequencies keep their 2 pi: an angular unit (rad/s, deg/s, rpm) is
+an angular frequency, so "2513rad/s" is 400 Hz and "400rpm" is 6.667 Hz, while
+Hz (and 1/s) counts cycles. On the command line a bare number for a dimensional
+quantity is refused (``bare="refuse"``); in the Python API a bare float is SI.
 """
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
 
 from clearjoint.errors import ParameterError
 
@@ -21,6 +28,7 @@ SI_UNITS: dict[str, str] = {
     "stiffness": "N/m",
     "force": "N",
     "frequency": "Hz",
+    "angular_frequency": "rad/s",
     "time": "s",
     "pressure": "Pa",
     "velocity": "m/s",
@@ -28,6 +36,20 @@ SI_UNITS: dict[str, str] = {
     "dimensionless": "",
 }
 
+#: A unit to show after a bare number in the "give a unit" message, per kind.
+UNIT_HINTS: dict[str, str] = {
+    "length": "mm",
+    "mass": "kg",
+    "stiffness": "N/m",
+    "force": "N",
+    "frequency": "Hz",
+    "angular_frequency": "rad/s",
+    "time": "s",
+    "pressure": "GPa",
+    "velocity": "m/s",
+    "acceleration": "m/s^2",
+    "dimensionless": "",
+}
 
 #: A value of each kind that parses, for error messages.
 EXAMPLES: dict[str, str] = {
@@ -36,12 +58,18 @@ EXAMPLES: dict[str, str] = {
     "stiffness": "8e7N/m",
     "force": "200N",
     "frequency": "20Hz",
+    "angular_frequency": "2513rad/s",
     "time": "2s",
     "pressure": "206GPa",
     "velocity": "0.1m/s",
     "acceleration": "100m/s^2",
     "dimensionless": "0.3",
 }
+
+_KIND_OF_UNIT = {unit: kind for kind, unit in SI_UNITS.items()}
+_TWO_PI = 2.0 * math.pi
+
+Bare = Literal["si", "refuse"]
 
 
 @lru_cache(maxsize=1)
@@ -52,18 +80,73 @@ def registry() -> pint.UnitRegistry[float]:
     return pint.UnitRegistry()
 
 
-def parse_quantity(text: str, kind: str, *, name: str) -> float:
+def kind_of(unit: str) -> str:
+    """The kind of quantity whose SI unit is ``unit`` ("m" -> "length"; "" -> dimensionless)."""
+    try:
+        return _KIND_OF_UNIT[unit]
+    except KeyError:
+        raise ValueError(f"no kind of quantity has the SI unit {unit!r}") from None
+
+
+def is_quantity(value: Any) -> bool:
+    """True for a pint Quantity (checked without importing pint)."""
+    return type(value).__module__.startswith("pint") and hasattr(value, "magnitude")
+
+
+def _convert(quantity: Any, kind: str, name: str, raw: str) -> Any:
+    """Magnitude of a pint quantity in the SI unit of ``kind`` (float or array)."""
+    import pint
+
+    si = SI_UNITS[kind]
+    example = EXAMPLES[kind]
+    root = quantity.to_root_units()
+    turns = dict(root.unit_items()).get("radian", 0)
+    try:
+        if kind in ("frequency", "angular_frequency") and turns == 1:
+            radians_per_second = root.to("radian / second").magnitude
+            return radians_per_second / _TWO_PI if kind == "frequency" else radians_per_second
+        if kind in ("frequency", "angular_frequency"):
+            if turns != 0:
+                raise pint.errors.DimensionalityError(quantity.units, "Hz")
+            hertz = quantity.to("Hz").magnitude
+            return hertz if kind == "frequency" else hertz * _TWO_PI
+        return quantity.to(si if si else "dimensionless").magnitude
+    except pint.errors.DimensionalityError:
+        kind_words = kind.replace("_", " ")
+        raise ParameterError(
+            f"{name}: {raw!r} is not a {kind_words} (its unit is {quantity.units:~}); "
+            f"write it like {example}"
+        ) from None
+
+
+def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "refuse") -> float:
     """Return ``text`` (e.g. ``"0.106mm"``) as a float in the SI unit of ``kind``.
+
+    Parameters
+    ----------
+    text : str
+        A number with a unit, e.g. ``"0.106mm"``, ``"8e7 N/m"``, ``"400rpm"``.
+    kind : str
+        A key of :data:`SI_UNITS`.
+    name : str
+        The option or key the text came from, for error messages.
+    bare : {"refuse", "si"}
+        What a number without a unit means: by default an error that shows how to
+        write it (``--clearance 0.106: give a unit, e.g. 0.106mm``), or SI.
+        Dimensionless kinds, and zero, always take bare numbers.
+
+    Returns
+    -------
+    float
+        The value in SI (frequency in Hz, angular frequency in rad/s).
 
     Raises
     ------
     ParameterError
         The text is not a number with a unit, or its unit is not a ``kind``;
-        the message names the option ``name`` and an example that would work.
+        the message names ``name`` and an example that would work.
     """
-    import pint
 
-    si = SI_UNITS[kind]
     example = EXAMPLES[kind]
     raw = text.strip()
     if not raw:
@@ -71,26 +154,50 @@ def parse_quantity(text: str, kind: str, *, name: str) -> float:
     ureg = registry()
     try:
         quantity: Any = ureg.Quantity(raw)
-    except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError) as exc:
+    except Exception as exc:  # pint's parser raises many types on odd text
         raise ParameterError(
             f"{name}: cannot read {raw!r} as a {kind} ({exc}); write it like {example}"
         ) from None
-    if isinstance(quantity, int | float):
-        return float(quantity)
-    if quantity.unitless:  # a bare number is SI
-        return float(quantity.magnitude)
-    try:
-        return float(quantity.to(si if si else "dimensionless").magnitude)
-    except pint.errors.DimensionalityError:
-        raise ParameterError(
-            f"{name}: {raw!r} is not a {kind} (its unit is {quantity.units:~}); "
-            f"write it like {example}"
-        ) from None
+    if isinstance(quantity, int | float) or quantity.unitless:
+        magnitude = quantity if isinstance(quantity, int | float) else quantity.magnitude
+        if kind != "dimensionless" and bare == "refuse" and magnitude != 0:
+            raise ParameterError(f"{name} {raw}: give a unit, e.g. {raw}{UNIT_HINTS[kind]}")
+        return float(magnitude)
+    return float(_convert(quantity, kind, name, raw))
 
 
-def parse_quantity_list(text: str, kind: str, *, name: str) -> list[float]:
+def parse_quantity_list(text: str, kind: str, *, name: str, bare: Bare = "refuse") -> list[float]:
     """Return a comma-separated list such as ``"1um,5um,20um"`` as SI floats."""
     parts = [part for part in text.split(",")]
     if not parts or any(not part.strip() for part in parts):
         raise ParameterError(f"{name}: {text!r} has an empty entry; write it like 1um,5um,20um")
-    return [parse_quantity(part, kind, name=name) for part in parts]
+    return [parse_quantity(part, kind, name=name, bare=bare) for part in parts]
+
+
+def to_si(value: Any, unit: str, *, name: str) -> Any:
+    """Return ``value`` in the SI ``unit``: a pint Quantity or a unit string is converted,
+    anything else (a float, an array: already SI) is returned unchanged. Text
+    without a unit ("0.106") is refused for a dimensional quantity, as on the
+    command line: a bare *number* is SI, bare *text* is ambiguous.
+
+    This is the one helper through which the Python API accepts units: the
+    validators of ``clearjoint._checks`` call it, so ``Joint(mass="2kg", ...)`` and
+    ``steady_state(joint, "1kN", "400Hz")`` work. ``unit`` is an SI unit of
+    :data:`SI_UNITS` ("m", "N/m", "rad/s", "" for dimensionless).
+
+    Raises
+    ------
+    ParameterError
+        The unit is not of the dimension ``unit`` needs, or the text does not parse.
+    """
+    if isinstance(value, str):  # text carries its unit, as on the command line
+        return parse_quantity(value, kind_of(unit), name=name, bare="refuse")
+    if is_quantity(value):
+        kind = kind_of(unit)
+        raw = f"{value:~}"
+        if value.unitless:
+            magnitude = value.to("dimensionless").magnitude
+        else:
+            magnitude = _convert(value, kind, name, raw)
+        return float(magnitude) if np.ndim(magnitude) == 0 else np.asarray(magnitude, float)
+    return value

@@ -1,16 +1,18 @@
 """A simulation study in one TOML file, with documented defaults, and its netCDF output.
 
-A study names the joint, the excitation and the losses; every value may carry
-a unit (``"0.106mm"``, ``"8e7N/m"``, ``"400Hz"``) or be a bare SI number.
-Anything left out takes the default in ``DEFAULT_STUDY``; an unknown key is an
-error (it is almost always a typo). The file format is documented in
-docs/simulate.md, with an example in examples/study.toml.
+A study names the joint, the excitation and the losses; every dimensional value
+carries its unit (``"0.106mm"``, ``"8e7N/m"``, ``"400Hz"``, ``"2513rad/s"``), or
+its key names the SI unit (``frequency_hz = 400``); dimensionless values
+(``damping_ratio = 0.01``) are bare numbers. The file is read by
+:mod:`clearjoint.io_toml`. Anything left out takes the default in
+``DEFAULT_STUDY``; an unknown key is an error (it is almost always a typo). The
+file format is documented in docs/simulate.md, with an example in
+examples/study.toml.
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,9 +21,9 @@ import numpy as np
 
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.io_toml import read_table, read_toml
 from clearjoint.joint import Friction, Joint, Pin
 from clearjoint.simulate.core import Motion, SteadyState, steady_state, time_response
-from clearjoint.units import parse_quantity
 
 #: Every key a study may give, with its default (None: required) and the kind of quantity.
 DEFAULT_STUDY: dict[str, dict[str, tuple[Any, str]]] = {
@@ -58,6 +60,7 @@ DEFAULT_STUDY: dict[str, dict[str, tuple[Any, str]]] = {
     },
     "output": {
         "samples_per_period": (256, "count"),
+        "periods": (8, "count"),  # forcing periods a steady state writes to --out
     },
 }
 
@@ -83,25 +86,7 @@ class Study:
     contact_friction_coefficient: float
     samples_per_period: int
     source: str
-
-
-def _value(section: str, key: str, raw: Any, kind: str, where: str) -> Any:
-    name = f"{where}: [{section}] {key}"
-    if kind == "text":
-        if not isinstance(raw, str):
-            raise StudyError(f"{name} must be text, got {raw!r}")
-        return raw
-    if kind == "count":
-        if isinstance(raw, bool) or not isinstance(raw, int):
-            raise StudyError(f"{name} must be a whole number, got {raw!r}")
-        return raw
-    if isinstance(raw, bool):
-        raise StudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
-    if isinstance(raw, int | float):
-        return float(raw)
-    if isinstance(raw, str):
-        return parse_quantity(raw, kind, name=name)
-    raise StudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
+    periods: int = 8
 
 
 def load_study(path: str | Path) -> Study:
@@ -113,38 +98,24 @@ def load_study(path: str | Path) -> Study:
         The file is missing or not TOML, a section or key is unknown, a required
         key is absent, or a value is invalid; the message names the file and key.
     """
-    path = Path(path)
     where = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise StudyError(f"{where}: no such study file") from None
-    except UnicodeDecodeError:
-        raise StudyError(f"{where}: not a text file; a study is a TOML file") from None
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{where}: not valid TOML ({exc})") from None
+    raw = read_toml(path, what="study", error=StudyError)
     unknown = sorted(set(raw) - set(DEFAULT_STUDY))
     if unknown:
         raise StudyError(f"{where}: unknown section(s) {unknown}; known: {sorted(DEFAULT_STUDY)}")
     values: dict[str, dict[str, Any]] = {}
     for section, spec in DEFAULT_STUDY.items():
-        given = raw.get(section, {})
-        if not isinstance(given, dict):
-            raise StudyError(f"{where}: [{section}] must be a table")
-        extra = sorted(set(given) - set(spec))
-        if extra:
-            raise StudyError(
-                f"{where}: unknown key(s) {extra} in [{section}]; known: {sorted(spec)}"
-            )
+        given = read_table(
+            raw.get(section, {}),
+            {key: kind for key, (_, kind) in spec.items()},
+            where=where,
+            section=f"[{section}]",
+            error=StudyError,
+        )
         values[section] = {}
-        for key, (default, kind) in spec.items():
+        for key, (default, _kind) in spec.items():
             if key in given:
-                try:
-                    values[section][key] = _value(section, key, given[key], kind, where)
-                except ParameterError as exc:  # a unit that does not parse: already names the key
-                    raise StudyError(str(exc)) from None
+                values[section][key] = given[key]
             elif default is None and (section != "pin" or "pin" in raw):
                 raise StudyError(f"{where}: [{section}] {key} is required")
             else:
@@ -198,6 +169,9 @@ def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -
             poisson_ratio=pv["poisson_ratio"],
         )
     samples = values["output"]["samples_per_period"]
+    periods = values["output"]["periods"]
+    if periods < 1:
+        raise StudyError(f"{where}: [output] periods must be >= 1, got {periods}")
     return Study(
         joint=joint,
         force_amplitude=ex["force_amplitude"],
@@ -212,6 +186,7 @@ def _build(values: dict[str, dict[str, Any]], raw: dict[str, Any], where: str) -
         contact_friction_coefficient=losses["contact_friction_coefficient"],
         samples_per_period=samples,
         source=where,
+        periods=periods,
     )
 
 
@@ -259,44 +234,72 @@ def summary(study: Study, motion: Motion) -> dict[str, Any]:
 
 
 def write_netcdf(study: Study, motion: Motion, path: str | Path, *, force: bool = False) -> Path:
-    """Write the motion, its stages, impacts and ledger to netCDF (xarray, h5netcdf engine).
+    """Write the motion as a test record (the one netCDF layout of ``clearjoint.records``).
+
+    The record's ``force`` is the excitation F0 sin(w t) on the mass, its control is
+    force and its metadata (mass, clearance, force amplitude, frequency) are the
+    study's, so ``read_record`` and ``clearjoint identify`` read the file. A steady
+    state is periodic: its exact orbit is repeated to cover ``study.periods`` forcing
+    periods. Beside the record: ``restoring_force`` on ``time``, the first orbit's
+    stages on ``stage`` and impacts on ``impact``, and the study, losses and energy
+    ledger as attributes.
 
     Raises
     ------
-    FileExistsError (a ClearjointError)
+    OutputExistsError (a ClearjointError)
         ``path`` exists and ``force`` is False.
+    StudyError
+        ``path`` does not end in .nc.
     """
-    import xarray as xr
+    from clearjoint.records import record_dataset
 
     path = Path(path)
+    if path.suffix.lower() != ".nc":
+        raise StudyError(f"{path}: a simulation is written as netCDF; name the file .nc")
     refuse_to_overwrite([path], force=force)
     joint = study.joint
-    stage_names = np.array([s.name for s in motion.stages], dtype=object)
-    data = xr.Dataset(
+    time = motion.time
+    series = {
+        "displacement": motion.displacement,
+        "velocity": motion.velocity,
+        "acceleration": motion.acceleration,
+        "force": motion.excitation,
+        "restoring_force": motion.restoring_force,
+    }
+    if isinstance(motion, SteadyState):
+        orbit = motion.period  # the whole orbit: period_multiple forcing periods
+        repeats = max(1, math.ceil(study.periods / motion.period_multiple))
+        time = np.concatenate([time + k * orbit for k in range(repeats)])
+        series = {name: np.tile(values, repeats) for name, values in series.items()}
+    restoring = series.pop("restoring_force")
+    data = record_dataset(
+        time,
+        series,
         {
-            "displacement": ("time", motion.displacement, {"units": "m"}),
-            "velocity": ("time", motion.velocity, {"units": "m/s"}),
-            "acceleration": ("time", motion.acceleration, {"units": "m/s^2"}),
-            "excitation_force": ("time", motion.excitation, {"units": "N"}),
-            "restoring_force": ("time", motion.restoring_force, {"units": "N"}),
-            "stage_name": ("stage", stage_names.astype(str)),
-            "stage_start": ("stage", np.array([s.start for s in motion.stages]), {"units": "s"}),
-            "stage_end": ("stage", np.array([s.end for s in motion.stages]), {"units": "s"}),
-            "impact_time": ("impact", motion.impact_times, {"units": "s"}),
-            "impact_velocity": ("impact", motion.impact_velocities, {"units": "m/s"}),
+            "joint_id": "simulation",
+            "control": "force",
+            "notes": f"clearjoint simulate {study.source} ({study.mode})",
+            "clearance": joint.clearance,
+            "force_amplitude": study.force_amplitude,
+            "frequency_hz": study.omega / (2.0 * math.pi),
+            "mass": joint.mass,
         },
-        coords={"time": ("time", motion.time, {"units": "s"})},
-        attrs={
+    )
+    stage_names = np.array([s.name for s in motion.stages], dtype=object)
+    data["restoring_force"] = ("time", restoring, {"units": "N"})
+    data["stage_name"] = ("stage", stage_names.astype(str))
+    data["stage_start"] = ("stage", np.array([s.start for s in motion.stages]), {"units": "s"})
+    data["stage_end"] = ("stage", np.array([s.end for s in motion.stages]), {"units": "s"})
+    data["impact_time"] = ("impact", motion.impact_times, {"units": "s"})
+    data["impact_velocity"] = ("impact", motion.impact_velocities, {"units": "m/s"})
+    data.attrs.update(
+        {
             "title": "clearjoint simulation",
             "study": study.source,
-            "mass_kg": joint.mass,
-            "clearance_m": joint.clearance,
             "compression_stiffness_n_per_m": joint.compression_stiffness,
             "tension_stiffness_n_per_m": joint.tension_stiffness,
             "gap_stiffness_n_per_m": joint.gap_stiffness,
             "gap_offset_m": joint.gap_offset,
-            "force_amplitude_n": study.force_amplitude,
-            "frequency_hz": study.omega / (2.0 * math.pi),
             "damping_ratio": study.damping_ratio,
             "restitution": study.restitution,
             "friction_force_n": study.friction.force if study.friction else 0.0,
@@ -306,7 +309,7 @@ def write_netcdf(study: Study, motion: Motion, path: str | Path, *, force: bool 
                 for key, val in summary(study, motion).items()
                 if isinstance(val, int | float) and not isinstance(val, bool)
             },
-        },
+        }
     )
     path.parent.mkdir(parents=True, exist_ok=True)
     data.to_netcdf(path, engine="h5netcdf")

@@ -1,0 +1,45 @@
+"""Shared plumbing of the result objects' ``plot``, ``to_xarray`` and ``to_pandas`` methods.
+
+No physics here: where a new Axes comes from, and how a result's 1-D amplitude
+axis is checked before it becomes a table.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint.errors import ParameterError
+
+
+def axes_or_new(ax: Any | None) -> Any:
+    """Return ``ax``, or a new Axes on a new pyplot figure when ``ax`` is None.
+
+    pyplot is imported only here, so that a result made in a script without a
+    display costs nothing until it is drawn.
+    """
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    _, new = plt.subplots(layout="constrained")
+    return new
+
+
+def one_dimensional(name: str, values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return ``values`` as a 1-D array (a scalar becomes one entry), or refuse a grid.
+
+    Raises
+    ------
+    ParameterError
+        ``values`` has more than one dimension: a table needs one row per value.
+    """
+    array = np.atleast_1d(np.asarray(values, dtype=np.float64))
+    if array.ndim != 1:
+        raise ParameterError(
+            f"{name} has shape {array.shape}; a table needs a 1-D {name}: "
+            "compute the result for a 1-D array of amplitudes"
+        )
+    return array

@@ -1,0 +1,639 @@
+"""Identify one record: cycles, model choice, the fit, standard errors and flags.
+
+MODEL.md section 3. The steps:
+
+1. the excitation frequency (the displacement spectrum's peak, interpolated);
+2. the cycles, cut at the minima of the fundamental, and the steady ones by the one
+   rule of :func:`clearjoint.identify.cycles.steady_rule`;
+3. the steady cycles stacked on one phase grid and averaged: the average is the latent
+   periodic signal, with 1/sqrt(n) of one cycle's noise in every channel;
+4. the model, chosen on that average (so on all the steady cycles): a friction damper
+   with backlash when a displacement-controlled loop's branches end on slip plateaus;
+   else a clearance joint (steep, flat, steep stages, found on both branches or lent by
+   one to the other, better than a straight line by BIC); else a straight line;
+5. the joint's parameters: without an acceleration channel by the weak form
+   (:mod:`clearjoint.identify.weak`: no derivative of the displacement, test functions
+   that stop at the contact instants); with one, or when a contact lasts too few samples
+   for test functions, by robust least squares over the average's samples (the velocity's
+   sign and drag from its spectral derivative); the damper's and the line's by their
+   per-sample fits;
+6. a jackknife over the cycles (the average without each of at most eight contiguous
+   groups of cycles in turn) for every standard error; the energy per cycle is each
+   cycle's own loop area (the closed integral of F dx, in which the inertia term cancels);
+7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
+   spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
+   exceeds a quarter of it, a fit residual above the noise floor, or a force-controlled
+   record without a mass (then estimated from the record, with a warning).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint import stiffness
+from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.identify.cycles import (
+    MIN_STEADY,
+    IdentificationError,
+    Stack,
+    cycle_bounds,
+    excitation_frequency,
+    stack,
+    steady,
+    steady_rule,
+)
+from clearjoint.identify.damper import _damper_fit
+from clearjoint.identify.result import QUANTITIES, CycleResult, Identification
+from clearjoint.identify.segments import (
+    STAGE_COMPRESSION,
+    STAGE_TENSION,
+    _Fit,
+    _is_joint,
+    _joint_fit,
+    _line_fit,
+    _windows,
+)
+from clearjoint.identify.weak import stage_runs, weak_fit, weak_system
+from clearjoint.joint import Joint
+from clearjoint.records import Record
+
+FloatArray = NDArray[np.float64]
+
+#: The noise floor is at least this part of the force's standard deviation (the resolution
+#: of a record's digits and ADC): a noise-free record is not held to zero residual.
+RESOLUTION = 1e-3
+#: A fit residual this many times the noise floor of the cycle average makes a value doubtful.
+RESIDUAL_FACTOR = 3.0
+#: Samples this close to a gap edge (a fraction of the clearance) belong to no stage's
+#: test functions: the contact instants are where the stages' laws switch.
+EDGE_MARGIN = 0.05
+#: Equations each stage needs for the weak form (else the stages are fitted sample by
+#: sample on the cycle average, as when a contact lasts only a few samples).
+MIN_EQUATIONS = 4
+#: A value whose standard error exceeds this part of it is doubtful (for these quantities).
+RELATIVE_ERROR = 0.25
+CREDIBLE = (
+    "compression_stiffness_n_per_m",
+    "tension_stiffness_n_per_m",
+    "friction_force_n",
+    "energy_per_cycle_j",
+)
+#: Groups of the jackknife (contiguous blocks of cycles; one cycle each up to this many).
+JACKKNIFE_GROUPS = 8
+#: Quantities taken per cycle (the cycle's own), not from the fit.
+PER_CYCLE = ("amplitude_m", "energy_per_cycle_j", "secant_stiffness_n_per_m")
+
+
+def restoring_force(
+    record: Record, acceleration: FloatArray, mass: float | None = None
+) -> FloatArray:
+    """Force minus m x'' (force control, MODEL.md sec. 3) or the measured force."""
+    m = record.mass if mass is None else mass
+    if record.control == "displacement" or not m:
+        return record.force
+    return record.force - m * acceleration
+
+
+def _periodic_derivatives(
+    x: FloatArray, step: float, noise: float = 0.0
+) -> tuple[FloatArray, FloatArray]:
+    """Velocity and acceleration of one periodic cycle, spectrally, harmonics above the noise.
+
+    The harmonics kept are those up to the last one whose amplitude exceeds three times
+    the noise's (``noise``: the rms noise per sample of ``x``). Used only to place the
+    stages, choose the model and take the sign of the velocity; the joint's parameters
+    never use them (the weak form needs no derivative).
+    """
+    m = x.size
+    spectrum = np.fft.rfft(x)
+    k = np.arange(spectrum.size)
+    floor = 3.0 * noise * math.sqrt(m / 2.0)
+    above = np.nonzero(np.abs(spectrum) > floor)[0]
+    cut = int(above[-1]) if above.size else 1
+    spectrum[cut + 1 :] = 0.0
+    w = 2.0 * math.pi * k / (m * step)
+    v = np.fft.irfft(1j * w * spectrum, n=m)
+    a = np.fft.irfft(-(w**2) * spectrum, n=m)
+    return v, a
+
+
+def _estimate_mass(x: FloatArray, f: FloatArray, v: FloatArray, a: FloatArray) -> float:
+    """The moving mass from F = m x'' + g(x) + c x' + F_f sgn x', g piecewise linear (hinges)."""
+    knots = np.linspace(x.min(), x.max(), 18)[1:-1]
+    design = np.column_stack(
+        (a, np.ones_like(x), x, np.maximum(x[:, None] - knots[None, :], 0.0), v, np.sign(v))
+    )
+    coef = np.linalg.lstsq(design, f, rcond=None)[0]
+    return float(coef[0])
+
+
+def _derived(x: FloatArray, fit: _Fit, mass: float | None) -> dict[str, float]:
+    """The quantities of one fit on one cycle average ``x`` (M,)."""
+    x_max, x_min = float(x.max()), float(x.min())
+    clearance = fit.upper_edge - fit.lower_edge
+    a_c, a_t = x_max - fit.upper_edge, fit.lower_edge - x_min
+    return {
+        "amplitude_m": 0.5 * (x_max - x_min),
+        "clearance_m": clearance,
+        "compression_stiffness_n_per_m": fit.k_compression,
+        "tension_stiffness_n_per_m": fit.k_tension,
+        "friction_force_n": fit.friction,
+        "compression_penetration_m": a_c,
+        "tension_penetration_m": a_t,
+        "gap_stiffness_n_per_m": fit.k_gap,
+        "dynamic_stiffness_n_per_m": _dynamic(fit, clearance, a_c, mass),
+        "mass_kg": math.nan if mass is None else mass,
+    }
+
+
+def _dynamic(fit: _Fit, clearance: float, a_c: float, mass: float | None) -> float:
+    k0 = fit.k_gap
+    if not mass or not (fit.k_compression > k0 and fit.k_tension > k0 and a_c > 0):
+        return math.nan
+    try:
+        joint = Joint(
+            mass=mass,
+            clearance=max(clearance, 0.0),
+            compression_stiffness=fit.k_compression - k0,
+            tension_stiffness=fit.k_tension - k0,
+            gap_stiffness=k0,
+        )
+        return float(stiffness.dynamic_stiffness(joint, a_c))
+    except (ParameterError, ClearjointError):
+        return math.nan
+
+
+def _groups(n: int) -> list[NDArray[np.int64]]:
+    """The jackknife's groups of cycles: contiguous blocks, at most JACKKNIFE_GROUPS."""
+    return [
+        np.asarray(g, dtype=np.int64)
+        for g in np.array_split(np.arange(n), min(n, JACKKNIFE_GROUPS))
+    ]
+
+
+def _leave_one_out(values: FloatArray, groups: list[NDArray[np.int64]]) -> FloatArray:
+    """The averages of the (n, M) rows without each group in turn, (G, M)."""
+    n = values.shape[0]
+    total = values.sum(axis=0)
+    out: FloatArray = np.array([(total - values[g].sum(axis=0)) / (n - g.size) for g in groups])
+    return out
+
+
+def _loop_areas(x: FloatArray, f: FloatArray) -> FloatArray:
+    """Each row's closed loop area, the integral of F dx round the cycle (trapezoids), (n,)."""
+    dx = np.roll(x, -1, axis=1) - x
+    out: FloatArray = np.abs(np.sum(0.5 * (f + np.roll(f, -1, axis=1)) * dx, axis=1))
+    return out
+
+
+def _secants(x: FloatArray, f: FloatArray) -> FloatArray:
+    """(F at x_max - F at x_min) / (x_max - x_min) of each row, F averaged over 5 samples."""
+    n, m = x.shape
+    rows = np.arange(n)
+    out = np.empty(n)
+    for name, sign in (("top", 1), ("bottom", -1)):
+        i = np.argmax(sign * x, axis=1)
+        near = (i[:, None] + np.arange(-2, 3)[None, :]) % m
+        value = f[rows[:, None], near].mean(axis=1)
+        if name == "top":
+            top = value
+        else:
+            out = (top - value) / np.ptp(x, axis=1)
+    return out
+
+
+def _branches_of(m: int, x: FloatArray) -> tuple[slice, slice] | None:
+    top = int(np.argmax(x))
+    if top < 8 or m - top < 8:
+        return None
+    return slice(0, top + 1), slice(top, m)
+
+
+def _noise_floor(stacked: FloatArray) -> float:
+    """The rms noise of the cycle average of one channel: the scatter over cycles / sqrt(n)."""
+    n = stacked.shape[0]
+    scatter = float(np.sqrt(np.mean(np.var(stacked, axis=0, ddof=1))))
+    return scatter / math.sqrt(n)
+
+
+def identify(record: Record, *, tolerance: float = 0.03) -> Identification:
+    """Return the identification of one record (see the module's docstring for the steps).
+
+    Parameters
+    ----------
+    record : Record
+        The test record (SI).
+    tolerance : float
+        Relative tolerance of the steady-cycle rule
+        (:func:`~clearjoint.identify.cycles.steady_rule`).
+
+    Returns
+    -------
+    Identification
+
+    Raises
+    ------
+    IdentificationError
+        Fewer than three steady cycles (the message states the rule), or a frequency far
+        from the record's nominal one.
+    """
+    where = record.source or "record"
+    x_all = record.displacement
+    frequency = excitation_frequency(record)
+    if record.frequency_hz and abs(frequency / record.frequency_hz - 1.0) > 0.05:
+        raise IdentificationError(
+            f"{where}: the displacement's frequency is {frequency:.4g} Hz, not the nominal "
+            f"{record.frequency_hz:g} Hz; check the record"
+        )
+    bounds = cycle_bounds(record, frequency)
+    kept = steady(x_all, bounds, tolerance)
+    if len(kept) < MIN_STEADY:
+        raise IdentificationError(
+            f"{where}: {len(kept)} steady cycles of {len(bounds)}; {steady_rule(tolerance)} "
+            "(a larger --tolerance admits more)"
+        )
+    channels = {"x": x_all, "f": record.force}
+    if record.acceleration is not None:
+        channels["a"] = record.acceleration
+    if record.velocity is not None:
+        channels["v"] = record.velocity
+    st = stack(record, frequency, bounds, kept, {"x": x_all})
+    # start every cycle at the minimum of the average (rising branch first), in time order
+    shift = int(np.argmin(st.channels["x"].mean(axis=0)))
+    if shift > st.samples // 2 and bounds[kept[0]][0] - (st.samples - shift) >= 0:
+        shift -= st.samples
+    st = stack(record, frequency, bounds, kept, channels, shift)
+    if st.cycles < MIN_STEADY:
+        raise IdentificationError(
+            f"{where}: {st.cycles} steady cycles lie wholly inside the record; "
+            f"{steady_rule(tolerance)}"
+        )
+    return _identify_stack(record, where, frequency, len(bounds), st)
+
+
+def _identify_stack(
+    record: Record, where: str, frequency: float, total: int, st: Stack
+) -> Identification:
+    n, m = st.cycles, st.samples
+    xs, fs = st.channels["x"], st.channels["f"]
+    x = xs.mean(axis=0)
+    f = fs.mean(axis=0)
+    noise_x = _noise_floor(xs)
+    v_crude, a_crude = _periodic_derivatives(x, st.step, noise_x)
+    v = st.channels["v"].mean(axis=0) if "v" in st.channels else v_crude
+    a = st.channels["a"].mean(axis=0) if "a" in st.channels else a_crude
+    warnings: list[str] = []
+    force_control = record.control == "force"
+    mass: float | None = record.mass if force_control and record.mass else None
+    mass_missing = force_control and mass is None
+    m_guess = _estimate_mass(x, f, v, a) if mass_missing else (mass or 0.0)
+    r = f - m_guess * a if force_control else f
+    parts = _branches_of(m, x)
+    if parts is None:
+        raise IdentificationError(f"{where}: the steady cycles' average has no rising branch")
+    windows = (
+        _windows(x[parts[0]], r[parts[0]], 3),
+        _windows(x[parts[1]], r[parts[1]], 3),
+    )
+    if _is_joint(windows[0]) != _is_joint(windows[1]):
+        # a stage too short to be found on one branch (e.g. a brief contact at a low
+        # force): the stages are places in x, the same on both branches, so the branch
+        # that shows all three lends them to the other
+        shown = windows[0] if _is_joint(windows[0]) else windows[1]
+        windows = (shown, shown)
+    model = "line"
+    system = None
+    # a displacement-controlled loop whose branches end on slip plateaus is a damper
+    damper = record.control == "displacement" and _damper_fit(x, f, parts) is not None
+    first_fit = (
+        _joint_fit(x, r, v, parts, windows)
+        if not damper and _is_joint(windows[0]) and _is_joint(windows[1])
+        else None
+    )
+    if damper:
+        model = "damper"
+    elif first_fit is not None:
+        edges = (first_fit.lower_edge, first_fit.upper_edge)
+        margin = EDGE_MARGIN * (edges[1] - edges[0])
+        model = "joint"
+        if "a" not in st.channels:  # with a measured acceleration: fit the samples
+            system = weak_system(x, v, st.step, stage_runs(x, edges, margin))
+        if system is not None and np.bincount(system.stage).min() < MIN_EQUATIONS:
+            system = None  # a contact too short for the weak form: fit sample by sample
+
+    # every replicate: row 0 the average of all cycles, then the averages without one
+    groups = _groups(n)
+    reps_x = np.vstack((x[None, :], _leave_one_out(xs, groups)))
+    reps_f = np.vstack((f[None, :], _leave_one_out(fs, groups)))
+    reps_a = (
+        np.vstack(
+            (st.channels["a"].mean(axis=0)[None, :], _leave_one_out(st.channels["a"], groups))
+        )
+        if "a" in st.channels
+        else None
+    )
+    fits: list[_Fit]
+    masses: FloatArray
+    residual = math.nan
+    if model == "joint" and system is not None:
+        weak = weak_fit(
+            system, reps_x, reps_f, mass=mass if force_control else 0.0, acceleration=reps_a
+        )
+        fits = []
+        for (lt, lf, lc), c_f in zip(weak.lines, weak.friction, strict=True):
+            (a_t, k_t), (a_f, k_f), (a_c, k_c) = lt, lf, lc
+            upper = (a_f - a_c) / (k_c - k_f) if k_c != k_f else math.nan
+            lower = (a_f - a_t) / (k_t - k_f) if k_t != k_f else math.nan
+            lines = ((float(a_t), float(k_t)), (float(a_f), float(k_f)), (float(a_c), float(k_c)))
+            fits.append(
+                _Fit(
+                    upper,
+                    lower,
+                    float(k_c),
+                    float(k_t),
+                    max(float(k_f), 0.0),
+                    abs(float(c_f)),
+                    lines,
+                )
+            )
+        masses = weak.mass
+        residual = float(weak.residual[0])
+    elif model == "joint":
+        assert first_fit is not None
+        fits = []
+        for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
+            vr, ar = _periodic_derivatives(xr_, st.step, noise_x)
+            if reps_a is not None:
+                ar = reps_a[i]
+            if "v" in st.channels:
+                vr = v
+            rr = fr_ - m_guess * ar if force_control else fr_
+            fits.append(_joint_fit(xr_, rr, vr, parts, windows, compete=False) or first_fit)
+        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
+    else:
+        fits = []
+        for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
+            vr, ar = _periodic_derivatives(xr_, st.step, noise_x)
+            if reps_a is not None:
+                ar = reps_a[i]
+            if "v" in st.channels:
+                vr = v
+            rr = fr_ - m_guess * ar if force_control else fr_
+            fit = _damper_fit(xr_, fr_, parts) if model == "damper" else None
+            if fit is None:
+                fit = _line_fit(xr_, rr, vr)
+            fits.append(fit)
+        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
+    values = [
+        _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
+        for i in range(len(groups) + 1)
+    ]
+    for vals, fit in zip(values, fits, strict=True):
+        symmetric = math.isnan(fit.level_positive)
+        vals["friction_force_positive_n"] = fit.friction if symmetric else fit.level_positive
+        vals["friction_force_negative_n"] = -fit.friction if symmetric else fit.level_negative
+    full, loo = values[0], values[1:]
+    summary: dict[str, float] = {}
+    spread: dict[str, float] = {}
+    stderr: dict[str, float] = {}
+    per_cycle: dict[str, FloatArray] = {}
+    own = {
+        "amplitude_m": 0.5 * np.ptp(xs, axis=1),
+        "energy_per_cycle_j": _loop_areas(xs, fs),
+        "secant_stiffness_n_per_m": _secants(
+            xs, fs - (m_guess * st.channels["a"] if force_control and "a" in st.channels else 0.0)
+        ),
+    }
+    g = len(groups)
+    member = np.empty(n, dtype=np.int64)
+    for k, group in enumerate(groups):
+        member[group] = k
+    for q in QUANTITIES:
+        if q in own:
+            cyc = own[q]
+            est = float(np.mean(cyc))
+            finite = np.isfinite(cyc)
+            se = float(np.std(cyc[finite], ddof=1)) / math.sqrt(n) if finite.sum() > 1 else math.nan
+        else:
+            est = full.get(q, math.nan)
+            pseudo = g * est - (g - 1) * np.array([vv.get(q, math.nan) for vv in loo])
+            cyc = pseudo[member]
+            finite = np.isfinite(pseudo)
+            se = (
+                float(np.std(pseudo[finite], ddof=1)) / math.sqrt(g)
+                if finite.sum() > 1
+                else math.nan
+            )
+        per_cycle[q] = cyc
+        summary[q] = est if q != "amplitude_m" else 0.5 * float(np.ptp(x))
+        stderr[q] = se
+        spread[q] = se * math.sqrt(n)
+    if model == "line":
+        for q in ("clearance_m",):
+            summary[q], spread[q], stderr[q] = 0.0, 0.0, 0.0
+            per_cycle[q] = np.zeros(n)
+    flags = _flags(
+        model,
+        summary,
+        stderr,
+        residual,
+        max(_noise_floor(fs), RESOLUTION * float(np.std(f))),
+        mass_missing,
+        summary["mass_kg"],
+    )
+    if mass_missing:
+        warnings.append(
+            f"{where}: force-controlled record without a mass: the mass was estimated from the "
+            f"record as {summary['mass_kg']:.4g} kg; add it to the record (CSV header line "
+            "'# mass = \"1.5 kg\"', netCDF attribute mass_kg) to use the known one"
+        )
+    head = fits[0]
+    cycles = tuple(
+        CycleResult(
+            int(st.starts[j]),
+            int(st.starts[j]) + m,
+            {q: float(per_cycle[q][j]) for q in QUANTITIES},
+            head.upper_edge,
+            head.lower_edge,
+            model,
+            head.lines,
+        )
+        for j in range(n)
+    )
+    force_all = restoring_force(record, _record_acceleration(record, frequency), m_guess)
+    stage = np.zeros(record.time.size, dtype=np.int8)
+    if model != "line":
+        stage[record.displacement >= head.upper_edge] = STAGE_COMPRESSION
+        stage[record.displacement <= head.lower_edge] = STAGE_TENSION
+    return Identification(
+        source=where,
+        frequency_hz=frequency,
+        cycles_total=total,
+        cycles=cycles,
+        summary=summary,
+        spread=spread,
+        control=record.control,
+        restoring_force=force_all,
+        stage=stage,
+        stderr=stderr,
+        flags=flags,
+        warnings=tuple(warnings),
+        joint_id=record.joint_id,
+        loop=(x, r),
+    )
+
+
+def _record_acceleration(record: Record, frequency: float) -> FloatArray:
+    """The record's acceleration for the figures only: measured, or the second difference of
+    the displacement smoothed over a fortieth of a period (a moving average)."""
+    if record.acceleration is not None or record.control == "displacement":
+        return (
+            record.acceleration if record.acceleration is not None else np.zeros_like(record.time)
+        )
+    window = max(1, int(record.sampling_rate / frequency / 40))
+    kernel = np.ones(window) / window
+    smooth = np.convolve(record.displacement, kernel, mode="same")
+    step = 1.0 / record.sampling_rate
+    out: FloatArray = np.gradient(np.gradient(smooth, step), step)
+    return out
+
+
+def _flags(
+    model: str,
+    summary: dict[str, float],
+    stderr: dict[str, float],
+    residual: float,
+    noise: float,
+    mass_missing: bool,
+    mass: float,
+) -> dict[str, tuple[str, str]]:
+    """A flag and its reason for each quantity (see the module's docstring)."""
+    flags = {q: ("ok", "") for q in QUANTITIES}
+    fitted = [q for q in QUANTITIES if q not in PER_CYCLE]
+    if model != "line":
+        c, se = summary["clearance_m"], stderr["clearance_m"]
+        if not (c - 2.0 * se > 0.0):
+            flags["clearance_m"] = (
+                "rejected",
+                f"clearance {c * 1e3:.3g} ± {se * 1e3:.2g} mm: its interval spans zero",
+            )
+    for q in CREDIBLE:
+        value, se = summary[q], stderr[q]
+        if flags[q][0] == "ok" and value and abs(se / value) > RELATIVE_ERROR:
+            flags[q] = (
+                "doubtful",
+                f"{q} has a standard error of {abs(se / value):.0%} of its value",
+            )
+    if math.isfinite(residual) and residual > RESIDUAL_FACTOR * noise:
+        reason = (
+            f"fit residual {residual:.3g} N is {residual / noise:.1f} times the noise floor "
+            f"{noise:.3g} N of the cycle average"
+        )
+        for q in fitted:
+            if flags[q][0] == "ok":
+                flags[q] = ("doubtful", reason)
+    if mass_missing:
+        reason = f"force control without a mass: m = {mass:.4g} kg estimated from the record"
+        for q in fitted:
+            if flags[q][0] == "ok":
+                flags[q] = ("doubtful", reason)
+    return flags
+
+
+def flag_outliers(results: list[Identification]) -> list[Identification]:
+    """Flag, per device (joint_id), a clearance more than twice the median of the others'.
+
+    Needs at least three tests of the device; the others are the tests of the same
+    ``joint_id`` in the same call.
+    """
+    out = list(results)
+    groups: dict[str, list[int]] = {}
+    for i, ident in enumerate(results):
+        if ident.joint_id and ident.model != "line":
+            groups.setdefault(ident.joint_id, []).append(i)
+    for device, members in groups.items():
+        if len(members) < 3:
+            continue
+        for i in members:
+            others = [results[j].summary["clearance_m"] for j in members if j != i]
+            median = float(np.median(others))
+            c = results[i].summary["clearance_m"]
+            if median > 0 and c > 2.0 * median and results[i].flags["clearance_m"][0] == "ok":
+                flags = dict(results[i].flags)
+                flags["clearance_m"] = (
+                    "doubtful",
+                    f"clearance {c * 1e3:.3g} mm is more than twice the median "
+                    f"{median * 1e3:.3g} mm of the other {len(others)} tests of {device}",
+                )
+                out[i] = replace(results[i], flags=flags)
+    return out
+
+
+def _identify_path(args: tuple[str, bool, float]) -> tuple[Record, Identification] | str:
+    """Read and identify one file; its result, or the line that says why it was not used."""
+    from clearjoint.records import read_record
+
+    path, resample, tolerance = args
+    try:
+        record = read_record(path, resample=resample)
+        return record, identify(record, tolerance=tolerance)
+    except ClearjointError as exc:
+        text = str(exc)
+        return text if text.startswith(str(path)) else f"{path}: {text}"
+
+
+def identify_files(
+    paths: list[str],
+    *,
+    resample: bool = False,
+    tolerance: float = 0.03,
+    jobs: int = 1,
+    progress: Callable[[int, int], Any] | None = None,
+) -> tuple[list[tuple[Record, Identification]], list[str]]:
+    """Identify every file; return the results and one line for each file not used.
+
+    Parameters
+    ----------
+    paths : list of str
+        Record files (any format of :mod:`clearjoint.records`).
+    resample, tolerance
+        As for :func:`~clearjoint.records.read_record` and :func:`identify`.
+    jobs : int
+        Processes over the files; the results are those of one process, in file order.
+    progress : callable, optional
+        ``progress(done, total)``, called after each file.
+
+    Returns
+    -------
+    results : list of (Record, Identification)
+    failures : list of str
+
+    Clearances more than twice the median of the other tests of the same device are
+    flagged (:func:`flag_outliers`).
+    """
+    tasks = [(str(path), resample, tolerance) for path in paths]
+    outcomes: list[tuple[Record, Identification] | str] = []
+    if jobs > 1 and len(tasks) > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            chunk = max(1, len(tasks) // (4 * jobs))
+            for k, outcome in enumerate(pool.map(_identify_path, tasks, chunksize=chunk), 1):
+                outcomes.append(outcome)
+                if progress:
+                    progress(k, len(tasks))
+    else:
+        for k, task in enumerate(tasks, start=1):
+            outcomes.append(_identify_path(task))
+            if progress:
+                progress(k, len(tasks))
+    results = [o for o in outcomes if not isinstance(o, str)]
+    failures = [o for o in outcomes if isinstance(o, str)]
+    flagged = flag_outliers([ident for _, ident in results])
+    return [(rec, ident) for (rec, _), ident in zip(results, flagged, strict=True)], failures

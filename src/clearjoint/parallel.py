@@ -1,0 +1,401 @@
+"""Chunks of pure tasks on an executor or a Dask client, and their results in a zarr store.
+
+No physics here: this module runs a pure function over a list of frozen arguments
+wherever the caller says (in this process, on a ``concurrent.futures`` executor,
+or on a ``dask.distributed`` client) and hands each result back as it finishes.
+The virtual rig, the dissipation agreement map and the sweeps all run on it.
+
+Reproducibility does not depend on where a task runs: a point's random numbers
+come from :func:`point_seed`, ``SeedSequence(seed).spawn(n)[index]`` made from the
+point's index alone, and every task is a pure function of its frozen argument.
+
+:class:`ResultStore` keeps a sweep's results on disk as a zarr group with one
+array per variable along ``point`` (a zarr chunk per task chunk) and a
+``chunk_done`` flag written after each chunk's values, so a run stopped at any
+moment resumes by computing only the chunks not flagged. A store records the
+fingerprint of the sweep that made it; resuming from another sweep is refused.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import shutil
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint.errors import ClearjointError, OutputExistsError, ParameterError
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+__all__ = [
+    "CONNECT_TIMEOUT_S",
+    "ChunkFailedError",
+    "Finished",
+    "ResultStore",
+    "Runner",
+    "SchedulerError",
+    "StoreError",
+    "Variable",
+    "chunk_bounds",
+    "dask_client",
+    "point_seed",
+    "process_pool",
+    "run_ordered",
+    "run_unordered",
+]
+
+A = TypeVar("A")
+R = TypeVar("R")
+
+#: What runs the tasks: None (this process), an executor, or a dask.distributed Client.
+Runner = Any
+
+#: Seconds to wait for a scheduler before giving up (the issue asks for an answer within 10 s).
+CONNECT_TIMEOUT_S = 4
+
+
+class SchedulerError(ClearjointError, ConnectionError):
+    """The Dask scheduler cannot be reached; the message names the address."""
+
+
+class StoreError(ClearjointError, ValueError):
+    """A result store cannot be used: it belongs to another sweep, or is not a sweep store."""
+
+
+class ChunkFailedError(ClearjointError, RuntimeError):
+    """Some chunks did not finish (a worker died, a bug); the others are saved."""
+
+
+def point_seed(seed: int, index: int) -> np.random.SeedSequence:
+    """Return the seed of point ``index``: ``SeedSequence(seed).spawn(n)[index]`` for any n.
+
+    Built from the index alone, so it is the same whatever the chunking, the
+    number of workers or the order they finish in.
+    """
+    return np.random.SeedSequence(seed, spawn_key=(index,))
+
+
+def chunk_bounds(n_points: int, chunk_size: int) -> list[tuple[int, int]]:
+    """Return the (start, stop) of each chunk of ``chunk_size`` points (the last may be short)."""
+    if chunk_size < 1:
+        raise ParameterError(f"chunk_size must be >= 1, got {chunk_size}")
+    return [(a, min(a + chunk_size, n_points)) for a in range(0, n_points, chunk_size)]
+
+
+@dataclass(frozen=True)
+class Finished(Generic[R]):
+    """One task's outcome: its index in the argument list, and its result or its error."""
+
+    index: int
+    result: R | None
+    error: BaseException | None = None
+
+
+def _is_dask_client(runner: Any) -> bool:
+    return type(runner).__name__ == "Client" and hasattr(runner, "scheduler_info")
+
+
+def run_unordered(
+    function: Callable[[A], R], arguments: Sequence[A], runner: Runner = None
+) -> Iterator[Finished[R]]:
+    """Yield each task's :class:`Finished` outcome as it ends, in whatever order.
+
+    Parameters
+    ----------
+    function : callable
+        A pure function of one picklable argument (module level, so workers find it).
+    arguments : sequence
+        One argument per task.
+    runner : None, concurrent.futures.Executor or distributed.Client
+        Where to run: None runs the tasks here, one after the other, in order.
+
+    Yields
+    ------
+    Finished
+        A task's error is yielded, not raised, so that the caller can keep the
+        results of every other task before deciding what to do.
+    """
+    if runner is None:
+        for index, argument in enumerate(arguments):
+            try:
+                yield Finished(index, function(argument))
+            except Exception as exc:
+                yield Finished(index, None, exc)
+        return
+    if _is_dask_client(runner):
+        from distributed import as_completed as dask_as_completed
+
+        futures = [runner.submit(function, a, pure=False) for a in arguments]
+        where = {future.key: i for i, future in enumerate(futures)}
+        try:
+            for future in dask_as_completed(futures):  # type: ignore[no-untyped-call]
+                yield _outcome(where[future.key], future)
+        finally:
+            for future in futures:  # on Ctrl-C or an early stop: nothing left running for us
+                future.cancel()
+        return
+    if not isinstance(runner, Executor):
+        raise ParameterError(
+            f"runner must be None, a concurrent.futures Executor or a dask.distributed Client, "
+            f"got {type(runner).__name__}"
+        )
+    pool_futures: dict[Future[R], int] = {
+        runner.submit(function, a): i for i, a in enumerate(arguments)
+    }
+    try:
+        for future in as_completed(pool_futures):
+            yield _outcome(pool_futures[future], future)
+    finally:
+        for future in pool_futures:
+            future.cancel()
+
+
+def _outcome(index: int, future: Any) -> Finished[Any]:
+    try:
+        return Finished(index, future.result())
+    except Exception as exc:
+        return Finished(index, None, exc)
+
+
+def run_ordered(
+    function: Callable[[A], R],
+    arguments: Sequence[A],
+    runner: Runner = None,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[R]:
+    """Return ``[function(a) for a in arguments]`` computed on ``runner``; raise the first error.
+
+    ``progress(done, total)`` is called after each task.
+    """
+    results: dict[int, R] = {}
+    for done in run_unordered(function, arguments, runner):
+        if done.error is not None:
+            raise done.error
+        results[done.index] = done.result  # type: ignore[assignment]
+        if progress:
+            progress(len(results), len(arguments))
+    return [results[i] for i in range(len(arguments))]
+
+
+@contextlib.contextmanager
+def process_pool(jobs: int | None) -> Iterator[Executor | None]:
+    """Yield a process pool of ``jobs`` workers (None: every core), or None for one job."""
+    if jobs is not None and jobs < 1:
+        raise ParameterError(f"jobs must be >= 1 (--jobs), got {jobs}")
+    workers = jobs or os.cpu_count() or 1
+    if workers == 1:
+        yield None
+        return
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        yield pool
+
+
+@contextlib.contextmanager
+def dask_client(
+    address: str | None = None, *, workers: int | None = None, processes: bool = True
+) -> Iterator[Client]:
+    """Yield a Dask client: to the scheduler at ``address``, or to a new LocalCluster.
+
+    Parameters
+    ----------
+    address : str, optional
+        A running scheduler, e.g. ``tcp://host:8786``. None starts a LocalCluster
+        of ``workers`` single-threaded workers (default: one per core), closed on exit.
+    workers : int, optional
+        Workers of the LocalCluster (ignored with ``address``).
+    processes : bool
+        Workers as processes (default) or as threads of this process (for tests).
+
+    Raises
+    ------
+    SchedulerError
+        The scheduler did not answer within :data:`CONNECT_TIMEOUT_S` seconds.
+    """
+    from distributed import Client, LocalCluster
+
+    if workers is not None and workers < 1:
+        raise ParameterError(f"workers must be >= 1 (--workers), got {workers}")
+    if address is not None:
+        try:
+            client = Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")  # type: ignore[no-untyped-call]
+        except (OSError, TimeoutError, ValueError) as exc:
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise SchedulerError(
+                f"cannot reach the Dask scheduler at {address!r} ({reason}); start one with "
+                f"`dask scheduler`, check the address, or leave out --scheduler to run locally"
+            ) from None
+        with client:
+            yield client
+        return
+    n = workers or os.cpu_count() or 1
+    with (
+        LocalCluster(  # type: ignore[no-untyped-call]
+            n_workers=n,
+            threads_per_worker=1,
+            processes=processes,
+            dashboard_address=":0",  # any free port: never a clash with a running one
+            silence_logs=logging.ERROR,
+        ) as cluster,
+        Client(cluster) as client,  # type: ignore[no-untyped-call]
+    ):
+        yield client
+
+
+# ---- the result store ------------------------------------------------------------------------
+
+_FINGERPRINT = "clearjoint_sweep_fingerprint"
+_DONE = "chunk_done"
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One array of a store: its name, numpy dtype ('f8', 'i8' or 'str') and attributes."""
+
+    name: str
+    dtype: str
+    attrs: Mapping[str, Any]
+
+
+class ResultStore:
+    """A zarr group of point-wise results written chunk by chunk (see the module docstring)."""
+
+    def __init__(self, path: Path, group: Any, chunk_size: int, n_points: int) -> None:
+        self.path = path
+        self._group = group
+        self.chunk_size = chunk_size
+        self.n_points = n_points
+
+    def __repr__(self) -> str:
+        done = len(self.done_chunks())
+        total = len(chunk_bounds(self.n_points, self.chunk_size))
+        return f"ResultStore({str(self.path)!r}, {self.n_points} points, {done}/{total} chunks)"
+
+    @classmethod
+    def create(
+        cls,
+        path: str | Path,
+        *,
+        fingerprint: str,
+        n_points: int,
+        chunk_size: int,
+        variables: Sequence[Variable],
+        attrs: Mapping[str, Any],
+        force: bool = False,
+    ) -> ResultStore:
+        """Create an empty store; an existing one is replaced only with ``force``.
+
+        Raises
+        ------
+        OutputExistsError
+            ``path`` exists and ``force`` is False.
+        StoreError
+            ``path`` exists and is not a sweep store (it is never deleted, even with force).
+        """
+        import zarr
+
+        path = Path(path)
+        if path.exists():
+            if not force:
+                raise OutputExistsError(
+                    f"will not overwrite {path}; pass --resume to finish it, --force to "
+                    f"start again, or choose another --out"
+                )
+            cls.open(path)  # a StoreError unless it is a sweep store: never delete anything else
+            shutil.rmtree(path)
+        group: Any = zarr.open_group(str(path), mode="w-", zarr_format=3)
+        n_chunks = len(chunk_bounds(n_points, chunk_size))
+        for var in variables:
+            kind: Any = str if var.dtype == "str" else var.dtype
+            fill: Any = "" if var.dtype == "str" else (np.nan if var.dtype == "f8" else 0)
+            array = group.create_array(
+                var.name,
+                shape=(n_points,),
+                chunks=(chunk_size,),
+                dtype=kind,
+                fill_value=fill,
+                dimension_names=["point"],
+            )
+            array.attrs.update(dict(var.attrs))
+        group.create_array(
+            _DONE,
+            shape=(n_chunks,),
+            chunks=(1,),
+            dtype="bool",
+            fill_value=False,
+            dimension_names=["chunk"],
+        )
+        group.attrs.update({**dict(attrs), _FINGERPRINT: fingerprint, "chunk_size": chunk_size})
+        return cls(path, group, chunk_size, n_points)
+
+    @classmethod
+    def open(cls, path: str | Path, *, fingerprint: str | None = None) -> ResultStore:
+        """Open an existing store; with ``fingerprint``, refuse one made by another sweep.
+
+        Raises
+        ------
+        StoreError
+            ``path`` is not a sweep store, or its fingerprint differs.
+        """
+        import zarr
+
+        path = Path(path)
+        if not path.exists():
+            raise StoreError(f"{path}: no such result store; check the path")
+        if not (path / "zarr.json").is_file():  # a file, a folder of something else
+            raise StoreError(f"{path}: not a clearjoint sweep store (no zarr.json); left as it is")
+        try:
+            group: Any = zarr.open_group(str(path), mode="r+")
+            stored = group.attrs[_FINGERPRINT]
+            chunk_size = int(group.attrs["chunk_size"])
+        except (KeyError, OSError, ValueError, TypeError) as exc:
+            raise StoreError(
+                f"{path}: not a clearjoint sweep store ({type(exc).__name__}: {exc}); "
+                f"choose another --out"
+            ) from None
+        if fingerprint is not None and stored != fingerprint:
+            raise StoreError(
+                f"{path} was made from a different sweep file (hash {stored[:12]} here, "
+                f"{fingerprint[:12]} now); use --force to start again or another --out"
+            )
+        points = [int(group[n].shape[0]) for n in group.array_keys() if n != _DONE]
+        return cls(path, group, chunk_size, points[0] if points else 0)
+
+    @property
+    def attrs(self) -> dict[str, Any]:
+        """The store's attributes (the sweep's description)."""
+        return dict(self._group.attrs)
+
+    def done_chunks(self) -> set[int]:
+        """Indices of the chunks whose values are all written."""
+        flags = np.asarray(self._group[_DONE][:], dtype=bool)
+        return {int(i) for i in np.flatnonzero(flags)}
+
+    def write(self, chunk: int, values: Mapping[str, NDArray[Any]]) -> None:
+        """Write one chunk's values, then flag the chunk done (so a cut never leaves half)."""
+        start = chunk * self.chunk_size
+        for name, array in values.items():
+            self._group[name][start : start + len(array)] = array
+        self._group[_DONE][chunk] = True
+
+    def read(self) -> dict[str, tuple[NDArray[Any], dict[str, Any]]]:
+        """Every variable along ``point`` with its attributes (not yet computed: NaN / '')."""
+        out: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
+        for name in sorted(self._group.array_keys()):
+            if name == _DONE:
+                continue
+            array = self._group[name]
+            values = np.asarray(array[:])
+            if values.dtype.kind in "OTU":
+                values = np.array(values.tolist(), dtype=str)
+            out[name] = (values, dict(array.attrs))
+        return out

@@ -1,0 +1,326 @@
+"""Run a sweep on Dask (or an executor, or here), chunk by chunk into a resumable zarr store.
+
+Each chunk is a pure function of frozen values (the task, the base, the points'
+values and their indices); a point's random numbers come from
+``clearjoint.parallel.point_seed(sweep.seed, index)``, so the results are the same
+bit for bit whatever the workers. A point whose task raises is NaN with the reason
+in ``status``; the sweep goes on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import warnings
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint.parallel import (
+    ChunkFailedError,
+    ResultStore,
+    Runner,
+    Variable,
+    chunk_bounds,
+    dask_client,
+    point_seed,
+    run_unordered,
+)
+from clearjoint.sweep.file import Sweep
+from clearjoint.sweep.tasks import Task
+
+__all__ = [
+    "SERIAL",
+    "open_sweep",
+    "run_sweep",
+]
+
+#: Pass as ``client`` to run every chunk in this process, one after the other.
+SERIAL = "serial"
+
+#: Longest reason kept in ``status`` for a failed point.
+_REASON_CHARS = 300
+
+
+@dataclass(frozen=True)
+class _Chunk:
+    """Everything one chunk needs, frozen and picklable."""
+
+    task: Task
+    base: Any
+    names: tuple[str, ...]
+    values: NDArray[np.float64]  # (n, len(names))
+    first: int
+    seed: int
+    outputs: tuple[str, ...]
+    fixed: tuple[tuple[str, float], ...]
+
+
+def _evaluate_chunk(chunk: _Chunk) -> dict[str, NDArray[Any]]:
+    """Run the task at every point of the chunk: outputs (n,) and ``status`` (n,) of str.
+
+    ``status`` is "ok", "ok; <first warning>" (values kept), or "<Error>: <message>"
+    for a point whose task raised (its outputs NaN).
+    """
+    n = chunk.values.shape[0]
+    out = {name: np.full(n, np.nan) for name in chunk.outputs}
+    status = np.full(n, "ok", dtype=object)
+    fixed = dict(chunk.fixed)
+    for row in range(n):
+        values = {**fixed, **dict(zip(chunk.names, map(float, chunk.values[row]), strict=True))}
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                result = chunk.task.evaluate(
+                    chunk.base, values, point_seed(chunk.seed, chunk.first + row)
+                )
+        except Exception as exc:  # a failed point is recorded, never a crashed sweep
+            status[row] = f"{type(exc).__name__}: {exc}"[:_REASON_CHARS]
+            continue
+        if caught:  # kept beside the values: "ok; SomeWarning: ..."
+            first = caught[0]
+            status[row] = f"ok; {first.category.__name__}: {first.message}"[:_REASON_CHARS]
+        for name in chunk.outputs:
+            out[name][row] = result[name]
+    return {**out, "status": np.asarray(status.astype(str))}
+
+
+def _point_values(sweep: Sweep, drawn: Mapping[str, NDArray[np.float64]], a: int, b: int) -> Any:
+    index = np.unravel_index(np.arange(a, b), sweep.shape)
+    columns = []
+    offset = 1 if sweep.samples else 0
+    for d in sweep.draws:
+        columns.append(drawn[d.name][index[0]])
+    for k, axis in enumerate(sweep.axes):
+        columns.append(np.asarray(axis.values)[index[k + offset]])
+    if not columns:
+        return np.zeros((b - a, 0))
+    return np.column_stack(columns)
+
+
+def _attrs(sweep: Sweep) -> dict[str, Any]:
+    return {
+        "title": f"clearjoint sweep: {sweep.task.name}",
+        "task": sweep.task.name,
+        "sweep_file": sweep.source,
+        "base": str(getattr(sweep.base, "source", "")),
+        "seed": sweep.seed,
+        "dims": json.dumps(list(sweep.dims)),
+        "shape": json.dumps(list(sweep.shape)),
+        "axes": json.dumps(
+            {a.name: {"values": list(a.values), "units": a.unit} for a in sweep.axes}
+        ),
+        "draws": json.dumps([d.name for d in sweep.draws]),
+        "fixed": json.dumps(dict(sweep.fixed)),
+        "files": json.dumps(list(getattr(sweep.base, "files", []))),
+    }
+
+
+def _variables(sweep: Sweep) -> list[Variable]:
+    out = [Variable(name, "f8", {"units": sweep.task.outputs[name]}) for name in sweep.outputs]
+    out += [
+        Variable(d.name, "f8", {"units": d.unit, "distribution": d.distribution})
+        for d in sweep.draws
+    ]
+    out.append(Variable("status", "str", {"description": "ok, or why the point failed"}))
+    return out
+
+
+@contextlib.contextmanager
+def _runner(client: Any, workers: int | None) -> Iterator[Runner]:
+    if client is None:
+        with dask_client(workers=workers) as local:
+            yield local
+    elif isinstance(client, str) and client == SERIAL:
+        yield None
+    else:
+        yield client
+
+
+def run_sweep(
+    sweep: Sweep,
+    *,
+    client: Any = None,
+    out: str | Path | None = None,
+    resume: bool = False,
+    force: bool = False,
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Any:
+    """Run the sweep and return its results as an xarray.Dataset.
+
+    Parameters
+    ----------
+    sweep : Sweep
+    client : distributed.Client, concurrent.futures.Executor, "serial" or None
+        Where the chunks run. None starts a dask.distributed LocalCluster of
+        ``workers`` processes (default: one per core) for this run.
+    out : path, optional
+        A zarr store written chunk by chunk as chunks finish.
+    resume : bool
+        Continue the store at ``out``: compute only the chunks it lacks. The store
+        must come from the same sweep (its fingerprint).
+    force : bool
+        Replace an existing store at ``out`` (without it, and without ``resume``, an
+        existing store is an error).
+    workers : int, optional
+        Workers of the LocalCluster started when ``client`` is None.
+    progress : callable, optional
+        ``progress(points_done, points_total)`` after each chunk (and once at the start).
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension per grid axis (after ``sample`` for Monte Carlo), each output
+        and ``status`` (``"ok"`` or why the point failed) over them, drawn values
+        as coordinates over ``sample``; units in each variable's ``units`` attribute.
+
+    Raises
+    ------
+    OutputExistsError
+        ``out`` exists and neither ``resume`` nor ``force`` is given.
+    StoreError
+        ``resume`` against a store made by a different sweep.
+    ChunkFailedError
+        A chunk did not finish (a worker died); every other chunk is in the store.
+    """
+    bounds = chunk_bounds(sweep.n_points, sweep.chunk_size)
+    store: ResultStore | None = None
+    todo = list(range(len(bounds)))
+    if out is not None:
+        path = Path(out)
+        if resume and path.exists():
+            store = ResultStore.open(path, fingerprint=sweep.fingerprint)
+            done = store.done_chunks()
+            todo = [i for i in todo if i not in done]
+        else:
+            store = ResultStore.create(
+                path,
+                fingerprint=sweep.fingerprint,
+                n_points=sweep.n_points,
+                chunk_size=sweep.chunk_size,
+                variables=_variables(sweep),
+                attrs=_attrs(sweep),
+                force=force,
+            )
+    drawn = sweep.drawn()
+    names = tuple(d.name for d in sweep.draws) + tuple(a.name for a in sweep.axes)
+    chunks = [
+        _Chunk(
+            task=sweep.task,
+            base=sweep.base,
+            names=names,
+            values=_point_values(sweep, drawn, *bounds[i]),
+            first=bounds[i][0],
+            seed=sweep.seed,
+            outputs=sweep.outputs,
+            fixed=sweep.fixed,
+        )
+        for i in todo
+    ]
+    finished = sweep.n_points - sum(bounds[i][1] - bounds[i][0] for i in todo)
+    if progress:
+        progress(finished, sweep.n_points)
+    in_memory: dict[int, dict[str, NDArray[Any]]] = {}
+    failures: list[str] = []
+    if chunks:
+        with _runner(client, workers) as runner:
+            for outcome in run_unordered(_evaluate_chunk, chunks, runner):
+                chunk = todo[outcome.index]
+                if outcome.error is not None or outcome.result is None:
+                    failures.append(
+                        f"chunk {chunk}: {type(outcome.error).__name__}: {outcome.error}"
+                    )
+                    continue
+                if store is not None:
+                    values = dict(outcome.result)
+                    for d in sweep.draws:
+                        a, b = bounds[chunk]
+                        values[d.name] = drawn[d.name][
+                            np.unravel_index(np.arange(a, b), sweep.shape)[0]
+                        ]
+                    store.write(chunk, values)
+                else:
+                    in_memory[chunk] = outcome.result
+                finished += bounds[chunk][1] - bounds[chunk][0]
+                if progress:
+                    progress(finished, sweep.n_points)
+    if failures:
+        where = f"; the others are in {out}: finish with --resume" if out is not None else ""
+        raise ChunkFailedError(
+            f"{len(failures)} of {len(bounds)} chunks did not finish ({failures[0]}){where}"
+        )
+    if store is not None:
+        return _dataset(store.read(), store.attrs)
+    flat: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
+    for var in _variables(sweep):
+        if var.name in drawn:
+            index = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
+            array = drawn[var.name][index]
+        else:
+            array = np.concatenate([in_memory[i][var.name] for i in range(len(bounds))])
+        flat[var.name] = (array, dict(var.attrs))
+    return _dataset(flat, {**_attrs(sweep), "clearjoint_sweep_fingerprint": sweep.fingerprint})
+
+
+def _dataset(
+    flat: Mapping[str, tuple[NDArray[Any], dict[str, Any]]], attrs: Mapping[str, Any]
+) -> Any:
+    import xarray as xr
+
+    dims = tuple(json.loads(attrs["dims"]))
+    shape = tuple(json.loads(attrs["shape"]))
+    axes = json.loads(attrs["axes"])
+    drawn = set(json.loads(attrs["draws"]))
+    coords: dict[str, Any] = {
+        name: (name, np.asarray(spec["values"]), {"units": spec["units"]})
+        for name, spec in axes.items()
+    }
+    if "sample" in dims:
+        coords["sample"] = ("sample", np.arange(shape[0]))
+    files = json.loads(attrs.get("files", "[]"))
+    if files:  # a record set: its files beside the record index
+        coords["record"] = ("record", np.arange(len(files)))
+        coords["file"] = ("record", np.asarray(files, dtype=str))
+    variables: dict[str, Any] = {}
+    for name, (values, var_attrs) in flat.items():
+        full = values.reshape(shape)
+        if name in drawn:
+            first = full.reshape(shape[0], -1)[:, 0]
+            coords[name] = ("sample", first, var_attrs)
+        else:
+            variables[name] = (dims, full, var_attrs)
+    status = flat["status"][0]
+    ok = np.char.startswith(status.astype(str), "ok")
+    failed = int(np.count_nonzero(~ok & (status != "")))
+    missing = int(np.count_nonzero(status == ""))
+    keep = {
+        k: v
+        for k, v in attrs.items()
+        if k not in ("dims", "shape", "axes", "draws", "chunk_size", "files")
+    }
+    return xr.Dataset(
+        variables,
+        coords=coords,
+        attrs={
+            **keep,
+            "points": math.prod(shape),
+            "points_failed": failed,
+            "points_missing": missing,
+        },
+    )
+
+
+def open_sweep(path: str | Path) -> Any:
+    """Return the results in a sweep's zarr store as an xarray.Dataset (as :func:`run_sweep`).
+
+    Points of chunks not yet computed are NaN with an empty ``status``
+    (``points_missing`` in the attributes counts them).
+    """
+    store = ResultStore.open(path)
+    return _dataset(store.read(), store.attrs)

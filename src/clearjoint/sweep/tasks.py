@@ -1,0 +1,493 @@
+"""What a sweep computes at each point: the task registry and the joint tasks.
+
+A :class:`Task` names its base (a ``study`` file of ``clearjoint simulate`` or a rig
+``campaign``), the parameters a sweep may vary or fix, its outputs with their units,
+and ``evaluate(base, values, seed)``: a pure, module-level function of frozen values
+that returns one float per output (it runs on Dask workers). The physics is the
+library's; this module only maps a point's values onto it:
+
+* ``steady_state``: the exact steady cycle of the forced joint (clearjoint.simulate,
+  MODEL.md sec. 2): amplitude, extremes, penetrations and the energy ledger per period;
+* ``energies``: every energy per free cycle at penetration ``task.amplitude``
+  (clearjoint.dissipation.energies, MODEL.md eq 10-18);
+* ``free_cycle``: the joint's amplitude-dependent natural frequency, dynamic stiffness,
+  c_d (MODEL.md eq 5-9) and equivalent damping ratio on the free cycle at ``task.amplitude``;
+* ``stepped_sine``: the frequency-response curve by a stepped sine up and down
+  (clearjoint.simulate.frequency_sweep), reduced to its peak and its up/down jump;
+* ``identify``: the identification of each record of a set (base: a glob of files),
+  one point per file along the ``record`` axis;
+* ``rig_test``: one test of the virtual rig (clearjoint.rig), measured with the
+  point's own noise seed, then identified (clearjoint.identify): truth beside estimate.
+
+Structure, periodic-orbit and continuation frequency-response tasks register themselves the same
+way with :func:`register_task` when their features land.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from clearjoint.errors import ParameterError
+
+__all__ = [
+    "FORCING_PARAMETERS",
+    "JOINT_PARAMETERS",
+    "TASKS",
+    "Parameter",
+    "RecordSet",
+    "Task",
+    "register_task",
+    "study_at",
+]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A value a sweep may vary: its kind of quantity, SI unit (as shown) and valid range."""
+
+    kind: str
+    unit: str
+    lower: float = 0.0
+    upper: float = math.inf
+    open_lower: bool = False  # True: the value must be > lower (a mass), not >= lower
+
+
+@dataclass(frozen=True)
+class Task:
+    """One kind of computation a sweep can run at each point (see the module docstring).
+
+    ``options`` are task parameters with a default (None: must be given in [task] or
+    as an axis); ``evaluate(base, values, seed)`` gets every parameter the sweep names
+    plus every option, in SI (frequencies in Hz), and returns one float per output.
+    """
+
+    name: str
+    base: str
+    parameters: Mapping[str, Parameter]
+    options: Mapping[str, tuple[float | None, Parameter]]
+    outputs: Mapping[str, str]
+    evaluate: Callable[[Any, Mapping[str, float], np.random.SeedSequence], Mapping[str, float]]
+    description: str
+
+
+#: Every task a sweep file may name, by name.
+TASKS: dict[str, Task] = {}
+
+
+def register_task(task: Task) -> None:
+    """Add ``task`` to :data:`TASKS` (a name is registered once)."""
+    if task.name in TASKS and TASKS[task.name] is not task:
+        raise ParameterError(f"a sweep task named {task.name!r} is already registered")
+    TASKS[task.name] = task
+
+
+# ---- the joint of a study file ---------------------------------------------------------------
+
+_POSITIVE = {"open_lower": True}
+JOINT_PARAMETERS: dict[str, Parameter] = {
+    "joint.mass": Parameter("mass", "kg", **_POSITIVE),
+    "joint.clearance": Parameter("length", "m"),
+    "joint.compression_stiffness": Parameter("stiffness", "N/m", **_POSITIVE),
+    "joint.tension_stiffness": Parameter("stiffness", "N/m", **_POSITIVE),
+    "joint.gap_stiffness": Parameter("stiffness", "N/m"),
+    "joint.gap_offset": Parameter("length", "m", lower=-math.inf),
+    "losses.damping_ratio": Parameter("dimensionless", ""),
+    "losses.restitution": Parameter("dimensionless", "", upper=1.0),
+    "losses.friction_coefficient": Parameter("dimensionless", ""),
+    "losses.lateral_load": Parameter("force", "N"),
+    "losses.contact_friction_coefficient": Parameter("dimensionless", ""),
+}
+FORCING_PARAMETERS: dict[str, Parameter] = {
+    "excitation.force_amplitude": Parameter("force", "N", **_POSITIVE),
+    "excitation.frequency": Parameter("frequency", "Hz", **_POSITIVE),
+}
+
+
+def study_at(study: Any, values: Mapping[str, float]) -> Any:
+    """Return the study with the point's ``values`` applied (keys as in the study file).
+
+    A symmetric joint (k_t = k_c) stays symmetric when only k_c is varied, and a
+    pin's hole follows a varied clearance (R_h = R_p + c/2), as in a study file
+    that leaves them to their defaults.
+    """
+    from clearjoint.joint import Friction, Pin
+
+    joint = study.joint
+    changes = {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith("joint.")}
+    if (
+        "compression_stiffness" in changes
+        and "tension_stiffness" not in changes
+        and joint.tension_stiffness == joint.compression_stiffness
+    ):
+        changes["tension_stiffness"] = changes["compression_stiffness"]
+    joint = replace(joint, **changes)
+    pin = study.pin
+    if pin is not None and "clearance" in changes:
+        pin = replace(pin, hole_radius=pin.radius + 0.5 * joint.clearance)
+    friction = study.friction
+    mu_s = values.get("losses.friction_coefficient", friction.coefficient if friction else 0.0)
+    load = values.get("losses.lateral_load", friction.lateral_load if friction else 0.0)
+    region = friction.region if friction else "everywhere"
+    friction = Friction(mu_s, load, region) if mu_s > 0.0 and load > 0.0 else None
+    omega = study.omega
+    if "excitation.frequency" in values:
+        omega = 2.0 * math.pi * values["excitation.frequency"]
+    return replace(
+        study,
+        joint=joint,
+        pin=pin if isinstance(pin, Pin) else None,
+        friction=friction,
+        omega=omega,
+        force_amplitude=values.get("excitation.force_amplitude", study.force_amplitude),
+        damping_ratio=values.get("losses.damping_ratio", study.damping_ratio),
+        restitution=values.get("losses.restitution", study.restitution),
+        contact_friction_coefficient=values.get(
+            "losses.contact_friction_coefficient", study.contact_friction_coefficient
+        ),
+    )
+
+
+def _steady_state(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.simulate import steady_state
+
+    study = study_at(base, values)
+    cycle = steady_state(
+        study.joint,
+        study.force_amplitude,
+        study.omega,
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+        pin=study.pin,
+        contact_friction_coefficient=study.contact_friction_coefficient,
+        samples_per_period=int(values.get("task.samples_per_period", 64)),
+        max_periods=int(values.get("task.max_periods", 20_000)),
+    )
+    per = 1.0 / cycle.period_multiple  # per forcing period
+    ledger = cycle.energy
+    return {
+        "amplitude_m": cycle.amplitude,
+        "x_max_m": cycle.x_max,
+        "x_min_m": cycle.x_min,
+        "compression_penetration_m": cycle.compression_penetration,
+        "tension_penetration_m": cycle.tension_penetration,
+        "period_multiple": float(cycle.period_multiple),
+        "periods_to_converge": float(cycle.periods_to_converge),
+        "energy_input_j": ledger.input * per,
+        "viscous_j": ledger.viscous * per,
+        "sliding_friction_j": ledger.sliding_friction * per,
+        "impact_j": ledger.impact * per,
+        "contact_friction_j": ledger.contact_friction * per,
+        "balance_error": ledger.balance_error,
+    }
+
+
+register_task(
+    Task(
+        name="steady_state",
+        base="study",
+        parameters={**JOINT_PARAMETERS, **FORCING_PARAMETERS},
+        options={
+            "task.samples_per_period": (64.0, Parameter("dimensionless", "", lower=8.0)),
+            "task.max_periods": (20_000.0, Parameter("dimensionless", "", lower=10.0)),
+        },
+        outputs={
+            "amplitude_m": "m",
+            "x_max_m": "m",
+            "x_min_m": "m",
+            "compression_penetration_m": "m",
+            "tension_penetration_m": "m",
+            "period_multiple": "",
+            "periods_to_converge": "",
+            "energy_input_j": "J",
+            "viscous_j": "J",
+            "sliding_friction_j": "J",
+            "impact_j": "J",
+            "contact_friction_j": "J",
+            "balance_error": "",
+        },
+        evaluate=_steady_state,
+        description="exact steady cycle of the forced joint (energies per forcing period)",
+    )
+)
+
+
+def _energies(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.dissipation import energies
+
+    study = study_at(base, values)
+    result = energies(
+        study.joint,
+        values["task.amplitude"],
+        friction=study.friction,
+        pin=study.pin,
+        contact_friction_coefficient=study.contact_friction_coefficient,
+        restitution=study.restitution,
+        damping_ratio=study.damping_ratio,
+    )
+    return {key: float(value) for key, value in result.items()}
+
+
+register_task(
+    Task(
+        name="energies",
+        base="study",
+        parameters=JOINT_PARAMETERS,
+        options={"task.amplitude": (None, Parameter("length", "m"))},
+        outputs={
+            "sliding_friction_j": "J",
+            "sliding_friction_paper_j": "J",
+            "contact_friction_j": "J",
+            "impact_j": "J",
+            "viscous_j": "J",
+            "total_j": "J",
+            "loss_factor": "",
+            "equivalent_damping_ratio": "",
+            "hertz_half_width_m": "m",
+        },
+        evaluate=_energies,
+        description="energies per free cycle at penetration task.amplitude (MODEL.md eq 10-18)",
+    )
+)
+
+
+def _free_cycle(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint import stiffness
+    from clearjoint.dissipation import energies
+
+    study = study_at(base, values)
+    amplitude = values["task.amplitude"]
+    period = float(stiffness.period(study.joint, amplitude))
+    damping = energies(
+        study.joint,
+        amplitude,
+        friction=study.friction,
+        pin=study.pin,
+        contact_friction_coefficient=study.contact_friction_coefficient,
+        restitution=study.restitution,
+        damping_ratio=study.damping_ratio,
+    )
+    return {
+        "natural_frequency_hz": 1.0 / period,
+        "dynamic_stiffness_n_per_m": float(stiffness.dynamic_stiffness(study.joint, amplitude)),
+        "stiffness_coefficient": float(stiffness.stiffness_coefficient(study.joint, amplitude)),
+        "equivalent_damping_ratio": float(damping["equivalent_damping_ratio"]),
+    }
+
+
+register_task(
+    Task(
+        name="free_cycle",
+        base="study",
+        parameters=JOINT_PARAMETERS,
+        options={"task.amplitude": (None, Parameter("length", "m"))},
+        outputs={
+            "natural_frequency_hz": "Hz",
+            "dynamic_stiffness_n_per_m": "N/m",
+            "stiffness_coefficient": "",
+            "equivalent_damping_ratio": "",
+        },
+        evaluate=_free_cycle,
+        description=(
+            "the joint's amplitude-dependent modal properties on the free cycle at "
+            "penetration task.amplitude: f_n (MODEL.md eq 5-6), k_d, c_d (eq 8-9), and the "
+            "equivalent damping ratio of every loss (eq 10-18)"
+        ),
+    )
+)
+
+
+def _stepped_sine(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    import warnings
+
+    from clearjoint.simulate import frequency_sweep
+
+    study = study_at(base, values)
+    low, high = values["task.frequency_start"], values["task.frequency_stop"]
+    steps = int(values["task.frequency_steps"])
+    if not high > low:
+        raise ParameterError(f"task.frequency_stop must exceed frequency_start, got {low}, {high}")
+    hz = np.linspace(low, high, steps)
+    curve = frequency_sweep(
+        study.joint,
+        study.force_amplitude,
+        2.0 * math.pi * hz,
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+        max_periods=int(values["task.max_periods"]),
+    )
+    both = np.vstack([curve.amplitude_up, curve.amplitude_down])
+    failed = int(np.count_nonzero(np.isnan(both)))
+    if failed == both.size:
+        raise ParameterError("no step of the stepped sine found a steady state")
+    if failed:
+        warnings.warn(
+            f"{failed} of {both.size} steps found no steady state (NaN there)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    peak = int(np.nanargmax(np.nanmax(both, axis=0)))
+    return {
+        "peak_amplitude_m": float(np.nanmax(both)),
+        "peak_frequency_hz": float(hz[peak]),
+        "peak_amplitude_up_m": float(np.nanmax(curve.amplitude_up)),
+        "peak_amplitude_down_m": float(np.nanmax(curve.amplitude_down)),
+        "jump_m": float(np.nanmax(np.abs(curve.amplitude_up - curve.amplitude_down))),
+        "steps_failed": float(failed),
+    }
+
+
+register_task(
+    Task(
+        name="stepped_sine",
+        base="study",
+        parameters={
+            **JOINT_PARAMETERS,
+            "excitation.force_amplitude": FORCING_PARAMETERS["excitation.force_amplitude"],
+        },
+        options={
+            "task.frequency_start": (None, Parameter("frequency", "Hz", open_lower=True)),
+            "task.frequency_stop": (None, Parameter("frequency", "Hz", open_lower=True)),
+            "task.frequency_steps": (40.0, Parameter("dimensionless", "", lower=2.0)),
+            "task.max_periods": (20_000.0, Parameter("dimensionless", "", lower=10.0)),
+        },
+        outputs={
+            "peak_amplitude_m": "m",
+            "peak_frequency_hz": "Hz",
+            "peak_amplitude_up_m": "m",
+            "peak_amplitude_down_m": "m",
+            "jump_m": "m",
+            "steps_failed": "",
+        },
+        evaluate=_stepped_sine,
+        description=(
+            "frequency-response curve by a stepped sine up and down (simulate.frequency_sweep; "
+            "no pin contact friction): its peak, where, and the up/down jump"
+        ),
+    )
+)
+
+
+# ---- a test of the virtual rig ---------------------------------------------------------------
+
+
+def _rig_test(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.identify import identify
+    from clearjoint.rig import Structure, TestSpec, simulate_test
+
+    clearance = values.get("test.clearance", base.structures[0].clearance)
+    spec = TestSpec(
+        index=0,
+        structure=Structure("joint", True, clearance),
+        frequency_hz=values.get("test.frequency", base.frequencies[0]),
+        force_amplitude=values.get("test.force_amplitude", base.force_amplitudes[0]),
+    )
+    record, truth = simulate_test(base.rig, spec, base.periods, seed)
+    found = identify(record)
+    return {
+        "clearance_m": truth["clearance_m"],
+        "energy_per_cycle_j": truth["energy_per_cycle_j"],
+        "amplitude_m": truth["amplitude_m"],
+        "identified_clearance_m": float(found.summary["clearance_m"]),
+        "identified_energy_per_cycle_j": float(found.summary["energy_per_cycle_j"]),
+    }
+
+
+register_task(
+    Task(
+        name="rig_test",
+        base="campaign",
+        parameters={
+            "test.clearance": Parameter("length", "m", **_POSITIVE),
+            "test.frequency": Parameter("frequency", "Hz", **_POSITIVE),
+            "test.force_amplitude": Parameter("force", "N", **_POSITIVE),
+        },
+        options={},
+        outputs={
+            "clearance_m": "m",
+            "energy_per_cycle_j": "J",
+            "amplitude_m": "m",
+            "identified_clearance_m": "m",
+            "identified_energy_per_cycle_j": "J",
+        },
+        evaluate=_rig_test,
+        description=(
+            "one virtual-rig test (the campaign's first jointed structure, frequency and "
+            "force unless varied), measured with the point's own noise, then identified"
+        ),
+    )
+)
+
+
+# ---- identification of a record set ----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RecordSet:
+    """The record files a sweep identifies: one point per file along the ``record`` axis."""
+
+    files: tuple[str, ...]
+    source: str = ""
+
+
+_IDENTIFIED = {
+    "amplitude_m": "m",
+    "clearance_m": "m",
+    "compression_stiffness_n_per_m": "N/m",
+    "tension_stiffness_n_per_m": "N/m",
+    "friction_force_n": "N",
+    "energy_per_cycle_j": "J",
+    "compression_penetration_m": "m",
+    "tension_penetration_m": "m",
+    "gap_stiffness_n_per_m": "N/m",
+    "secant_stiffness_n_per_m": "N/m",
+    "dynamic_stiffness_n_per_m": "N/m",
+}
+
+
+def _identify(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.identify import identify
+    from clearjoint.records import read_record
+
+    record = read_record(base.files[int(values["record"])])
+    found = identify(record, tolerance=values["task.tolerance"])
+    out = {key: float(found.summary[key]) for key in _IDENTIFIED}
+    out["frequency_hz"] = float(found.frequency_hz)
+    out["cycles_used"] = float(found.cycles_used)
+    return out
+
+
+register_task(
+    Task(
+        name="identify",
+        base="records",
+        parameters={},
+        options={
+            "task.tolerance": (0.03, Parameter("dimensionless", "", open_lower=True, upper=1.0))
+        },
+        outputs={**_IDENTIFIED, "frequency_hz": "Hz", "cycles_used": ""},
+        evaluate=_identify,
+        description=(
+            "identification of each record of a set (clearjoint.identify): the mean over its "
+            "steady cycles of each quantity; a record that cannot be identified says why"
+        ),
+    )
+)

@@ -1,0 +1,62 @@
+"""The docs site's promises that a test can check without building it.
+
+Every picture a page shows is drawn by a script the docs build runs (a gallery
+example lists it in ``DOCS_FIGURES``) or by docs/make_report_figures.py, so none can
+fall behind the code; and the LICENSE is the one pyproject.toml names.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Figures cut out of the two reports by docs/make_report_figures.py.
+REPORT_FIGURES = ("reproduce_fig", "brfd_fig")
+
+
+def pages() -> list[Path]:
+    return [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+
+
+def shown() -> dict[str, Path]:
+    found = {}
+    for page in pages():
+        if "_build" in page.parts:
+            continue
+        for name in re.findall(r"figures/([\w.-]+\.png)", page.read_text(encoding="utf-8")):
+            found[name] = page
+    return found
+
+
+def drawn_by_gallery() -> set[str]:
+    names: set[str] = set()
+    for script in (ROOT / "examples" / "gallery").glob("plot_*.py"):
+        text = script.read_text(encoding="utf-8")
+        names.update(re.findall(r"DOCS_FIGURES\[\"([\w.-]+\.png)\"\]", text))
+    return names
+
+
+def test_every_figure_a_page_shows_is_drawn_by_a_script() -> None:
+    gallery = drawn_by_gallery()
+    assert len(gallery) >= 7
+    for name, page in shown().items():
+        assert (ROOT / "docs" / "figures" / name).is_file(), f"{page} shows a missing {name}"
+        assert name in gallery or name.startswith(REPORT_FIGURES), (
+            f"{page.name} shows figures/{name}, which no script draws: draw it in an "
+            "examples/gallery/plot_*.py and add it to that script's DOCS_FIGURES"
+        )
+
+
+def test_every_gallery_figure_is_shown_somewhere() -> None:
+    unused = drawn_by_gallery() - set(shown())
+    assert not unused, f"drawn for the docs but shown on no page: {sorted(unused)}"
+
+
+def test_license_file_is_the_mit_licence_pyproject_names() -> None:
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert project["license"]["text"] == "MIT"
+    text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert text.startswith("MIT License")
+    assert "Permission is hereby granted, free of charge" in text

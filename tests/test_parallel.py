@@ -1,0 +1,190 @@
+"""Tests of clearjoint.parallel: where tasks run changes nothing, and the store keeps its chunks."""
+
+from __future__ import annotations
+
+import socket
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from clearjoint.errors import OutputExistsError, ParameterError
+from clearjoint.parallel import (
+    ResultStore,
+    SchedulerError,
+    StoreError,
+    Variable,
+    chunk_bounds,
+    dask_client,
+    point_seed,
+    run_ordered,
+    run_unordered,
+)
+
+
+def _noisy_chunk(bounds: tuple[int, int]) -> list[float]:
+    """A pure task: one normal draw per point from that point's own seed."""
+    start, stop = bounds
+    return [float(np.random.default_rng(point_seed(42, i)).normal()) for i in range(start, stop)]
+
+
+def _fails_on_two(x: int) -> int:
+    if x == 2:
+        raise ArithmeticError("no convergence at 2")
+    return x * x
+
+
+def test_point_seed_is_numpys_spawn_whatever_the_number_of_points() -> None:
+    for n in (5, 17, 1000):
+        children = np.random.SeedSequence(7).spawn(n)
+        for i in (0, 3, 4):
+            a = np.random.default_rng(children[i]).integers(0, 2**62, 4)
+            b = np.random.default_rng(point_seed(7, i)).integers(0, 2**62, 4)
+            np.testing.assert_array_equal(a, b)
+
+
+def test_chunk_bounds_cover_every_point_once() -> None:
+    bounds = chunk_bounds(10, 4)
+    assert bounds == [(0, 4), (4, 8), (8, 10)]
+    with pytest.raises(ParameterError, match="chunk_size"):
+        chunk_bounds(10, 0)
+
+
+def test_results_are_bit_for_bit_the_same_wherever_and_in_whatever_order() -> None:
+    bounds = chunk_bounds(23, 4)
+    serial = np.concatenate(run_ordered(_noisy_chunk, bounds))
+    # chunked differently and run backwards: the same numbers for the same points
+    other = chunk_bounds(23, 5)[::-1]
+    backwards = np.concatenate(run_ordered(_noisy_chunk, other)[::-1])
+    np.testing.assert_array_equal(serial, backwards)
+    with ThreadPoolExecutor(2) as pool:
+        np.testing.assert_array_equal(
+            serial, np.concatenate(run_ordered(_noisy_chunk, bounds, pool))
+        )
+    for workers in (1, 2):
+        with dask_client(workers=workers, processes=False) as client:
+            on_dask = np.concatenate(run_ordered(_noisy_chunk, bounds, client))
+        np.testing.assert_array_equal(serial, on_dask)
+
+
+def test_a_failing_task_is_reported_and_the_others_still_finish() -> None:
+    outcomes = {done.index: done for done in run_unordered(_fails_on_two, [0, 1, 2, 3])}
+    assert {i: o.result for i, o in outcomes.items() if o.error is None} == {0: 0, 1: 1, 3: 9}
+    assert isinstance(outcomes[2].error, ArithmeticError)
+    with pytest.raises(ArithmeticError, match="at 2"):
+        run_ordered(_fails_on_two, [0, 1, 2, 3])
+    with pytest.raises(ParameterError, match="runner must be"):
+        list(run_unordered(_fails_on_two, [0], runner="pool"))
+
+
+def test_an_unreachable_scheduler_is_one_clear_error_within_ten_seconds() -> None:
+    with socket.socket() as s:  # a port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    start = time.perf_counter()
+    with (
+        pytest.raises(SchedulerError, match=rf"tcp://127.0.0.1:{port}.*--scheduler") as info,
+        dask_client(f"tcp://127.0.0.1:{port}"),
+    ):
+        pass
+    assert time.perf_counter() - start < 10.0
+    assert "\n" not in str(info.value)
+
+
+def _store(path: Path, fingerprint: str = "abc", force: bool = False) -> ResultStore:
+    return ResultStore.create(
+        path,
+        fingerprint=fingerprint,
+        n_points=10,
+        chunk_size=4,
+        variables=[Variable("x", "f8", {"units": "m"}), Variable("status", "str", {})],
+        attrs={"title": "test"},
+        force=force,
+    )
+
+
+def test_the_store_keeps_finished_chunks_and_refuses_what_it_should(tmp_path: Path) -> None:
+    path = tmp_path / "r.zarr"
+    store = _store(path)
+    assert store.done_chunks() == set()
+    store.write(2, {"x": np.array([8.0, 9.0]), "status": np.array(["ok", "bad"])})
+    store.write(0, {"x": np.arange(4.0), "status": np.array(["ok"] * 4)})
+    again = ResultStore.open(path, fingerprint="abc")
+    assert again.done_chunks() == {0, 2}
+    assert again.n_points == 10
+    values = again.read()
+    np.testing.assert_array_equal(values["x"][0][[0, 1, 2, 3, 8, 9]], [0, 1, 2, 3, 8, 9])
+    assert np.isnan(values["x"][0][4:8]).all()  # not computed yet
+    assert values["x"][1]["units"] == "m"
+    assert list(values["status"][0][[0, 8, 9, 5]]) == ["ok", "ok", "bad", ""]
+    assert again.attrs["title"] == "test"
+    assert "2/3 chunks" in repr(again)
+    with pytest.raises(OutputExistsError, match="--resume"):
+        _store(path)
+    with pytest.raises(StoreError, match="different sweep file"):
+        ResultStore.open(path, fingerprint="xyz")
+    with pytest.raises(StoreError, match="no such result store"):
+        ResultStore.open(tmp_path / "none.zarr")
+    (tmp_path / "plain").mkdir()
+    with pytest.raises(StoreError, match="not a clearjoint sweep store"):
+        ResultStore.open(tmp_path / "plain")
+    with pytest.raises(StoreError, match="not a clearjoint sweep store"):
+        _store(tmp_path / "plain", force=True)  # force never deletes what is not a store
+    assert (tmp_path / "plain").is_dir()
+    (tmp_path / "file.zarr").write_text("mine", encoding="utf-8")
+    with pytest.raises(StoreError, match="not a clearjoint sweep store"):
+        _store(tmp_path / "file.zarr", force=True)
+    assert (tmp_path / "file.zarr").read_text(encoding="utf-8") == "mine"
+    fresh = _store(path, force=True)
+    assert fresh.done_chunks() == set()
+
+
+CAMPAIGN = """
+seed = 7
+periods = 12
+[grid]
+frequencies = ["40Hz"]
+force_amplitudes = ["1200N"]
+[[structures]]
+name = "joint-1"
+clearance = "0.106mm"
+[[structures]]
+name = "beam"
+jointed = false
+"""
+
+
+def test_the_rig_gives_the_same_records_here_and_on_a_dask_client(tmp_path: Path) -> None:
+    from clearjoint.records import read_record
+    from clearjoint.rig import load_campaign, run_campaign
+
+    (tmp_path / "c.toml").write_text(CAMPAIGN, encoding="utf-8")
+    campaign = load_campaign(tmp_path / "c.toml")
+    here = run_campaign(campaign, tmp_path / "here", jobs=1)
+    with dask_client(workers=2, processes=False) as client:
+        there = run_campaign(campaign, tmp_path / "there", executor=client)
+    assert here.read_text() == there.read_text()
+    for name in ("joint-1_40Hz_1200N.nc", "beam_40Hz_1200N.nc"):
+        a, b = read_record(here.parent / name), read_record(there.parent / name)
+        np.testing.assert_array_equal(a.displacement, b.displacement)
+        np.testing.assert_array_equal(a.acceleration, b.acceleration)
+
+
+def test_the_agreement_map_is_the_same_row_by_row_on_an_executor() -> None:
+    from clearjoint.dissipation import agreement_map, compare
+    from clearjoint.joint import Joint
+
+    joint = Joint(mass=2.0, clearance=1e-4, compression_stiffness=8e7)
+    omegas, forces = [2 * np.pi * 300, 2 * np.pi * 500], [300.0, 800.0]
+    kwargs = {"restitution": 0.8, "damping_ratio": 0.02}
+    serial = agreement_map(joint, omegas, forces, **kwargs)
+    with ThreadPoolExecutor(2) as pool:
+        pooled = agreement_map(joint, omegas, forces, executor=pool, **kwargs)
+    np.testing.assert_array_equal(serial.penetration, pooled.penetration)
+    for key, gap in serial.gap.items():
+        np.testing.assert_array_equal(gap, pooled.gap[key])
+    # each row starts from rest at the lowest force: compare() there directly
+    first = compare(joint, 300.0, omegas[1], samples_per_period=128, max_periods=2000, **kwargs)
+    assert serial.penetration[1, 0] == first.penetration

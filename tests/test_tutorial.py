@@ -1,0 +1,37 @@
+"""docs/tutorial/csv-to-report.md: its commands run on the shipped CSV files as it says."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from clearjoint.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+LAB = ROOT / "examples" / "lab-csv"
+#: The clearance each file was made with by examples/make_lab_csv.py (the rig's truth), m.
+TRUTH = {"joint-1": 0.106e-3, "joint-2": 0.196e-3}
+
+
+def read_rows(path: Path) -> list[dict[str, str]]:
+    with path.open(encoding="utf-8") as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_report_on_the_lab_csv_finds_the_clearances_and_fits_eq_21(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "lab-report"
+    assert main(["report", "--records", str(LAB), "--out", str(out)]) == 0
+    capsys.readouterr()
+    for name in ("report.html", "results.json", "results.csv", "fits.csv"):
+        assert (out / name).stat().st_size > 0
+    rows = read_rows(out / "results.csv")
+    assert len(rows) == 6  # every shipped test identified
+    for row in rows:
+        truth = TRUTH[Path(row["file"]).name.split("_")[0]]
+        assert float(row["clearance_m"]) == pytest.approx(truth, rel=0.02)
+    fitted = {(row["law"], row["group"]) for row in read_rows(out / "fits.csv")}
+    assert ("eq 21", "joint-1, 40 Hz") in fitted
