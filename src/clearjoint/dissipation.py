@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ParameterError
-from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
 from clearjoint.simulate import SteadyState, steady_state
 from clearjoint.stiffness import FreeOrbit, free_orbit, viscous_coefficient
 
@@ -166,8 +166,12 @@ def total(
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
     form: Literal["exact", "paper"] = "exact",
+    losses: Losses | None = None,
 ) -> FloatArray:
     """Return E_Z = E_P + E_C + E_I (+ viscous) per free cycle at penetration A, J (eq 17)."""
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     result = impact(joint, amplitude, restitution)
     if friction is not None:
         result = result + sliding_friction(joint, amplitude, friction, form=form)
@@ -222,6 +226,7 @@ def energies(
     contact_friction_coefficient: float = 0.0,
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
+    losses: Losses | None = None,
 ) -> Energies:
     """Return every energy per free cycle at penetration A, keyed as ``ENERGY_KEYS`` (SI).
 
@@ -229,6 +234,9 @@ def energies(
     is the paper's equivalent-viscous form beside it. ``hertz_half_width_m`` is the
     half-width at the largest contact force of the cycle (0 without a pin).
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     if friction is not None and not isinstance(friction, Friction):
         raise ParameterError(f"friction must be a clearjoint.Friction, got {friction!r}")
     mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
@@ -494,6 +502,7 @@ def compare(
     initial: ArrayLike | None = None,
     samples_per_period: int = 1024,
     max_periods: int = 20_000,
+    losses: Losses | None = None,
 ) -> Comparison:
     """Return each energy by the closed form and over the exact steady cycle, with their gap.
 
@@ -501,6 +510,9 @@ def compare(
     exactly; the closed forms are evaluated on the free cycle at that cycle's
     compression penetration A = x_max - g_c.
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     cycle = steady_state(
         joint,
         force_amplitude,
@@ -592,6 +604,7 @@ def agreement_map(
     damping_ratio: float = 0.0,
     max_periods: int = 2000,
     executor: Any = None,
+    losses: Losses | None = None,
 ) -> AgreementMap:
     """Return the closed-form-to-exact gap of every energy over a grid of (omega, F0).
 
@@ -602,11 +615,14 @@ def agreement_map(
     concurrent.futures Executor or a dask.distributed Client: clearjoint.parallel),
     with the same result.
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     from clearjoint.parallel import run_ordered
 
     w = np.atleast_1d(np.asarray(omegas, dtype=np.float64))
     f = np.sort(np.atleast_1d(np.asarray(forces, dtype=np.float64)))
-    losses: dict[str, Any] = {
+    loss_keywords: dict[str, Any] = {
         "friction": friction,
         "pin": pin,
         "contact_friction_coefficient": contact_friction_coefficient,
@@ -614,7 +630,9 @@ def agreement_map(
         "damping_ratio": damping_ratio,
     }
     rows = run_ordered(
-        _agreement_row, [(joint, float(omega), f, losses, max_periods) for omega in w], executor
+        _agreement_row,
+        [(joint, float(omega), f, loss_keywords, max_periods) for omega in w],
+        executor,
     )
     penetration = np.full((w.size, f.size), np.nan)
     gaps: dict[str, FloatArray] = {}
