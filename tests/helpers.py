@@ -191,3 +191,21 @@ def reference_describing_stiffness(joint: Joint, amplitude: float, n: int = 200_
     theta = np.linspace(0.0, 2.0 * math.pi, n)
     force = joint.restoring_force(amplitude * np.sin(theta))
     return float(simpson(force * np.sin(theta), x=theta) / (math.pi * amplitude))
+
+
+def check_tangent_stiffness(
+    force: object, tangent: object, points: np.ndarray, step: float, rtol: float = 1e-6
+) -> None:
+    """Assert that ``tangent(points)`` matches central differences of ``force`` (shared helper).
+
+    ``force`` and ``tangent`` map an array of relative displacements (any shape) to an
+    array of the same shape; ``points`` must stay at least ``step`` away from any kink.
+    """
+    points = np.asarray(points, dtype=np.float64)
+    f_plus = np.asarray(force(points + step))  # type: ignore[operator]
+    f_minus = np.asarray(force(points - step))  # type: ignore[operator]
+    numeric = (f_plus - f_minus) / (2.0 * step)
+    analytic = np.asarray(tangent(points))  # type: ignore[operator]
+    assert analytic.shape == points.shape
+    scale = max(float(np.max(np.abs(analytic))), 1e-300)
+    np.testing.assert_allclose(analytic, numeric, rtol=0.0, atol=rtol * scale)

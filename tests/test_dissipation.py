@@ -204,3 +204,26 @@ def test_excitation_work_of_the_sampled_cycle_matches_the_ledger() -> None:
 def test_bad_input(call: object, words: str) -> None:
     with pytest.raises(ParameterError, match=words):
         call()  # type: ignore[operator]
+
+
+def test_energies_accept_a_losses_value_for_the_five_keywords() -> None:
+    from clearjoint import Joint, Losses
+
+    joint = Joint(2.0, 1.06e-4, 8e7)
+    pin = Pin.for_clearance(5e-3, 1.06e-4, 1e-2)
+    keywords = dict(
+        friction=Friction(0.1, 50.0),
+        pin=pin,
+        contact_friction_coefficient=0.2,
+        restitution=0.7,
+        damping_ratio=0.01,
+    )
+    amplitude = np.array([1e-6, 3e-6])
+    by_keywords = ds.energies(joint, amplitude, **keywords)  # type: ignore[arg-type]
+    by_value = ds.energies(joint, amplitude, losses=Losses(**keywords))  # type: ignore[arg-type]
+    for key, value in by_keywords.items():
+        np.testing.assert_array_equal(by_value[key], value)
+    np.testing.assert_array_equal(
+        ds.total(joint, amplitude, losses=Losses(**keywords)),  # type: ignore[arg-type]
+        ds.total(joint, amplitude, **keywords),  # type: ignore[arg-type]
+    )

@@ -97,3 +97,87 @@ def test_large_amplitude_stiffness_is_the_bilinear_oscillators() -> None:
     big_c, big_t = 8.1e7, 2.1e7
     period = math.pi * math.sqrt(2.0 / big_c) + math.pi * math.sqrt(2.0 / big_t)
     assert joint.large_amplitude_stiffness == pytest.approx(2.0 * (2 * math.pi / period) ** 2)
+
+
+# ---- the massless element and the Losses value ------------------------------------------
+
+from clearjoint import ClearanceJoint, Friction, Losses  # noqa: E402
+from clearjoint.joint import unpack_losses  # noqa: E402
+from helpers import check_tangent_stiffness  # noqa: E402
+
+
+def _element() -> ClearanceJoint:
+    return ClearanceJoint(1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=2e-5)
+
+
+def test_clearance_joint_force_matches_the_piecewise_law_by_hand() -> None:
+    el = _element()
+    g_c, g_t = 0.5e-4 + 2e-5, 0.5e-4 - 2e-5
+    delta = np.array([[-2e-4, 0.0], [1e-4, 3e-4]])  # shape (N_t, n) as an element sees
+    expected = np.where(
+        delta > g_c,
+        1e6 * delta + 8e7 * (delta - g_c),
+        np.where(delta < -g_t, 1e6 * delta + 3e7 * (delta + g_t), 1e6 * delta),
+    )
+    np.testing.assert_allclose(el.force(delta), expected, rtol=1e-15)
+    assert el.force(delta).shape == (2, 2)
+
+
+def test_clearance_joint_tangent_stiffness_matches_finite_differences() -> None:
+    el = _element()
+    points = np.array([[-3e-4, -1e-4, -2e-5], [0.0, 4e-5, 2e-4]])
+    check_tangent_stiffness(el.force, el.tangent_stiffness, points, step=1e-9)
+    series = el.in_series(5e7)
+    check_tangent_stiffness(series.force, series.tangent_stiffness, points, step=1e-9)
+
+
+def test_clearance_joint_in_series_is_the_spring_and_joint_solved_together() -> None:
+    # independent route: for a total elongation delta, solve s + f_J(s)/k_m = delta for the
+    # joint's own displacement s by bisection; the member force is f_J(s)
+    el, k_m = _element(), 5e7
+    series = el.in_series(k_m)
+    for delta in np.linspace(-4e-4, 4e-4, 41):
+        lo, hi = -1e-2, 1e-2
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if mid + float(el.force(mid)) / k_m > delta:
+                hi = mid
+            else:
+                lo = mid
+        assert float(series.force(delta)) == pytest.approx(float(el.force(lo)), rel=1e-9, abs=1e-9)
+
+
+def test_clearance_joint_validates_as_joint_does() -> None:
+    with pytest.raises(ParameterError, match="clearance must be >= 0"):
+        ClearanceJoint(-1e-4, 1e7)
+    with pytest.raises(ParameterError, match="gap_offset must lie within"):
+        ClearanceJoint(1e-4, 1e7, gap_offset=1e-4)
+    with pytest.raises(ParameterError, match="restitution"):
+        ClearanceJoint(1e-4, 1e7, restitution=1.5)
+    with pytest.raises(ParameterError, match=r"restitution 0\.5 on a joint in series"):
+        ClearanceJoint(1e-4, 1e7, restitution=0.5).in_series(1e8)
+    assert ClearanceJoint(1e-4, 1e7, restitution=0.5).in_series(math.inf).restitution == 0.5
+
+
+def test_joint_is_a_mass_on_its_element() -> None:
+    joint = Joint(2.0, 1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=2e-5)
+    x = np.linspace(-3e-4, 3e-4, 13)
+    np.testing.assert_array_equal(joint.restoring_force(x), _element().force(x))
+    assert joint.element == _element()
+
+
+def test_losses_replace_the_five_keywords_and_refuse_both() -> None:
+    from clearjoint.simulate import time_response
+
+    joint = Joint(2.0, 1e-4, 8e7)
+    friction = Friction(0.1, 50.0)
+    by_keywords = time_response(
+        joint, 300.0, 5000.0, 0.01, damping_ratio=0.02, friction=friction, restitution=0.8
+    )
+    losses = Losses(damping_ratio=0.02, friction=friction, restitution=0.8)
+    by_value = time_response(joint, 300.0, 5000.0, 0.01, losses=losses)
+    np.testing.assert_array_equal(by_value.displacement, by_keywords.displacement)
+    with pytest.raises(ParameterError, match="losses given both"):
+        unpack_losses(losses, 0.01, None, 1.0, None, 0.0)
+    with pytest.raises(ParameterError, match="damping_ratio must be >= 0"):
+        Losses(damping_ratio=-1.0)

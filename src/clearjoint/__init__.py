@@ -9,12 +9,14 @@ circular frequencies in rad/s.
 
 from clearjoint import stiffness
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
-from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.joint import ClearanceJoint, Friction, Joint, Losses, Pin
 
 __all__ = [
+    "ClearanceJoint",
     "ClearjointError",
     "Friction",
     "Joint",
+    "Losses",
     "ParameterError",
     "ParameterTypeError",
     "Pin",

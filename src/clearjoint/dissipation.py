@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ParameterError
-from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
 from clearjoint.simulate import SteadyState, steady_state
 from clearjoint.stiffness import FreeOrbit, free_orbit, viscous_coefficient
 
@@ -160,8 +160,12 @@ def total(
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
     form: Literal["exact", "paper"] = "exact",
+    losses: Losses | None = None,
 ) -> FloatArray:
     """Return E_Z = E_P + E_C + E_I (+ viscous) per free cycle at penetration A, J (eq 17)."""
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     result = impact(joint, amplitude, restitution)
     if friction is not None:
         result = result + sliding_friction(joint, amplitude, friction, form=form)
@@ -216,6 +220,7 @@ def energies(
     contact_friction_coefficient: float = 0.0,
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
+    losses: Losses | None = None,
 ) -> dict[str, FloatArray]:
     """Return every energy per free cycle at penetration A, keyed as ``ENERGY_KEYS`` (SI).
 
@@ -223,6 +228,9 @@ def energies(
     is the paper's equivalent-viscous form beside it. ``hertz_half_width_m`` is the
     half-width at the largest contact force of the cycle (0 without a pin).
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     if friction is not None and not isinstance(friction, Friction):
         raise ParameterError(f"friction must be a clearjoint.Friction, got {friction!r}")
     mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
@@ -321,6 +329,7 @@ def compare(
     initial: ArrayLike | None = None,
     samples_per_period: int = 1024,
     max_periods: int = 20_000,
+    losses: Losses | None = None,
 ) -> Comparison:
     """Return each energy by the closed form and over the exact steady cycle, with their gap.
 
@@ -328,6 +337,9 @@ def compare(
     exactly; the closed forms are evaluated on the free cycle at that cycle's
     compression penetration A = x_max - g_c.
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     cycle = steady_state(
         joint,
         force_amplitude,
@@ -388,6 +400,7 @@ def agreement_map(
     restitution: float = 1.0,
     damping_ratio: float = 0.0,
     max_periods: int = 2000,
+    losses: Losses | None = None,
 ) -> AgreementMap:
     """Return the closed-form-to-exact gap of every energy over a grid of (omega, F0).
 
@@ -395,6 +408,9 @@ def agreement_map(
     last steady state (as a test rig would), so every point is an exact steady
     cycle compared with the closed forms at its own penetration (:func:`compare`).
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     from clearjoint.simulate import SimulationError
 
     w = np.atleast_1d(np.asarray(omegas, dtype=np.float64))

@@ -20,12 +20,184 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import _checks
-from clearjoint.errors import ParameterError
+from clearjoint.errors import ParameterError, ParameterTypeError
+
+
+@dataclass(frozen=True)
+class ClearanceJoint:
+    """A massless pin joint with axial clearance: a law of the relative displacement across it.
+
+    MODEL.md section 0 and 5.2: the force f(delta) it transmits at the relative
+    displacement delta (positive in compression) is piecewise linear, with gap edges
+    at delta = g_c and delta = -g_t. It knows nothing of the masses it links.
+
+    Parameters
+    ----------
+    clearance : float
+        Total axial clearance c in m (the free-play stroke), >= 0.
+    compression_stiffness : float
+        Contact stiffness k_c in compression, N/m, > 0.
+    tension_stiffness : float, optional
+        Contact stiffness k_t in tension, N/m, > 0. Defaults to ``compression_stiffness``.
+    gap_stiffness : float, optional
+        Stiffness k0 inside the gap (free-play), N/m, >= 0. Default 0 (the paper's choice).
+    gap_offset : float, optional
+        Position d of the gap's centre relative to delta = 0 (the rest position of the
+        k0 spring), m, positive toward compression, with |d| <= c/2. Default 0.
+    friction : Friction, optional
+        Coulomb sliding friction in the joint (MODEL.md eq 10). Default none.
+    restitution : float, optional
+        Coefficient of restitution e in [0, 1] on entering contact (MODEL.md eq 16).
+        Default 1 (no impact loss).
+
+    Raises
+    ------
+    ParameterError
+        A value is NaN, infinite or outside its range; the message names the field.
+    """
+
+    clearance: float
+    compression_stiffness: float
+    tension_stiffness: float = field(default=None)  # type: ignore[assignment]
+    gap_stiffness: float = 0.0
+    gap_offset: float = 0.0
+    friction: Friction | None = None
+    restitution: float = 1.0
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "clearance", _checks.non_negative("clearance", self.clearance, unit="m"))
+        k_c = _checks.positive("compression_stiffness", self.compression_stiffness, unit="N/m")
+        set_(self, "compression_stiffness", k_c)
+        k_t = k_c if self.tension_stiffness is None else self.tension_stiffness
+        set_(self, "tension_stiffness", _checks.positive("tension_stiffness", k_t, unit="N/m"))
+        set_(
+            self,
+            "gap_stiffness",
+            _checks.non_negative("gap_stiffness", self.gap_stiffness, unit="N/m"),
+        )
+        offset = _checks.real_scalar("gap_offset", self.gap_offset, unit="m")
+        half = 0.5 * self.clearance
+        if abs(offset) > half:
+            raise ParameterError(
+                f"gap_offset must lie within the clearance, -c/2 <= gap_offset <= c/2 "
+                f"= [{-half!r}, {half!r}] m, got {offset!r}"
+            )
+        set_(self, "gap_offset", offset)
+        if self.friction is not None and not isinstance(self.friction, Friction):
+            raise ParameterTypeError(
+                "friction must be a clearjoint.Friction(coefficient, lateral_load) or None, "
+                f"got {self.friction!r}"
+            )
+        set_(self, "restitution", _restitution(self.restitution))
+
+    @property
+    def compression_gap(self) -> float:
+        """Distance g_c from delta = 0 to the compression gap edge, m."""
+        return 0.5 * self.clearance + self.gap_offset
+
+    @property
+    def tension_gap(self) -> float:
+        """Distance g_t from delta = 0 to the tension gap edge, m."""
+        return 0.5 * self.clearance - self.gap_offset
+
+    @property
+    def large_amplitude_stiffness(self) -> float:
+        """The limit k_inf of the dynamic stiffness at large amplitude, N/m (MODEL.md sec. 1).
+
+        k_inf = 4 K_c K_t / (sqrt(K_c) + sqrt(K_t))^2 with K_s = k0 + k_s: the
+        stiffness of the bilinear oscillator left when the gap is negligible.
+        """
+        big_c = self.gap_stiffness + self.compression_stiffness
+        big_t = self.gap_stiffness + self.tension_stiffness
+        return 4.0 * big_c * big_t / (math.sqrt(big_c) + math.sqrt(big_t)) ** 2
+
+    def force(self, delta: ArrayLike) -> NDArray[np.float64]:
+        """Return the force f(delta) in N the joint carries at relative displacement delta in m.
+
+        MODEL.md sec. 0. ``delta`` of any shape (e.g. (N_t, n)); the result has its shape.
+        """
+        delta = np.asarray(delta, dtype=np.float64)
+        force = self.gap_stiffness * delta
+        force = force + self.compression_stiffness * np.maximum(delta - self.compression_gap, 0.0)
+        force = force + self.tension_stiffness * np.minimum(delta + self.tension_gap, 0.0)
+        return force
+
+    def tangent_stiffness(self, delta: ArrayLike) -> NDArray[np.float64]:
+        """Return df/d(delta) in N/m at relative displacement delta in m (same shape).
+
+        At a gap edge itself (a kink of f) the free-play stiffness k0 is returned.
+        """
+        delta = np.asarray(delta, dtype=np.float64)
+        stiffness = np.full(delta.shape, self.gap_stiffness)
+        stiffness = stiffness + np.where(
+            delta > self.compression_gap, self.compression_stiffness, 0.0
+        )
+        stiffness = stiffness + np.where(delta < -self.tension_gap, self.tension_stiffness, 0.0)
+        return stiffness
+
+    def potential_energy(self, delta: ArrayLike) -> NDArray[np.float64]:
+        """Return the energy V(delta) in J stored in the joint, the integral of f from 0."""
+        delta = np.asarray(delta, dtype=np.float64)
+        energy = 0.5 * self.gap_stiffness * delta**2
+        energy = (
+            energy
+            + 0.5 * self.compression_stiffness * np.maximum(delta - self.compression_gap, 0.0) ** 2
+        )
+        energy = (
+            energy + 0.5 * self.tension_stiffness * np.minimum(delta + self.tension_gap, 0.0) ** 2
+        )
+        return energy
+
+    def in_series(self, stiffness: float) -> ClearanceJoint:
+        """Return the one massless law of this joint in series with a spring (MODEL.md 5.2).
+
+        In each state the stiffnesses add in series, K k_m / (K + k_m), and with
+        k0 > 0 the gap edges, measured on the total elongation, move by the spring's
+        share: g_s (1 + k0 / k_m). ``stiffness`` = inf returns the joint itself.
+
+        Raises
+        ------
+        ParameterError
+            The joint has a restitution below 1 or friction: a massless spring has no
+            mass to stop, so neither is defined in series with it.
+        """
+        k_m = positive_or_inf("member stiffness", stiffness, unit="N/m")
+        if math.isinf(k_m):
+            return self
+        if self.restitution != 1.0:
+            raise ParameterError(
+                f"restitution {self.restitution!r} on a joint in series with a member of "
+                f"stiffness {k_m!r} N/m is not defined (no mass between them to stop); "
+                "set restitution=1 or make the member rigid (stiffness=inf)"
+            )
+        if self.friction is not None:
+            raise ParameterError(
+                "friction on a joint in series with a member is not supported; "
+                "set friction=None or make the member rigid (stiffness=inf)"
+            )
+        k0 = self.gap_stiffness
+
+        def series(k: float) -> float:
+            return k * k_m / (k + k_m)
+
+        k0_s = series(k0)
+        stretch = 1.0 + k0 / k_m
+        return ClearanceJoint(
+            clearance=self.clearance * stretch,
+            compression_stiffness=series(k0 + self.compression_stiffness) - k0_s,
+            tension_stiffness=series(k0 + self.tension_stiffness) - k0_s,
+            gap_stiffness=k0_s,
+            gap_offset=self.gap_offset * stretch,
+        )
 
 
 @dataclass(frozen=True)
 class Joint:
     """A pin joint with axial clearance, carrying a moving mass (all SI).
+
+    The paper's single joint: a mass ``mass`` on a :class:`ClearanceJoint` to ground
+    (``element``), so x is the joint's relative displacement.
 
     Parameters
     ----------
@@ -59,24 +231,32 @@ class Joint:
     def __post_init__(self) -> None:
         set_ = object.__setattr__
         set_(self, "mass", _checks.positive("mass", self.mass, unit="kg"))
-        set_(self, "clearance", _checks.non_negative("clearance", self.clearance, unit="m"))
-        k_c = _checks.positive("compression_stiffness", self.compression_stiffness, unit="N/m")
-        set_(self, "compression_stiffness", k_c)
-        k_t = k_c if self.tension_stiffness is None else self.tension_stiffness
-        set_(self, "tension_stiffness", _checks.positive("tension_stiffness", k_t, unit="N/m"))
-        set_(
-            self,
-            "gap_stiffness",
-            _checks.non_negative("gap_stiffness", self.gap_stiffness, unit="N/m"),
+        element = ClearanceJoint(
+            self.clearance,
+            self.compression_stiffness,
+            self.tension_stiffness,
+            self.gap_stiffness,
+            self.gap_offset,
         )
-        offset = _checks.real_scalar("gap_offset", self.gap_offset, unit="m")
-        half = 0.5 * self.clearance
-        if abs(offset) > half:
-            raise ParameterError(
-                f"gap_offset must lie within the clearance, -c/2 <= gap_offset <= c/2 "
-                f"= [{-half!r}, {half!r}] m, got {offset!r}"
-            )
-        set_(self, "gap_offset", offset)
+        for name in (
+            "clearance",
+            "compression_stiffness",
+            "tension_stiffness",
+            "gap_stiffness",
+            "gap_offset",
+        ):
+            set_(self, name, getattr(element, name))
+
+    @property
+    def element(self) -> ClearanceJoint:
+        """The massless joint this mass sits on (no friction, restitution 1)."""
+        return ClearanceJoint(
+            self.clearance,
+            self.compression_stiffness,
+            self.tension_stiffness,
+            self.gap_stiffness,
+            self.gap_offset,
+        )
 
     @property
     def compression_gap(self) -> float:
@@ -90,33 +270,16 @@ class Joint:
 
     @property
     def large_amplitude_stiffness(self) -> float:
-        """The limit k_inf of the dynamic stiffness at large amplitude, N/m (MODEL.md sec. 1).
-
-        k_inf = 4 K_c K_t / (sqrt(K_c) + sqrt(K_t))^2 with K_s = k0 + k_s: the
-        stiffness of the bilinear oscillator left when the gap is negligible.
-        """
-        big_c = self.gap_stiffness + self.compression_stiffness
-        big_t = self.gap_stiffness + self.tension_stiffness
-        return 4.0 * big_c * big_t / (math.sqrt(big_c) + math.sqrt(big_t)) ** 2
+        """The limit k_inf of the dynamic stiffness at large amplitude, N/m (MODEL.md sec. 1)."""
+        return self.element.large_amplitude_stiffness
 
     def restoring_force(self, x: ArrayLike) -> NDArray[np.float64]:
         """Return the restoring force f(x) in N at displacement x in m (MODEL.md sec. 0)."""
-        x = np.asarray(x, dtype=np.float64)
-        force = self.gap_stiffness * x
-        force = force + self.compression_stiffness * np.maximum(x - self.compression_gap, 0.0)
-        force = force + self.tension_stiffness * np.minimum(x + self.tension_gap, 0.0)
-        return force
+        return self.element.force(x)
 
     def potential_energy(self, x: ArrayLike) -> NDArray[np.float64]:
         """Return the potential energy V(x) in J, the integral of f from 0 to x."""
-        x = np.asarray(x, dtype=np.float64)
-        energy = 0.5 * self.gap_stiffness * x**2
-        energy = (
-            energy
-            + 0.5 * self.compression_stiffness * np.maximum(x - self.compression_gap, 0.0) ** 2
-        )
-        energy = energy + 0.5 * self.tension_stiffness * np.minimum(x + self.tension_gap, 0.0) ** 2
-        return energy
+        return self.element.potential_energy(x)
 
 
 FRICTION_REGIONS = ("everywhere", "free-play")
@@ -220,3 +383,95 @@ def _poisson(name: str, value: float) -> float:
     if not 0.0 <= nu < 0.5:
         raise ParameterError(f"{name} must satisfy 0 <= nu < 0.5, got {nu!r}")
     return nu
+
+
+def _restitution(value: float) -> float:
+    e = _checks.real_scalar("restitution", value)
+    if not 0.0 <= e <= 1.0:
+        raise ParameterError(f"restitution must satisfy 0 <= e <= 1, got {e!r}")
+    return e
+
+
+@dataclass(frozen=True)
+class Losses:
+    """The losses of a joint's motion as one value (MODEL.md sec. 2).
+
+    Accepted as ``losses=`` by the functions that take these five keywords.
+
+    Parameters
+    ----------
+    damping_ratio : float
+        zeta >= 0 of the linear part (c_v = 2 zeta sqrt(m k_c), held fixed).
+    friction : Friction, optional
+        Coulomb sliding friction mu_s P sign(x').
+    restitution : float
+        Coefficient of restitution e in [0, 1] on entering contact.
+    pin : Pin, optional
+        The pin and hole, for contact friction (MODEL.md eq 13-15).
+    contact_friction_coefficient : float
+        mu_c >= 0 on the pin's contact arc.
+    """
+
+    damping_ratio: float = 0.0
+    friction: Friction | None = None
+    restitution: float = 1.0
+    pin: Pin | None = None
+    contact_friction_coefficient: float = 0.0
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "damping_ratio", _checks.non_negative("damping_ratio", self.damping_ratio))
+        if self.friction is not None and not isinstance(self.friction, Friction):
+            raise ParameterTypeError(
+                f"friction must be a clearjoint.Friction or None, got {self.friction!r}"
+            )
+        set_(self, "restitution", _restitution(self.restitution))
+        if self.pin is not None and not isinstance(self.pin, Pin):
+            raise ParameterTypeError(f"pin must be a clearjoint.Pin or None, got {self.pin!r}")
+        set_(
+            self,
+            "contact_friction_coefficient",
+            _checks.non_negative("contact_friction_coefficient", self.contact_friction_coefficient),
+        )
+
+
+def unpack_losses(
+    losses: Losses | None,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+    pin: Pin | None,
+    contact_friction_coefficient: float,
+) -> tuple[float, Friction | None, float, Pin | None, float]:
+    """Return the five loss values from ``losses`` or, when it is None, the keywords as given.
+
+    A keyword that differs from its default while ``losses`` is given is an error,
+    so no value is silently dropped.
+    """
+    given = (damping_ratio, friction, restitution, pin, contact_friction_coefficient)
+    if losses is None:
+        return given
+    if not isinstance(losses, Losses):
+        raise ParameterTypeError(f"losses must be a clearjoint.Losses, got {losses!r}")
+    names = ("damping_ratio", "friction", "restitution", "pin", "contact_friction_coefficient")
+    default = Losses()
+    clash = [n for n, v in zip(names, given, strict=True) if v != getattr(default, n)]
+    if clash:
+        raise ParameterError(
+            f"losses given both as losses= and as {', '.join(clash)}; "
+            f"move {clash[0]} into the Losses value"
+        )
+    return (
+        losses.damping_ratio,
+        losses.friction,
+        losses.restitution,
+        losses.pin,
+        losses.contact_friction_coefficient,
+    )
+
+
+def positive_or_inf(name: str, value: float, *, unit: str = "") -> float:
+    """Return ``value`` as a float > 0 where +inf is allowed (a rigid member)."""
+    if isinstance(value, int | float) and not isinstance(value, bool) and value == math.inf:
+        return math.inf
+    return _checks.positive(name, value, unit=unit)

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
 from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate.shooting import newton_orbit, start_state
 from clearjoint.stiffness import viscous_coefficient
@@ -394,6 +394,7 @@ def time_response(
     contact_friction_coefficient: float = 0.0,
     samples_per_period: int = 256,
     sampling_rate: float | None = None,
+    losses: Losses | None = None,
 ) -> Motion:
     """Return the exact transient response from ``initial`` = (x0, v0) over ``duration`` s.
 
@@ -402,6 +403,9 @@ def time_response(
     sampled ``samples_per_period`` times per forcing period, or at
     ``sampling_rate`` (Hz) when that is given.
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
     duration = _checks.positive("duration", duration, unit="s")
     time = _sample_times(duration, p[kn.P_TF], samples_per_period, sampling_rate)
@@ -514,6 +518,7 @@ def steady_state(
     max_multiple: int = 8,
     tolerance: float = 1e-11,
     samples_per_period: int = 256,
+    losses: Losses | None = None,
 ) -> SteadyState:
     """Return the steady periodic response of the forced joint (MODEL.md sec. 2).
 
@@ -549,6 +554,9 @@ def steady_state(
         No periodic orbit was found within ``max_periods`` (e.g. a lossless
         system, which never settles, or a chaotic response).
     """
+    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
+        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
+    )
     p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
     _check_samples(samples_per_period)
     mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)

@@ -1,0 +1,63 @@
+"""Builders: the chain's sign convention and the truss's member forms."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint import ClearanceJoint, Joint
+from clearjoint.structure import Member, StructureError, chain, truss
+
+
+def test_chain_links_are_compressed_by_the_difference_of_neighbours() -> None:
+    joint = ClearanceJoint(1e-4, 1e7)
+    s = chain([1.0, 2.0, 3.0], [1e6, math.inf, 2e6], [None, joint, None], dampers=[1.0, 2.0, 3.0])
+    # link i is compressed by u_i - u_(i-1), displacements positive toward the ground
+    np.testing.assert_array_equal(
+        s.member_directions, [[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]]
+    )
+    np.testing.assert_array_equal(s.joint_directions, [[-1.0, 1.0, 0.0]])
+    c = s.damping_matrix()
+    np.testing.assert_array_equal(c, [[3.0, -2.0, 0.0], [-2.0, 5.0, -3.0], [0.0, -3.0, 3.0]])
+
+
+def test_one_rigid_link_chain_is_exactly_the_joint() -> None:
+    joint = Joint(2.0, 1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=2e-5)
+    s = chain([2.0], [math.inf], [joint.element])
+    x = np.linspace(-3e-4, 3e-4, 25)
+    (law,) = s.joint_laws
+    np.testing.assert_array_equal(law.force(x), joint.restoring_force(x))
+    assert s.mass_diagonal().tolist() == [2.0]
+
+
+def test_truss_accepts_members_as_objects_mappings_or_pairs() -> None:
+    nodes = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]
+    t = truss(
+        nodes,
+        [Member(0, 2, stiffness=1e6), {"start": 1, "end": 3, "stiffness": 2e6}, (1, 2), (2, 3)],
+        supports=[0, 1],
+        masses=1.0,
+        stiffness=3e6,
+    )
+    assert t.n_dof == 4
+    assert t.dof_names == ["n2x", "n2y", "n3x", "n3y"]
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: chain([1.0, 1.0], [1e6]), "stiffnesses must have one entry per link (2)"),
+        (lambda: chain([1.0], [1e6], [None, None]), "joints must have one entry per link (1)"),
+        (lambda: chain([0.0], [1e6]), "masses[0] must be > 0 kg"),
+        (
+            lambda: truss([[0.0, 0.0], [1.0, 0.0]], [(0, 1)], supports=[0]),
+            "member 0 is a pair of nodes but no default stiffness was given",
+        ),
+    ],
+)
+def test_builder_input_errors_name_the_item(call, message) -> None:  # type: ignore[no-untyped-def]
+    with pytest.raises(StructureError) as info:
+        call()
+    assert message in str(info.value)
