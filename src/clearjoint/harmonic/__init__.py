@@ -6,6 +6,7 @@ structure; ``nonlinear_modes`` gives each mode's frequency and damping against
 amplitude (EPMC).
 """
 
+from clearjoint.harmonic.response import frequency_response
 from clearjoint.harmonic.system import HarmonicError
 
-__all__ = ["HarmonicError"]
+__all__ = ["HarmonicError", "frequency_response"]

@@ -1,0 +1,323 @@
+"""Frequency-response curves by harmonic balance with pseudo-arclength continuation (MODEL.md 5.3).
+
+The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the force
+amplitude) by the same continuation as the exact shooting of
+:mod:`clearjoint.periodic`, and returned as the same
+:class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
+kept. Stability comes from Hill's method; events are located as in
+:mod:`clearjoint.periodic`: folds where the parameter component of the tangent
+changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
+through -1), grazings where a joint's extreme relative displacement crosses a gap
+edge.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from clearjoint import _checks
+from clearjoint.continuation import ContinuationSettings, continue_branch
+from clearjoint.errors import ParameterError
+from clearjoint.harmonic import aft
+from clearjoint.harmonic.solve import TOLERANCE, linear_guess, newton
+from clearjoint.harmonic.system import (
+    HarmonicError,
+    LinearSystem,
+    build,
+    force_vector,
+    scale_length,
+)
+from clearjoint.joint import Friction
+from clearjoint.periodic import FrequencyResponse, ResponseEvent
+
+FloatArray = NDArray[np.float64]
+
+
+def _range(
+    parameter: str,
+    force_amplitude: float,
+    omega_start: float,
+    omega_stop: float | None,
+    force_stop: float | None,
+) -> tuple[float, float]:
+    if parameter == "omega":
+        if omega_stop is None:
+            raise ParameterError("omega_stop is required with parameter='omega' (rad/s)")
+        w1 = _checks.positive("omega_stop", omega_stop, unit="rad/s")
+        if w1 == omega_start:
+            raise ParameterError(
+                f"the omega range has zero width ({omega_start!r} to {w1!r} rad/s); give two values"
+            )
+        return omega_start, w1
+    if force_stop is None:
+        raise ParameterError(
+            "force_stop is required with parameter='force': give the end of the force range (N)"
+        )
+    f1 = _checks.positive("force_stop", force_stop, unit="N")
+    if f1 == force_amplitude:
+        raise ParameterError(
+            f"the force range has zero width ({force_amplitude!r} to {f1!r} N); give two values"
+        )
+    return force_amplitude, f1
+
+
+def frequency_response(
+    system: Any,
+    force: float | ArrayLike,
+    omega_start: float,
+    omega_stop: float | None,
+    *,
+    harmonics: int = 7,
+    samples: int | None = None,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+    parameter: Literal["omega", "force"] = "omega",
+    force_stop: float | None = None,
+    max_points: int = 2000,
+    max_step: float = 0.02,
+) -> FrequencyResponse:
+    """Return the frequency-response curve by harmonic balance and continuation (MODEL.md 5.3).
+
+    The periodic response to F sin(w t), truncated to ``harmonics`` harmonics plus
+    the mean, followed by pseudo-arclength continuation from ``omega_start`` to
+    ``omega_stop`` through folds, stable and unstable alike (Hill's method). With
+    ``parameter="force"`` it continues in the force amplitude from ``force`` to
+    ``force_stop`` at the fixed ``omega_start``.
+
+    Parameters
+    ----------
+    system : Joint or Structure
+    force : float or (N,) array_like
+        F0 > 0 in N for a Joint; the amplitude per DOF (N,) in N for a Structure
+        (with ``parameter="force"`` the curve scales this pattern, and
+        ``force_amplitude`` is its largest entry).
+    omega_start, omega_stop : float
+        rad/s, either order.
+    harmonics : int
+        H >= 1.
+    samples : int, optional
+        N_t time samples per period for AFT, >= 2 (2H + 1); default 32 (2H + 1)
+        rounded up to a power of two (fewer samples leave the sampled law's kinks
+        visible as small zigzags of the curve near a fold).
+    damping_ratio : float
+        zeta of a Joint's linear part, c_v = 2 zeta sqrt(m k_c).
+    friction, restitution
+        Refused (HarmonicError): Coulomb friction and impacts need the exact
+        solver, :func:`clearjoint.periodic.frequency_response`.
+    parameter : {"omega", "force"}
+    force_stop : float, optional
+        End of the force range, N (largest entry for a Structure).
+    max_points : int
+        Largest number of points on the curve.
+    max_step : float
+        Largest arclength step in scaled coordinates (smaller: more points).
+
+    Returns
+    -------
+    FrequencyResponse
+        ``method == "harmonic"``; ``coefficients`` holds the harmonic coefficients,
+        (n, 2H + 1) for a Joint and (n, 2H + 1, N) for a Structure, rows a_0, a_1,
+        b_1, ..., a_H, b_H in m. For a Structure ``x_max``, ``x_min``,
+        ``amplitude`` are (n, N), ``multipliers`` (n, 2N) and ``initial_state``
+        (n, 2N): u(0) then u'(0).
+
+    Raises
+    ------
+    HarmonicError
+        Bad harmonics or samples, friction or restitution, no solution at the start.
+    ParameterError
+        A range of zero width, a value not finite and positive, a force of the wrong shape.
+    """
+    if parameter not in ("omega", "force"):
+        raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
+    h, n_t = aft.check_harmonics(harmonics, samples)
+    model = build(system, damping_ratio, friction, restitution)
+    pattern = force_vector(model, force)
+    peak = float(np.max(np.abs(pattern)))
+    w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
+    start, stop = _range(parameter, peak, w0, omega_stop, force_stop)
+    unit_force = pattern / peak
+    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
+        raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
+    basis = aft.Basis.make(h, n_t)
+    k_ref = model.reference_stiffness
+
+    def at(lam: float) -> tuple[float, FloatArray]:
+        if parameter == "omega":
+            return lam, pattern
+        return w0, lam * unit_force
+
+    q0 = _start(model, basis, w0, pattern, k_ref)
+    x_scale = max(0.5 * scale_length(model), float(np.max(np.abs(q0))))
+
+    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
+        if not lam > 0.0:
+            raise HarmonicError(f"the parameter left the positive range ({lam!r})")
+        w, f = at(lam)
+        ev = aft.evaluate(model, basis, u, w, f)
+        if parameter == "omega":
+            d_lam = ev.d_omega
+        else:
+            d_lam = np.zeros_like(ev.residual)
+            d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
+        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, None
+
+    branch = continue_branch(
+        residual,
+        q0,
+        start,
+        stop,
+        u_scale=np.full(q0.size, x_scale),
+        lam_scale=abs(stop - start),
+        settings=ContinuationSettings(
+            step=min(0.002, max_step),
+            min_step=1e-7,
+            max_step=max_step,
+            max_points=max_points,
+            tolerance=TOLERANCE,
+        ),
+    )
+    return _response(
+        model,
+        basis,
+        branch.u,
+        branch.lam,
+        branch.tangent[:, -1],
+        parameter,
+        w0,
+        pattern,
+        unit_force,
+        branch.reason,
+        {"system": system, "harmonics": h, "samples": n_t, "damping_ratio": damping_ratio},
+    )
+
+
+def _start(
+    model: LinearSystem, basis: aft.Basis, omega: float, force: FloatArray, k_ref: float
+) -> FloatArray:
+    """Solve HB at the start from the open and the closed linear responses."""
+    scale = 0.5 * scale_length(model)
+
+    def function(q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        ev = aft.evaluate(model, basis, q, omega, force)
+        return ev.residual / k_ref, ev.jacobian / k_ref
+
+    for stiffness in (model.open_stiffness(), model.closed_stiffness()):
+        guess = linear_guess(model, basis, omega, force, stiffness)
+        found = newton(function, guess, max(scale, float(np.max(np.abs(guess)))))
+        if found is not None:
+            return found[0]
+    raise HarmonicError(
+        f"harmonic balance found no periodic response at omega_start = {omega!r} rad/s; "
+        "start the curve at another frequency"
+    )
+
+
+def _response(
+    model: LinearSystem,
+    basis: aft.Basis,
+    u: FloatArray,
+    lam: FloatArray,
+    lam_tangent: FloatArray,
+    parameter: str,
+    w0: float,
+    pattern: FloatArray,
+    unit_force: FloatArray,
+    reason: str,
+    settings: dict[str, Any],
+) -> FrequencyResponse:
+    n_pts = lam.size
+    n, n_c = model.n_dof, 2 * basis.harmonics + 1
+    omega = lam.copy() if parameter == "omega" else np.full(n_pts, w0)
+    peak = float(np.max(np.abs(pattern)))
+    force = lam.copy() if parameter == "force" else np.full(n_pts, peak)
+    coef = u.reshape(n_pts, n_c, n)
+    # extremes per DOF and per joint (the relative displacements, for grazing)
+    cols = coef.transpose(1, 0, 2).reshape(n_c, n_pts * n)
+    x_max, x_min = (v.reshape(n_pts, n) for v in basis.extremes(cols))
+    b = model.directions
+    rel = np.einsum("pcn,jn->cpj", coef, b).reshape(n_c, -1)
+    d_max, d_min = (v.reshape(n_pts, b.shape[0]) for v in basis.extremes(rel))
+    multipliers = np.empty((n_pts, 2 * n), dtype=np.complex128)
+    for i in range(n_pts):
+        f = pattern if parameter == "omega" else force[i] * unit_force
+        ev = aft.evaluate(model, basis, u[i], float(omega[i]), f)
+        lam_i = aft.hill_exponents(model, basis, ev.jacobian, float(omega[i]))
+        multipliers[i] = aft.hill_multipliers(lam_i, float(omega[i]))
+    stable = np.max(np.abs(multipliers), axis=1) < 1.0
+    amplitude = 0.5 * (x_max - x_min)
+    x0 = coef[:, 0, :] + coef[:, 1::2, :].sum(axis=1)
+    v0 = omega[:, None] * np.einsum("c,pcn->pn", _velocity_row(basis), coef)
+    initial = np.concatenate((x0, v0), axis=1)
+    events = _events(
+        model, lam_tangent, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1)
+    )
+    if model.is_joint:
+        x_max, x_min, amplitude, coef_out = x_max[:, 0], x_min[:, 0], amplitude[:, 0], coef[:, :, 0]
+    else:
+        coef_out = coef
+    return FrequencyResponse(
+        omega=omega,
+        force_amplitude=force,
+        x_max=x_max,
+        x_min=x_min,
+        amplitude=amplitude,
+        stable=stable,
+        multipliers=multipliers,
+        initial_state=initial,
+        events=events,
+        parameter=parameter,
+        stop_reason=reason,
+        settings=settings,
+        coefficients=coef_out.copy(),
+        method="harmonic",
+    )
+
+
+def _velocity_row(basis: aft.Basis) -> FloatArray:
+    """Row r with u'(0) / w = r . coefficients: sum over h of h b_h."""
+    row = np.zeros(2 * basis.harmonics + 1)
+    row[2::2] = np.arange(1, basis.harmonics + 1)
+    return row
+
+
+def _events(
+    model: LinearSystem,
+    lam_tangent: FloatArray,
+    multipliers: NDArray[np.complex128],
+    d_max: FloatArray,
+    d_min: FloatArray,
+    omega: FloatArray,
+    force: FloatArray,
+    amplitude: FloatArray,
+) -> list[ResponseEvent]:
+    """Folds, period doublings and grazings between successive points, located linearly."""
+    tests: list[tuple[str, FloatArray, str]] = [
+        ("fold", lam_tangent, ""),
+        (
+            "period_doubling",
+            np.prod(1.0 + multipliers, axis=1).real,
+            "a multiplier passes -1: a period-2 branch is born here (not followed)",
+        ),
+    ]
+    for j in range(model.directions.shape[0]):
+        name = "" if model.is_joint else f" of joint {j}"
+        tests.append(("grazing", d_max[:, j] - model.g_c[j], f"touches the compression edge{name}"))
+        tests.append(("grazing", -model.g_t[j] - d_min[:, j], f"touches the tension edge{name}"))
+    found: list[tuple[int, ResponseEvent]] = []
+    for kind, g, note in tests:
+        for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
+            frac = float(g[i] / (g[i] - g[i + 1]))
+
+            def lerp(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
+                return float(a[i] + frac * (a[i + 1] - a[i]))
+
+            found.append(
+                (int(i), ResponseEvent(kind, lerp(omega), lerp(force), lerp(amplitude), note))
+            )
+    found.sort(key=lambda item: item[0])
+    return [e for _, e in found]
