@@ -6,7 +6,8 @@ structure; ``nonlinear_modes`` gives each mode's frequency and damping against
 amplitude (EPMC).
 """
 
+from clearjoint.harmonic.modes import NonlinearMode, nonlinear_modes
 from clearjoint.harmonic.response import frequency_response
 from clearjoint.harmonic.system import HarmonicError
 
-__all__ = ["HarmonicError", "frequency_response"]
+__all__ = ["HarmonicError", "NonlinearMode", "frequency_response", "nonlinear_modes"]
