@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import _checks
 from clearjoint.continuation import ContinuationSettings, continue_branch
-from clearjoint.errors import ParameterError
+from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.harmonic import aft
 from clearjoint.harmonic.solve import TOLERANCE, linear_guess, newton
 from clearjoint.harmonic.system import (
@@ -199,7 +199,8 @@ def frequency_response(
 def _start(
     model: LinearSystem, basis: aft.Basis, omega: float, force: FloatArray, k_ref: float
 ) -> FloatArray:
-    """Solve HB at the start from the open and the closed linear responses."""
+    """Solve HB at the start: Newton from the open and the closed linear responses, else a
+    continuation in the force from a level where the open linear response fits the gaps."""
     scale = 0.5 * scale_length(model)
 
     def function(q: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -211,6 +212,37 @@ def _start(
         found = newton(function, guess, max(scale, float(np.max(np.abs(guess)))))
         if found is not None:
             return found[0]
+    # Homotopy: from a force small enough for the open (all joints in free-play) linear
+    # response to stay inside every gap, follow the solution up to the full force.
+    open_guess = linear_guess(model, basis, omega, force, model.open_stiffness())
+    coef = open_guess.reshape(2 * basis.harmonics + 1, model.n_dof)
+    reach = np.hypot(coef[1], coef[2]) @ np.abs(model.directions.T)
+    room = np.minimum(model.g_c, model.g_t)
+    if reach.size and np.all(np.isfinite(reach)) and np.max(reach) > 0.0 and np.all(room > 0):
+        fraction = min(0.5 * float(np.min(room / np.maximum(reach, 1e-300))), 0.5)
+
+        def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
+            ev = aft.evaluate(model, basis, u, omega, lam * force)
+            d_lam = np.zeros_like(ev.residual)
+            d_lam.reshape(2 * basis.harmonics + 1, -1)[2] = -force
+            return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, None
+
+        try:
+            branch = continue_branch(
+                residual,
+                fraction * open_guess,
+                fraction,
+                1.0,
+                u_scale=np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess))))),
+                lam_scale=1.0,
+                settings=ContinuationSettings(
+                    step=0.01, min_step=1e-7, max_step=0.1, max_points=2000, tolerance=TOLERANCE
+                ),
+            )
+        except ClearjointError:
+            branch = None
+        if branch is not None and branch.reason == "reached":
+            return np.asarray(branch.u[-1], dtype=np.float64)
     raise HarmonicError(
         f"harmonic balance found no periodic response at omega_start = {omega!r} rad/s; "
         "start the curve at another frequency"
