@@ -174,6 +174,34 @@ def _identify_parser(sub: Any) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _frf_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "frf",
+        help="whole frequency-response curve of exact periodic orbits, stable and unstable",
+        description=(
+            "Follow the exact period-1 orbit of the joint in STUDY.toml (joint, force, losses; "
+            "its frequency is not used) by continuation from --from to --to, through folds; "
+            "report folds, period doublings and grazings. With --parameter force, --from and "
+            "--to are forces and --frequency (default: the study's) is held fixed."
+        ),
+    )
+    p.add_argument("study", help="study file (TOML), as for clearjoint simulate")
+    p.add_argument("--from", dest="start", required=True, help="start: 20Hz (or 100N)")
+    p.add_argument("--to", dest="stop", required=True, help="end: 900Hz (or 2kN)")
+    p.add_argument("--out", required=True, help="write the curve to this netCDF file (.nc)")
+    p.add_argument("--plot", help="draw the curve to this image file (.png)")
+    p.add_argument("--json", action="store_true", help="print the curve as one JSON object")
+    p.add_argument(
+        "--parameter",
+        choices=["frequency", "force"],
+        default="frequency",
+        help="what varies along the curve (default frequency)",
+    )
+    p.add_argument("--frequency", help="fixed frequency with --parameter force, e.g. 400Hz")
+    p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
+    p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``clearjoint`` command."""
     parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
@@ -186,6 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
     _identify_parser(sub)
     _reproduce_parser(sub)
     _report_parser(sub)
+    _frf_parser(sub)
     return parser
 
 
@@ -527,6 +556,111 @@ def _run_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_frf(args: argparse.Namespace) -> int:
+    import math
+
+    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.periodic import frequency_response
+    from clearjoint.simulate.study import load_study
+    from clearjoint.units import parse_quantity
+
+    study = load_study(args.study)
+    outputs = [Path(args.out)] + ([Path(args.plot)] if args.plot else [])
+    refuse_to_overwrite(outputs, force=args.force)  # before the run, not after
+    kind = "force" if args.parameter == "force" else "frequency"
+    start = parse_quantity(args.start, kind, name="--from")
+    stop = parse_quantity(args.stop, kind, name="--to")
+    for option, text, value in (("--from", args.start, start), ("--to", args.stop, stop)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ParameterError(f"{option} must be finite and > 0, got {text!r}")
+    if start == stop:
+        raise ParameterError(
+            f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
+            "give two different values"
+        )
+    losses: dict[str, Any] = {
+        "damping_ratio": study.damping_ratio,
+        "friction": study.friction,
+        "restitution": study.restitution,
+    }
+    if args.parameter == "force":
+        frequency = (
+            parse_quantity(args.frequency, "frequency", name="--frequency")
+            if args.frequency
+            else study.omega / (2.0 * math.pi)
+        )
+        curve = frequency_response(
+            study.joint,
+            start,
+            2.0 * math.pi * frequency,
+            None,
+            parameter="force",
+            force_stop=stop,
+            max_points=args.max_points,
+            **losses,
+        )
+    else:
+        if args.frequency:
+            raise ParameterError("--frequency goes with --parameter force; drop it or add that")
+        curve = frequency_response(
+            study.joint,
+            study.force_amplitude,
+            2.0 * math.pi * start,
+            2.0 * math.pi * stop,
+            max_points=args.max_points,
+            **losses,
+        )
+    data = curve.to_xarray()
+    data.attrs["study"] = study.source
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    data.to_netcdf(args.out, engine="h5netcdf")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        figure: Any = curve.plot().figure
+        figure.savefig(args.plot, dpi=120, bbox_inches="tight")
+    if curve.stop_reason != "reached":
+        print(
+            f"clearjoint frf: warning: the continuation stopped early ({curve.stop_reason}) at "
+            f"{curve.omega[-1] / (2 * math.pi):.6g} Hz, {curve.force_amplitude[-1]:.6g} N; "
+            "the curve covers only part of the range",
+            file=sys.stderr,
+        )
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "frequency_hz": (curve.omega / (2 * math.pi)).tolist(),
+                    "force_n": curve.force_amplitude.tolist(),
+                    "amplitude_m": curve.amplitude.tolist(),
+                    "x_max_m": curve.x_max.tolist(),
+                    "x_min_m": curve.x_min.tolist(),
+                    "stable": curve.stable.tolist(),
+                    "events": [
+                        {
+                            "kind": e.kind,
+                            "frequency_hz": e.omega / (2 * math.pi),
+                            "force_n": e.force_amplitude,
+                            "amplitude_m": e.amplitude,
+                        }
+                        for e in curve.events
+                    ],
+                }
+            )
+        )
+        return 0
+    lines = [f"study: {study.source}", repr(curve)]
+    for e in curve.events:
+        lines.append(
+            f"{e.kind}: {e.omega / (2 * math.pi):.6g} Hz, {e.force_amplitude:.6g} N, "
+            f"X = {e.amplitude * 1e6:.5g} um"
+        )
+    lines.append(f"wrote {args.out}" + (f" and {args.plot}" if args.plot else ""))
+    print("\n".join(lines))
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
@@ -539,6 +673,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "identify": _run_identify,
         "reproduce": _run_reproduce,
         "report": _run_report,
+        "frf": _run_frf,
     }
     try:
         return runners[args.command](args)

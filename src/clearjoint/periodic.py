@@ -523,6 +523,12 @@ def frequency_response(
         friction=friction,
         restitution=restitution,
     )
+    if np.min(np.abs(first.multipliers - 1.0)) < 1e-9:
+        raise SimulationError(
+            f"the orbit at the start ({first!r}) has a multiplier of exactly 1: it is one of a "
+            "continuum of orbits (it stays in the gap with gap_stiffness = 0, or sticks), so "
+            "no single curve exists; give gap_stiffness > 0 or start where the joint is in contact"
+        )
     p = _parameters(joint, f0, w0, damping_ratio, friction, restitution)
     x_scale = max(joint.clearance / 2.0, first.amplitude)
     v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
@@ -534,7 +540,11 @@ def frequency_response(
         u_scale=np.array([x_scale, v_scale]),
         lam_scale=abs(stop - start),
         settings=ContinuationSettings(
-            step=0.002, min_step=1e-7, max_step=0.02, max_points=max_points, tolerance=1e-11
+            step=0.002,
+            min_step=1e-7,
+            max_step=0.02,
+            max_points=max_points,
+            tolerance=1e-11,
         ),
     )
     shots: list[Shot] = branch.data

@@ -1,0 +1,109 @@
+"""clearjoint frf: the curve as JSON, netCDF and a figure; one-line errors with exit code 2."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from clearjoint.cli import main
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "frf.toml"
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    try:
+        code = main(args)
+    except SystemExit as exc:  # argparse exits on usage errors
+        code = int(exc.code or 0)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_frequency_curve_as_json_netcdf_and_png(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import xarray as xr
+
+    out, png = tmp_path / "frf.nc", tmp_path / "frf.png"
+    args = ["frf", str(EXAMPLE), "--from", "10Hz", "--to", "360Hz", "--out", str(out)]
+    code, text, err = run([*args, "--plot", str(png), "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    assert set(data) >= {"frequency_hz", "amplitude_m", "x_max_m", "x_min_m", "stable", "events"}
+    n = len(data["frequency_hz"])
+    assert n >= 300
+    assert all(len(data[k]) == n for k in ("amplitude_m", "x_max_m", "x_min_m", "stable"))
+    assert data["frequency_hz"][0] == pytest.approx(10.0)
+    assert data["frequency_hz"][-1] == pytest.approx(360.0)
+    kinds = [e["kind"] for e in data["events"]]
+    assert kinds.count("fold") == 2
+    assert kinds.count("grazing") == 2
+    for event in data["events"]:
+        assert set(event) == {"kind", "frequency_hz", "force_n", "amplitude_m"}
+    # the study scales pyHarm's case to w0 = 2 pi 200 Hz and 1 mm: its peak 0.3973 near 1.534 w0
+    peak = max(range(n), key=lambda i: data["amplitude_m"][i])
+    assert data["amplitude_m"][peak] == pytest.approx(0.3973e-3, rel=2e-3)
+    assert data["frequency_hz"][peak] == pytest.approx(1.534 * 200.0, rel=2e-3)
+    assert png.stat().st_size > 1000
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.sizes["point"] == n
+        assert ds["frequency"].attrs["units"] == "Hz"
+    # and it will not overwrite what it wrote without --force
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert "--force" in err
+
+
+def test_force_curve_at_a_fixed_frequency(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["frf", str(EXAMPLE), "--parameter", "force", "--from", "10N", "--to", "0.2kN"]
+    args += ["--frequency", "300Hz", "--out", str(tmp_path / "f.nc"), "--json"]
+    code, text, err = run(args, capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["force_n"][0] == pytest.approx(10.0)
+    assert data["force_n"][-1] == pytest.approx(200.0)
+    assert all(f == pytest.approx(300.0) for f in data["frequency_hz"])
+    # inside the gap the orbit is linear: X = F0 / |k0 - m w^2 + i c w|
+    w = 2 * math.pi * 300.0
+    k0, c = 1.5791e6, 2 * 0.014434 * math.sqrt(4.7374e6)
+    gain = 1.0 / math.hypot(k0 - w * w, c * w)
+    assert data["amplitude_m"][0] == pytest.approx(10.0 * gain, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (["--from", "20Hz", "--to", "20Hz"], "zero width"),
+        (["--from=-5Hz", "--to", "20Hz"], "must be finite and > 0"),
+        (["--from", "nan", "--to", "20Hz"], "must be finite and > 0"),
+        (["--from", "20N", "--to", "90Hz"], "--from"),
+        (["--parameter", "force", "--from", "10N"], "--to"),
+        (["--from", "20Hz", "--to", "90Hz", "--frequency", "5Hz"], "--parameter force"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(
+    extra: list[str], match: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = run(["frf", str(EXAMPLE), *extra, "--out", str(tmp_path / "x.nc")], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert match in err
+    assert "Traceback" not in err
+
+
+def test_a_study_without_a_force_is_one_line_and_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    study = tmp_path / "s.toml"
+    text = EXAMPLE.read_text(encoding="utf-8").replace('force_amplitude = "47.37N"', "")
+    study.write_text(text, encoding="utf-8")
+    args = ["frf", str(study), "--from", "10Hz", "--to", "20Hz", "--out", str(tmp_path / "x.nc")]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "force_amplitude" in err
