@@ -13,6 +13,7 @@ edge.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Literal
 
 import numpy as np
@@ -186,7 +187,6 @@ def frequency_response(
         basis,
         branch.u,
         branch.lam,
-        branch.tangent[:, -1],
         parameter,
         w0,
         pattern,
@@ -254,7 +254,6 @@ def _response(
     basis: aft.Basis,
     u: FloatArray,
     lam: FloatArray,
-    lam_tangent: FloatArray,
     parameter: str,
     w0: float,
     pattern: FloatArray,
@@ -285,9 +284,7 @@ def _response(
     x0 = coef[:, 0, :] + coef[:, 1::2, :].sum(axis=1)
     v0 = omega[:, None] * np.einsum("c,pcn->pn", _velocity_row(basis), coef)
     initial = np.concatenate((x0, v0), axis=1)
-    events = _events(
-        model, lam_tangent, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1)
-    )
+    events = _events(model, lam, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1))
     if model.is_joint:
         x_max, x_min, amplitude, coef_out = x_max[:, 0], x_min[:, 0], amplitude[:, 0], coef[:, :, 0]
     else:
@@ -317,9 +314,31 @@ def _velocity_row(basis: aft.Basis) -> FloatArray:
     return row
 
 
+#: Reversals of the parameter smaller than this fraction of it are not folds.
+FOLD_TOLERANCE = 5e-4
+
+
+def _turning_points(lam: FloatArray, tolerance: float) -> list[int]:
+    """Indices where ``lam`` reaches an extreme and then goes back by more than ``tolerance``."""
+    points: list[int] = []
+    direction = 0.0
+    extreme = 0
+    for i in range(1, lam.size):
+        step = float(lam[i] - lam[extreme])
+        if direction == 0.0:
+            if abs(step) > tolerance:
+                direction, extreme = math.copysign(1.0, step), i
+        elif direction * step > 0.0:
+            extreme = i
+        elif -direction * step > tolerance:
+            points.append(extreme)
+            direction, extreme = -direction, i
+    return points
+
+
 def _events(
     model: LinearSystem,
-    lam_tangent: FloatArray,
+    lam: FloatArray,
     multipliers: NDArray[np.complex128],
     d_max: FloatArray,
     d_min: FloatArray,
@@ -327,9 +346,20 @@ def _events(
     force: FloatArray,
     amplitude: FloatArray,
 ) -> list[ResponseEvent]:
-    """Folds, period doublings and grazings between successive points, located linearly."""
+    """Folds, period doublings and grazings between successive points.
+
+    Period doublings and grazings are located linearly between the points where
+    their test function changes sign. Folds are the points where the parameter
+    turns back by more than ``FOLD_TOLERANCE`` of its largest value: the sampled
+    law makes the HB branch zigzag by about 1e-4 of the parameter where it is
+    nearly flat at a fold (each sample crossing a gap edge is a tiny kink), and
+    those reversals, below the truncation error, are not folds.
+    """
+    found: list[tuple[int, ResponseEvent]] = [
+        (i, ResponseEvent("fold", float(omega[i]), float(force[i]), float(amplitude[i])))
+        for i in _turning_points(lam, FOLD_TOLERANCE * float(np.max(np.abs(lam))))
+    ]
     tests: list[tuple[str, FloatArray, str]] = [
-        ("fold", lam_tangent, ""),
         (
             "period_doubling",
             np.prod(1.0 + multipliers, axis=1).real,
@@ -340,7 +370,6 @@ def _events(
         name = "" if model.is_joint else f" of joint {j}"
         tests.append(("grazing", d_max[:, j] - model.g_c[j], f"touches the compression edge{name}"))
         tests.append(("grazing", -model.g_t[j] - d_min[:, j], f"touches the tension edge{name}"))
-    found: list[tuple[int, ResponseEvent]] = []
     for kind, g, note in tests:
         for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
             frac = float(g[i] / (g[i] - g[i + 1]))
@@ -352,4 +381,18 @@ def _events(
                 (int(i), ResponseEvent(kind, lerp(omega), lerp(force), lerp(amplitude), note))
             )
     found.sort(key=lambda item: item[0])
-    return [e for _, e in found]
+    merged: list[tuple[int, ResponseEvent]] = []
+    for i, event in found:
+        last = merged[-1] if merged else None
+        if last and event.kind == "grazing" and last[1].kind == "grazing" and last[0] == i:
+            both = ResponseEvent(
+                "grazing",
+                event.omega,
+                event.force_amplitude,
+                event.amplitude,
+                f"{last[1].note}; {event.note}",
+            )
+            merged[-1] = (i, both)
+            continue
+        merged.append((i, event))
+    return [e for _, e in merged]
