@@ -382,9 +382,9 @@ def _events(
             )
     found.sort(key=lambda item: item[0])
     merged: list[tuple[int, ResponseEvent]] = []
-    for i, event in found:
+    for index, event in found:
         last = merged[-1] if merged else None
-        if last and event.kind == "grazing" and last[1].kind == "grazing" and last[0] == i:
+        if last and event.kind == "grazing" and last[1].kind == "grazing" and last[0] == index:
             both = ResponseEvent(
                 "grazing",
                 event.omega,
@@ -392,7 +392,7 @@ def _events(
                 event.amplitude,
                 f"{last[1].note}; {event.note}",
             )
-            merged[-1] = (i, both)
+            merged[-1] = (index, both)
             continue
-        merged.append((i, event))
+        merged.append((index, event))
     return [e for _, e in merged]
