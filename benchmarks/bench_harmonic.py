@@ -39,6 +39,8 @@ from clearjoint.harmonic import frequency_response
 JOINT = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_stiffness=1.0)
 ZETA = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 2 zeta sqrt(m k_c) = 0.05
 H = 12
+#: pyHarm sometimes stalls after the upper fold on this case; give up after this many s.
+PYHARM_TIMEOUT = 240
 
 PYHARM_SCRIPT = """
 import json, sys, time
@@ -101,9 +103,17 @@ def pyharm(python: str, harmonics: int) -> dict[str, object]:
     with tempfile.TemporaryDirectory() as folder:
         script = Path(folder) / "pyharm_case.py"
         script.write_text(PYHARM_SCRIPT % {"h": harmonics})
-        done = subprocess.run(
-            [python, str(script)], capture_output=True, text=True, check=True, cwd=folder
-        )
+        try:
+            done = subprocess.run(
+                [python, str(script)],
+                capture_output=True,
+                text=True,
+                check=True,
+                cwd=folder,
+                timeout=PYHARM_TIMEOUT,
+            )
+        except subprocess.TimeoutExpired:
+            return {}
     result: dict[str, object] = json.loads(done.stdout.strip().splitlines()[-1])
     return result
 
@@ -128,6 +138,11 @@ def main() -> None:
         print(f"  {e.kind}: omega = {e.omega:.4f} rad/s, X = {e.amplitude:.4f}")
     if args.pyharm:
         ph = pyharm(args.pyharm, H)
+        if not ph:
+            print(
+                f"pyHarm did not finish within {PYHARM_TIMEOUT} s (it sometimes stalls after the fold)"
+            )
+            return
         om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])
         print(
             f"pyHarm (nti = 512): {ph['points']} points, first call {ph['first_s']:.3f} s, "

@@ -61,6 +61,9 @@ def test_an_orbit_hill_calls_unstable_is_left_by_the_exact_motion(three_links: S
     omega = 600.0
     fr = frequency_response(three_links, FORCE, omega, 1.001 * omega, harmonics=7, max_points=2)
     assert not fr.stable[0]
+    ds = fr.to_xarray()
+    assert ds["x_max"].dims == ("point", "dof")
+    assert ds["coefficients"].dims == ("point", "coefficient", "dof")
     u = _exact_from(three_links, omega, fr.initial_state[0], 6)
     first = np.max(np.abs(u[:SAMPLES].max(axis=0) - fr.x_max[0]))
     last = np.max(np.abs(u[-SAMPLES:].max(axis=0) - fr.x_max[0]))
