@@ -140,7 +140,8 @@ def main() -> None:
         ph = pyharm(args.pyharm, H)
         if not ph:
             print(
-                f"pyHarm did not finish within {PYHARM_TIMEOUT} s (it sometimes stalls after the fold)"
+                f"pyHarm did not finish within {PYHARM_TIMEOUT} s "
+                "(it sometimes stalls after the fold)"
             )
             return
         om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])

@@ -42,8 +42,8 @@ def test_basis_round_trip_and_derivative() -> None:
     assert bottom[0] == pytest.approx(grid.min(), abs=1e-9)
 
 
-@pytest.mark.parametrize("offset", [0.0, 0.03])
-def test_jacobian_matches_finite_differences(offset: float) -> None:
+@pytest.mark.parametrize(("offset", "friction"), [(0.0, None), (0.03, Friction(0.02, 1.0))])
+def test_jacobian_matches_finite_differences(offset: float, friction: Friction | None) -> None:
     joint = Joint(
         mass=1.5,
         clearance=0.2,
@@ -52,7 +52,7 @@ def test_jacobian_matches_finite_differences(offset: float) -> None:
         gap_stiffness=0.5,
         gap_offset=offset,
     )
-    model = system.from_joint(joint, 0.02, None, 1.0)
+    model = system.from_joint(joint, 0.02, friction, 1.0, 0.05)
     basis = aft.Basis.make(6, 128)
     rng = np.random.default_rng(7)
     q = 0.1 * rng.normal(size=13)
@@ -82,7 +82,7 @@ def test_restitution_and_friction_are_refused_with_a_pointer() -> None:
     with pytest.raises(HarmonicError, match=r"clearjoint\.periodic"):
         system.build(PYHARM, 0.0, None, 0.8)
     with pytest.raises(HarmonicError, match=r"clearjoint\.periodic"):
-        system.build(PYHARM, 0.0, Friction(0.1, 1.0), 1.0)
+        system.build(PYHARM, 0.0, Friction(0.1, 1.0, "free-play"), 1.0, 1e-3)
 
 
 def _hb_orbit(harmonics: int, omega: float, guess: np.ndarray) -> tuple[np.ndarray, aft.Basis]:

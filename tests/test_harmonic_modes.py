@@ -8,7 +8,7 @@ import matplotlib
 import numpy as np
 import pytest
 
-from clearjoint import Joint, ParameterError, dissipation, stiffness
+from clearjoint import Friction, Joint, ParameterError, dissipation, stiffness
 from clearjoint.harmonic import HarmonicError, NonlinearMode, nonlinear_modes
 
 matplotlib.use("Agg")
@@ -78,6 +78,8 @@ def test_result_object() -> None:
         ({"amplitudes": [-1e-6, 1e-3]}, ParameterError, "starts at -1e-06"),
         ({"harmonics": 0}, HarmonicError, "harmonics must be an integer >= 1"),
         ({"samples": 5}, HarmonicError, "samples must be an integer"),
+        ({"friction": Friction(0.1, 10.0)}, HarmonicError, "does not carry Coulomb friction"),
+        ({"restitution": 0.5}, HarmonicError, "clearjoint.periodic"),
     ],
 )
 def test_bad_input(kwargs: dict[str, object], error: type, match: str) -> None:

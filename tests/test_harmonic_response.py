@@ -8,7 +8,7 @@ import matplotlib
 import numpy as np
 import pytest
 
-from clearjoint import ParameterError
+from clearjoint import Friction, ParameterError
 from clearjoint.harmonic import HarmonicError, frequency_response
 from clearjoint.periodic import FrequencyResponse, periodic_orbit
 from clearjoint.simulate import SimulationError
@@ -108,6 +108,8 @@ def test_force_continuation_reaches_the_exact_orbit() -> None:
         ({"harmonics": 0}, HarmonicError, "harmonics must be an integer >= 1"),
         ({"samples": 10}, HarmonicError, "samples must be an integer >= 2"),
         ({"restitution": 0.7}, HarmonicError, "clearjoint.periodic"),
+        ({"friction": Friction(0.01, 1.0, "free-play")}, HarmonicError, "free-play stroke only"),
+        ({"friction": Friction(0.01, 1.0), "friction_regularization": 0.0}, ParameterError, "> 0"),
         ({"parameter": "force"}, ParameterError, "force_stop is required"),
         ({"force": [0.1, 0.2]}, Exception, "force"),
     ],
@@ -123,3 +125,31 @@ def test_bad_input_one_clear_message(kwargs: dict[str, object], error: type, mat
             args.pop("omega_stop"),  # type: ignore[arg-type]
             **args,  # type: ignore[arg-type]
         )
+
+
+@pytest.mark.parametrize("omega", [0.8, 1.3])
+def test_regularised_friction_against_exact_stick_slip_orbits(omega: float) -> None:
+    """mu_s P tanh(v / v_eps) with the default v_eps: x_max and stability vs exact shooting."""
+    friction = Friction(0.005, 1.0)
+    fr = frequency_response(
+        PYHARM,
+        0.03,
+        omega,
+        1.001 * omega,
+        harmonics=15,
+        damping_ratio=PYHARM_ZETA,
+        friction=friction,
+        max_points=2,
+    )
+    exact = periodic_orbit(
+        PYHARM,
+        0.03,
+        omega,
+        damping_ratio=PYHARM_ZETA,
+        friction=friction,
+        initial=fr.initial_state[0],
+    )
+    assert abs(fr.x_max[0] - exact.x_max) < 2e-3 * exact.amplitude
+    assert bool(fr.stable[0]) == exact.stable
+    mu = float(np.max(np.abs(fr.multipliers[0])))
+    assert mu == pytest.approx(float(np.max(np.abs(exact.multipliers))), rel=0.01)

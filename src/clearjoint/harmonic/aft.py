@@ -159,12 +159,15 @@ class Evaluation:
         dR/dw, N s.
     tangent : (N_t, n_j) ndarray
         Each joint's sampled tangent stiffness, N/m.
+    velocity_tangent : (N_t, n_j) ndarray or None
+        Each joint's sampled d(friction force)/dv, N s/m (None without friction).
     """
 
     residual: FloatArray
     jacobian: FloatArray
     d_omega: FloatArray
     tangent: FloatArray
+    velocity_tangent: FloatArray | None = None
 
 
 def evaluate(
@@ -215,7 +218,17 @@ def evaluate(
         jac = np.kron(np.eye(n_c), k) - np.kron(np.diag(w2h2), m) + omega * np.kron(d, c_eff)
         for j in range(b.shape[0]):
             jac += np.kron((p * kt[:, j]) @ e, np.outer(b[j], b[j]))
-    return Evaluation(residual.ravel(), jac, d_omega.ravel(), kt)
+    kv = None
+    if system.friction_force is not None:
+        rel_rate = d @ (coef @ b.T)  # d delta / d tau, coefficients (2H + 1, n_j)
+        speed = omega * (e @ rel_rate)
+        f_fr, kv = system.friction_forces(speed)
+        residual += (p @ f_fr) @ b
+        d_omega += (p @ (kv * (e @ rel_rate))) @ b
+        for j in range(b.shape[0]):
+            g = omega * (((p * kv[:, j]) @ e) @ d)
+            jac += g if n == 1 else np.kron(g, np.outer(b[j], b[j]))
+    return Evaluation(residual.ravel(), jac, d_omega.ravel(), kt, kv)
 
 
 def hill_exponents(
@@ -223,6 +236,7 @@ def hill_exponents(
     basis: Basis,
     jacobian: FloatArray,
     omega: float,
+    velocity_tangent: FloatArray | None = None,
 ) -> NDArray[np.complex128]:
     """Return the 2N Floquet exponents (1/s) by Hill's method, from the HB Jacobian.
 
@@ -236,6 +250,11 @@ def hill_exponents(
     inv_m = np.linalg.inv(system.mass)
     eye = np.eye(n_c)
     delta1 = np.kron(eye, system.damping) + 2.0 * omega * np.kron(basis.derivative, system.mass)
+    if velocity_tangent is not None:  # regularised friction: a sampled viscous term
+        b = system.directions
+        for j in range(b.shape[0]):
+            g = (basis.to_coefficients * velocity_tangent[:, j]) @ basis.to_time
+            delta1 += np.kron(g, np.outer(b[j], b[j]))
     minv = np.kron(eye, inv_m)
     size = n_c * n
     a = np.zeros((2 * size, 2 * size))

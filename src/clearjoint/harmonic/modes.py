@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint.errors import ParameterError, ParameterTypeError
 from clearjoint.harmonic import aft
 from clearjoint.harmonic.solve import newton
-from clearjoint.harmonic.system import LinearSystem, build, scale_length
+from clearjoint.harmonic.system import HarmonicError, LinearSystem, build, scale_length
 from clearjoint.joint import Friction
 
 if TYPE_CHECKING:
@@ -214,7 +214,8 @@ def nonlinear_modes(
     damping_ratio : float
         zeta of a Joint's linear part (c_v = 2 zeta sqrt(m k_c)).
     friction, restitution
-        Refused, as for :func:`clearjoint.harmonic.frequency_response`.
+        Refused (HarmonicError): friction is not carried by EPMC here yet, and
+        impacts need :mod:`clearjoint.periodic`.
 
     Returns
     -------
@@ -228,6 +229,11 @@ def nonlinear_modes(
         Bad harmonics or samples, friction or restitution.
     """
     h, n_t = aft.check_harmonics(harmonics, samples)
+    if friction is not None and friction.force > 0.0:
+        raise HarmonicError(
+            "nonlinear_modes does not carry Coulomb friction yet; set friction=None, or use "
+            "clearjoint.harmonic.frequency_response (regularised) or clearjoint.periodic"
+        )
     model = build(system, damping_ratio, friction, restitution)
     ref, omega_lin, shape = _reference(model, mode)
     length = scale_length(model)

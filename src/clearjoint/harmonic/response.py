@@ -29,6 +29,7 @@ from clearjoint.harmonic.system import (
     LinearSystem,
     build,
     force_vector,
+    friction_speed,
     scale_length,
 )
 from clearjoint.joint import Friction
@@ -80,6 +81,7 @@ def frequency_response(
     force_stop: float | None = None,
     max_points: int = 2000,
     max_step: float = 0.02,
+    friction_regularization: float | None = None,
 ) -> FrequencyResponse:
     """Return the frequency-response curve by harmonic balance and continuation (MODEL.md 5.3).
 
@@ -106,9 +108,13 @@ def frequency_response(
         visible as small zigzags of the curve near a fold).
     damping_ratio : float
         zeta of a Joint's linear part, c_v = 2 zeta sqrt(m k_c).
-    friction, restitution
-        Refused (HarmonicError): Coulomb friction and impacts need the exact
-        solver, :func:`clearjoint.periodic.frequency_response`.
+    friction : Friction, optional
+        Coulomb friction of a Joint over its whole path (region "everywhere"),
+        regularised as mu_s P tanh(v / v_eps); its error against the exact
+        stick-slip orbits of :mod:`clearjoint.periodic` is in docs/harmonic.md.
+        Friction over the free-play stroke only is refused.
+    restitution : float
+        Must be 1: impacts need :func:`clearjoint.periodic.frequency_response`.
     parameter : {"omega", "force"}
     force_stop : float, optional
         End of the force range, N (largest entry for a Structure).
@@ -116,6 +122,8 @@ def frequency_response(
         Largest number of points on the curve.
     max_step : float
         Largest arclength step in scaled coordinates (smaller: more points).
+    friction_regularization : float, optional
+        v_eps in m/s; default 1e-3 * omega_start * c (c the joint's clearance).
 
     Returns
     -------
@@ -136,10 +144,16 @@ def frequency_response(
     if parameter not in ("omega", "force"):
         raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
     h, n_t = aft.check_harmonics(harmonics, samples)
-    model = build(system, damping_ratio, friction, restitution)
+    w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
+    model = build(
+        system,
+        damping_ratio,
+        friction,
+        restitution,
+        friction_speed(system, w0, friction_regularization),
+    )
     pattern = force_vector(model, force)
     peak = float(np.max(np.abs(pattern)))
-    w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
     start, stop = _range(parameter, peak, w0, omega_stop, force_stop)
     unit_force = pattern / peak
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
@@ -277,7 +291,7 @@ def _response(
     for i in range(n_pts):
         f = pattern if parameter == "omega" else force[i] * unit_force
         ev = aft.evaluate(model, basis, u[i], float(omega[i]), f)
-        lam_i = aft.hill_exponents(model, basis, ev.jacobian, float(omega[i]))
+        lam_i = aft.hill_exponents(model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent)
         multipliers[i] = aft.hill_multipliers(lam_i, float(omega[i]))
     stable = np.max(np.abs(multipliers), axis=1) < 1.0
     amplitude = 0.5 * (x_max - x_min)

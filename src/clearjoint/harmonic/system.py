@@ -47,6 +47,10 @@ class LinearSystem:
     is_joint : bool
         True for a single :class:`Joint` (one DOF, its x).
     source : Joint or Structure
+    friction_force : (n_j,) ndarray, optional
+        Coulomb force mu_s P of each joint, N, regularised as mu_s P tanh(v / v_eps).
+    friction_speed : float
+        The regularisation speed v_eps, m/s.
     """
 
     mass: FloatArray
@@ -61,6 +65,8 @@ class LinearSystem:
     dof_names: list[str]
     is_joint: bool
     source: Any
+    friction_force: FloatArray | None = None
+    friction_speed: float = 0.0
 
     @property
     def n_dof(self) -> int:
@@ -95,9 +101,25 @@ class LinearSystem:
         tangent = self.k0 + self.k_c * (over > 0.0) + self.k_t * (under < 0.0)
         return force, tangent
 
+    def friction_forces(self, speed: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Return mu_s P tanh(v / v_eps) (N) and its derivative in v (N s/m), samples (N_t, n_j)."""
+        assert self.friction_force is not None
+        ratio = np.tanh(speed / self.friction_speed)
+        return (
+            self.friction_force * ratio,
+            (self.friction_force / self.friction_speed) * (1.0 - ratio * ratio),
+        )
 
-def _refuse_losses(friction: Friction | None, restitution: float, where: str) -> None:
-    if friction is not None and friction.force > 0.0:
+
+def _refuse_losses(
+    friction: Friction | None, restitution: float, where: str, *, allow_friction: bool = False
+) -> None:
+    if friction is not None and friction.force > 0.0 and friction.region != "everywhere":
+        raise HarmonicError(
+            f"Coulomb friction over the free-play stroke only ({where}) is not carried by "
+            "clearjoint.harmonic; use clearjoint.periodic, or region='everywhere'"
+        )
+    if friction is not None and friction.force > 0.0 and not allow_friction:
         raise HarmonicError(
             f"Coulomb friction ({where}) is not carried by clearjoint.harmonic; "
             "use clearjoint.periodic (exact orbits with stick-slip) or set friction=None"
@@ -111,11 +133,23 @@ def _refuse_losses(friction: Friction | None, restitution: float, where: str) ->
 
 
 def from_joint(
-    joint: Joint, damping_ratio: float, friction: Friction | None, restitution: float
+    joint: Joint,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+    friction_speed: float = 0.0,
 ) -> LinearSystem:
-    """The one-DOF system of a :class:`Joint` with viscous damping c_v = 2 zeta sqrt(m k_c)."""
+    """The one-DOF system of a :class:`Joint` with viscous damping c_v = 2 zeta sqrt(m k_c).
+
+    Coulomb friction (region "everywhere") is regularised as mu_s P tanh(v / v_eps),
+    v_eps = ``friction_speed`` (m/s, > 0 when there is friction).
+    """
     e = _checks.real_scalar("restitution", restitution)
-    _refuse_losses(friction, e, "on the joint")
+    _refuse_losses(friction, e, "on the joint", allow_friction=True)
+    force = None
+    if friction is not None and friction.force > 0.0:
+        force = np.array([friction.force])
+        friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
     c_v = viscous_coefficient(joint, damping_ratio)
     one = np.ones((1, 1))
     return LinearSystem(
@@ -131,6 +165,8 @@ def from_joint(
         dof_names=["x"],
         is_joint=True,
         source=joint,
+        friction_force=force,
+        friction_speed=float(friction_speed),
     )
 
 
@@ -164,11 +200,15 @@ def from_structure(structure: Any) -> LinearSystem:
 
 
 def build(
-    system: Any, damping_ratio: float, friction: Friction | None, restitution: float
+    system: Any,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+    friction_speed: float = 0.0,
 ) -> LinearSystem:
     """A :class:`LinearSystem` from a Joint (with its losses) or a Structure."""
     if isinstance(system, Joint):
-        return from_joint(system, damping_ratio, friction, restitution)
+        return from_joint(system, damping_ratio, friction, restitution, friction_speed)
     from clearjoint.structure.model import Structure
 
     if isinstance(system, Structure):
@@ -208,3 +248,12 @@ def scale_length(system: LinearSystem) -> float:
     """A typical length (m): the largest clearance, or 1 um if there is none."""
     gaps = system.g_c + system.g_t
     return float(max(np.max(gaps, initial=0.0), 1e-6)) if gaps.size else 1e-6
+
+
+def friction_speed(system: Any, omega: float, given: float | None) -> float:
+    """The regularisation speed v_eps (m/s): ``given``, or 1e-3 * omega * c for a Joint."""
+    if given is not None:
+        return _checks.positive("friction_regularization", given, unit="m/s")
+    if isinstance(system, Joint):
+        return 1e-3 * omega * max(system.clearance, 1e-6)
+    return 0.0
