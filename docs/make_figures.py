@@ -154,6 +154,54 @@ def rig_picture() -> None:
     fig.savefig(HERE / "rig_record_loop.png", dpi=110)
 
 
+def periodic_pictures() -> None:
+    """Whole frequency-response curves: pyHarm's SDOF case with eq 7, and a period doubling."""
+    import matplotlib.pyplot as plt
+
+    from clearjoint.periodic import frequency_response
+    from clearjoint.stiffness import equivalent_linear_response
+
+    joint = Joint(
+        mass=1.0,
+        clearance=2 * 0.1745,
+        gap_stiffness=1.0,
+        compression_stiffness=3.0,
+        tension_stiffness=3.0,
+    )
+    zeta = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 0.05
+    fr = frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)
+    fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2))
+    fr.plot(axes[0])
+    omegas = np.linspace(0.6, 1.8, 121)
+    eq7 = [
+        (w, b.displacement_amplitude)
+        for w in omegas
+        for b in equivalent_linear_response(joint, 0.03, float(w), zeta, method="period")
+    ]
+    axes[0].plot(
+        [w / (2 * math.pi) for w, _ in eq7],
+        [x * 1e3 for _, x in eq7],
+        ".",
+        ms=2.5,
+        color="0.5",
+        label="eq 7 (k_d(A))",
+    )
+    axes[0].legend(frameon=False, fontsize="small")
+    axes[0].set_title("pyHarm's SDOF clearance case (m = 1, c_v = 0.05, F0 = 0.03)")
+    one_sided = Joint(
+        mass=1.0,
+        clearance=0.2,
+        gap_stiffness=1.0,
+        compression_stiffness=20.0,
+        tension_stiffness=1e-3,
+    )
+    pd = frequency_response(one_sided, 1.0, 1.5, 4.5, damping_ratio=0.05)
+    pd.plot(axes[1])
+    axes[1].set_title("One-sided contact (k_c = 20 k0, F0 = 1): period doubling")
+    fig.tight_layout()
+    fig.savefig(HERE / "periodic_frequency_response.png", dpi=110)
+
+
 def main() -> None:
     HERE.mkdir(exist_ok=True)
     fig = stiffness_coefficient_figure(
@@ -184,6 +232,8 @@ def main() -> None:
     print("wrote the dissipation pictures")
     rig_picture()
     print("wrote the rig pictures")
+    periodic_pictures()
+    print("wrote the periodic pictures")
 
 
 if __name__ == "__main__":

@@ -61,3 +61,18 @@ def test_builder_input_errors_name_the_item(call, message) -> None:  # type: ign
     with pytest.raises(StructureError) as info:
         call()
     assert message in str(info.value)
+
+
+def test_mast_has_two_hinged_longerons_per_bay_and_bends_first() -> None:
+    from clearjoint.structure import mast
+
+    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
+    tower = mast(10, joints=hinge)
+    assert len(tower.joint_members) == 20
+    assert tower.n_dof == 40
+    closed, opened = tower.modes("closed"), tower.modes("open")
+    assert opened.omega[0] < closed.omega[0]  # open joints soften the mast
+    tip = tower.node_displacements(closed.shapes[:, 0])[-1]
+    assert abs(tip[0]) > 5.0 * abs(tip[1])  # the first mode sways sideways
+    with pytest.raises(StructureError, match="one per longeron"):
+        mast(2, joints=[hinge] * 3)

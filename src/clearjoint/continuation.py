@@ -5,7 +5,7 @@ use it, and so can harmonic balance. A branch is followed in scaled coordinates
 y = (u / u_scale, lambda / lambda_scale):
 
 - tangent t: the null vector of [dR/du, dR/dlambda], oriented along the last one;
-- predictor y + h t;
+- predictor y + h t + (h^2 / 2) dt/ds, the curvature taken from the last step;
 - corrector: Newton on R(y) = 0 together with the arclength condition
   t . (y - y_predicted) = 0, so that it passes folds where dR/du is singular;
 - step control from the corrector's iteration count: grow after an easy
@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from clearjoint.errors import ClearjointError, ParameterError
@@ -108,6 +109,13 @@ class Branch:
     reason: str
 
 
+@njit(cache=True)
+def _solve(a: FloatArray, b: FloatArray) -> FloatArray:
+    """np.linalg.solve compiled: the systems are tiny and called thousands of times."""
+    x: FloatArray = np.asarray(np.linalg.solve(a, b), dtype=np.float64)
+    return x
+
+
 def _tangent(a: FloatArray, previous: FloatArray) -> FloatArray:
     """Unit null vector of the (d, d+1) matrix ``a``, oriented along ``previous``."""
     system = np.vstack((a, previous))
@@ -133,27 +141,34 @@ def _correct(
     """Newton on [R(y); t . (y - y0)] = 0 (or on R at fixed lambda); None if it fails."""
     y = y0.copy()
     d = y.size - 1
-    border = np.zeros(d + 1)
-    border[-1] = 1.0
+    u_scale = scale[:d]
+    system = np.empty((d + 1, d + 1))
+    if fixed_lambda:
+        system[d, :d] = 0.0
+        system[d, d] = 1.0
+    else:
+        system[d] = tangent
+    rhs = np.empty(d + 1)
     for iteration in range(settings.max_iterations + 1):
         try:
-            r, jac_u, r_lam, data = residual(y[:d] * scale[:d], float(y[d] * scale[d]))
+            r, jac_u, r_lam, data = residual(y[:d] * u_scale, float(y[d] * scale[d]))
         except ClearjointError:
             return None
-        a = np.empty((d, d + 1))
-        a[:, :d] = jac_u * scale[:d]
-        a[:, d] = r_lam * scale[d]
-        rs = r / scale[:d]
-        if not np.all(np.isfinite(rs)) or not np.all(np.isfinite(a)):
+        # rows scaled by the unknowns' sizes, columns by the scaled unknowns
+        system[:d, :d] = jac_u * (u_scale / u_scale[:, None])
+        system[:d, d] = r_lam * (scale[d] / u_scale)
+        rs = r / u_scale
+        size = float(np.max(np.abs(rs)))
+        if not math.isfinite(size) or not math.isfinite(float(system.sum())):
             return None
-        if np.max(np.abs(rs)) <= settings.tolerance:
-            return y, a / scale[:d, None], data, iteration
+        if size <= settings.tolerance:
+            return y, system[:d].copy(), data, iteration
         if iteration == settings.max_iterations:
             return None
-        system = np.vstack((a / scale[:d, None], border if fixed_lambda else tangent))
-        rhs = np.concatenate((-rs, [0.0 if fixed_lambda else -float(tangent @ (y - y0))]))
+        rhs[:d] = -rs
+        rhs[d] = 0.0 if fixed_lambda else -float(tangent @ (y - y0))
         try:
-            dy = np.linalg.solve(system, rhs)
+            dy = _solve(system, rhs)
         except np.linalg.LinAlgError:
             return None
         y = y + dy
@@ -214,8 +229,10 @@ def continue_branch(
     h = settings.step
     stop = lam_stop / scale[-1]
     reason = "max_points"
+    curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
     while len(ys) < settings.max_points:
-        attempt = _correct(residual, y + h * t, t, scale, settings, fixed_lambda=False)
+        predicted = y + h * t + 0.5 * h * h * curvature
+        attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
         if attempt is not None:
             y_new, a_new, data_new, its = attempt
             t_new = _tangent(a_new, t)
@@ -242,6 +259,8 @@ def continue_branch(
                 iters.append(its_end)
             reason = "reached"
             break
+        step_length = float(np.linalg.norm(y_new - y))
+        curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         y, t = y_new, t_new
         ys.append(y)
         ts.append(t)

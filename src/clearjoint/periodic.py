@@ -43,7 +43,18 @@ from clearjoint.simulate.core import (
     _parameters,
     _run,
 )
-from clearjoint.simulate.shooting import MapError, Shot, newton_orbit, shoot, start_state
+from clearjoint.simulate.shooting import (
+    N_RES,
+    R_DLAM,
+    R_JAC,
+    R_RES,
+    R_XMAX,
+    R_XMIN,
+    Shot,
+    map_residual,
+    newton_orbit,
+    start_state,
+)
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -411,31 +422,18 @@ class FrequencyResponse:
         return ds
 
 
-def _with(p: FloatArray, parameter: str, value: float) -> FloatArray:
-    q = p.copy()
-    if parameter == "omega":
-        q[kn.P_W] = value
-        q[kn.P_TF] = 2.0 * math.pi / value
-    else:
-        q[kn.P_F0] = value
-    return q
+def _map_residual(p: FloatArray, parameter: str) -> Any:
+    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
+    code = 0 if parameter == "omega" else 1
 
-
-def _map_residual(
-    p: FloatArray, parameter: str
-) -> Any:  # the continuation's Residual, closed over p
-    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, Shot]:
+    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
         if not lam > 0.0:
             raise SimulationError(f"the parameter left the positive range ({lam!r})")
-        q = _with(p, parameter, lam)
-        try:
-            shot = shoot(q, u, 1)
-            delta = 1e-7 * lam
-            shifted = shoot(_with(p, parameter, lam + delta), u, 1)
-        except MapError as error:
-            raise SimulationError(f"the exact map failed (kernel status {error.status})") from None
-        r = shot.end - u
-        return r, shot.monodromy - np.eye(2), (shifted.end - shot.end) / delta, shot
+        out = np.empty(N_RES)
+        status = map_residual(p, code, float(u[0]), float(u[1]), lam, out)
+        if status != kn.STATUS_OK:
+            raise SimulationError(f"the exact map failed (kernel status {status})")
+        return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
 
     return residual
 
@@ -542,18 +540,18 @@ def frequency_response(
         settings=ContinuationSettings(
             step=0.002,
             min_step=1e-7,
-            max_step=0.02,
+            max_step=0.023,
             max_points=max_points,
             tolerance=1e-11,
         ),
     )
-    shots: list[Shot] = branch.data
+    rows = np.array(branch.data)
     n = branch.lam.size
     omega = branch.lam.copy() if parameter == "omega" else np.full(n, w0)
     force = branch.lam.copy() if parameter == "force" else np.full(n, f0)
-    x_max = np.array([s.x_max for s in shots])
-    x_min = np.array([s.x_min for s in shots])
-    mono = np.array([s.monodromy for s in shots])
+    x_max = rows[:, R_XMAX]
+    x_min = rows[:, R_XMIN]
+    mono = rows[:, R_JAC : R_JAC + 4].reshape(n, 2, 2) + np.eye(2)
     mu = np.linalg.eigvals(mono).astype(np.complex128)
     mu = np.take_along_axis(mu, np.argsort(-np.abs(mu), axis=1), axis=1)
     stable = np.max(np.abs(mu), axis=1) < 1.0

@@ -6,18 +6,22 @@
 motion with an energy ledger.
 """
 
-from clearjoint.structure.builders import chain, truss
+from clearjoint.structure.backbone import Backbone, decay_backbone
+from clearjoint.structure.builders import chain, mast, truss
 from clearjoint.structure.model import Member, Modes, Structure, StructureError
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
 
 __all__ = [
+    "Backbone",
     "Member",
     "Modes",
     "Structure",
     "StructureError",
     "StructureMotion",
     "chain",
+    "decay_backbone",
     "free_decay",
+    "mast",
     "time_response",
     "truss",
 ]

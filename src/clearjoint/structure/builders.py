@@ -122,3 +122,96 @@ def truss(
                 f"member {i} must be a Member, a mapping or a node pair, got {item!r}"
             )
     return Structure(xyz, mass, tuple(built), supports=tuple(supports), rayleigh=rayleigh)
+
+
+def mast(
+    bays: int,
+    *,
+    width: float = 0.5,
+    bay_height: float = 0.5,
+    longeron_rigidity: float = 2.0e7,
+    batten_rigidity: float = 2.0e7,
+    diagonal_rigidity: float = 2.0e7,
+    node_mass: float = 0.5,
+    tip_mass: float = 0.0,
+    joints: ClearanceJoint | Sequence[ClearanceJoint] | None = None,
+    member_damping: float = 0.0,
+    rayleigh: tuple[float, float] = (0.0, 0.0),
+) -> Structure:
+    """Return a planar deployable mast: ``bays`` square bays stacked on a clamped base.
+
+    Geometry (2-D, y up, base nodes 0 and 1 supported)::
+
+        2b ---- 2b+1     level b: nodes 2b (left, x = 0) and 2b+1 (right, x = width)
+         |  \\    |       longerons: 2(b-1) -> 2b and 2(b-1)+1 -> 2b+1, each with a
+         j   \\   j       hinge joint j in series (2 per bay, 2 x bays in all)
+         |    \\  |       batten: 2b -> 2b+1 (rigid-jointed, no clearance)
+        2b-2 -- 2b-1     diagonal: 2(b-1) -> 2b+1
+
+    Each member's axial stiffness is its rigidity EA (N) over its length. The hinge
+    joints sit in the longerons, which carry the mast's bending as axial push and
+    pull, so the lateral modes soften with the joints' clearance.
+
+    Parameters
+    ----------
+    bays : int
+        Number of bays, >= 1.
+    width, bay_height : float
+        m.
+    longeron_rigidity, batten_rigidity, diagonal_rigidity : float
+        EA of each member family, N.
+    node_mass : float
+        Lumped mass of every free node, kg (members' own mass included by the user).
+    tip_mass : float
+        Added to each of the two top nodes, kg.
+    joints : ClearanceJoint or sequence of 2 x bays, optional
+        The same joint in every longeron, or one per longeron in order (bay 1 left,
+        bay 1 right, bay 2 left, ...). Default: no joints (a linear mast).
+    member_damping : float
+        Dashpot across every member, N s/m.
+    rayleigh : (alpha, beta)
+        Rayleigh damping.
+    """
+    if isinstance(bays, bool) or not isinstance(bays, int) or bays < 1:
+        raise StructureError(f"bays must be a whole number >= 1, got {bays!r}")
+    if joints is None or isinstance(joints, ClearanceJoint):
+        hinge: list[ClearanceJoint | None] = [joints] * (2 * bays)
+    else:
+        hinge = _per_link("joints (one per longeron, 2 x bays)", joints, 2 * bays, None)
+    nodes = np.array(
+        [[side * width, level * bay_height] for level in range(bays + 1) for side in (0, 1)],
+        dtype=np.float64,
+    )
+    if width <= 0.0 or bay_height <= 0.0:
+        raise StructureError("width and bay_height must be > 0 m")
+    diagonal = math.hypot(width, bay_height)
+    members: list[Member] = []
+    for level in range(1, bays + 1):
+        lo, hi = 2 * (level - 1), 2 * level
+        members.append(
+            Member(
+                lo,
+                hi,
+                stiffness=longeron_rigidity / bay_height,
+                joint=hinge[2 * (level - 1)],
+                damping=member_damping,
+            )
+        )
+        members.append(
+            Member(
+                lo + 1,
+                hi + 1,
+                stiffness=longeron_rigidity / bay_height,
+                joint=hinge[2 * (level - 1) + 1],
+                damping=member_damping,
+            )
+        )
+        members.append(
+            Member(hi, hi + 1, stiffness=batten_rigidity / width, damping=member_damping)
+        )
+        members.append(
+            Member(lo, hi + 1, stiffness=diagonal_rigidity / diagonal, damping=member_damping)
+        )
+    masses = np.full(nodes.shape[0], float(node_mass))
+    masses[-2:] += tip_mass
+    return Structure(nodes, masses, tuple(members), supports=(0, 1), rayleigh=rayleigh)

@@ -7,19 +7,22 @@ In one contact pattern s the structure is linear,
 and so is the augmented state y = (u, v, sin w t, cos w t, 1): y' = A_s y. Its flow
 exp(A_s tau) is therefore exact for the forcing and the joints' constant forces alike,
 with no special case for a singular K_s (an open joint with k0 = 0), a defective A_s or
-resonance. Per visited pattern we cache exp(A_s H 2^-k), k = 0..10, for a base step H
-(an eighth of the shortest period of forcing, structure and damping); any step is a
-product of these (its binary digits) and a short Taylor series of the last sliver
-(|A_s tau| < 3e-3, seven terms reach round-off). The same caches carry the energy
-integrals exactly: the input power F.v sin(w t) and the viscous power v^T C v are
-quadratic forms of y, so int_0^h y^T Q y = y0^T W(h) y0 with W(2h) = W(h) + E(h)^T W(h) E(h).
+resonance. Steps never exceed a base step H (an eighth of the shortest period of forcing,
+structure and damping), so |A_s tau| is of order one and the Taylor series of
+exp(A_s tau) y, summed until its terms fall below 1e-18 of y, is the exact flow to
+round-off. The same series carries the energy integrals exactly: the input power
+F.v sin(w t) and the viscous power v^T C v are quadratic forms of y, integrated term by
+term. Per visited pattern only its generator and eigen-decomposition (for the event
+bound below) are cached.
 
 Events (a joint's shortening delta_j reaches a gap edge) are found by *certified
 marching*, as in the one-joint kernel: from the state at tau = 0 the event function
 g = distance to the edge satisfies g(tau) >= g + g' tau + g'' tau^2/2 - B tau^3/6 on the
 whole base step, where B bounds |g'''|: g''' = w_j^T A^3 y(tau), so
-|g'''| <= |w_j^T A^3| |y(tau)| <= |w_j^T A^3| exp(mu(A) H) |y(0)| with mu the logarithmic
-norm of A (in scaled variables, so that the norm is meaningful). Stepping to the first
+|g'''| <= sum_k |w_j^T v_k| |lambda_k|^3 |c_k| max(1, exp(Re lambda_k H)) over the modes
+(v_k, lambda_k) of A_s with y = sum_k c_k v_k (falling back, when the eigenvectors are
+ill-conditioned, to |w_j^T A^3| exp(mu(A) H) |y(0)|, mu the logarithmic norm of A in
+scaled variables). Stepping to the first
 root of that lower bound never passes a root, grazing included; near a transversal
 crossing the steps shrink like Newton's. Restitution on a joint that links two masses
 directly (a rigid member) applies an impulse along b_j that takes the relative speed
@@ -54,10 +57,12 @@ from clearjoint.structure.model import (
 
 FloatArray = NDArray[np.float64]
 
-#: Binary levels of the cached propagators: exp(A H 2^-k), k = 0..LEVELS.
-LEVELS = 10
-#: Taylor terms for the sliver below H 2^-LEVELS.
-TAYLOR_TERMS = 8
+#: Largest number of Taylor terms for a step shorter than the base step.
+TAYLOR_TERMS = 60
+#: Above this condition number of the pattern's eigenvectors, the modal jerk bound gives
+#: way to the plain norm bound.
+MODAL_CONDITION_LIMIT = 1e10
+
 #: The most events allowed per base step on average before the run is called chattering.
 MAX_EVENTS_PER_STEP = 1000
 
@@ -84,10 +89,11 @@ class _Pattern:
     """The cached exact flow of one contact pattern, in scaled variables."""
 
     a: FloatArray  # scaled generator (n_aug, n_aug)
-    e: list[FloatArray]  # exp(a H 2^-k)
-    w: list[FloatArray]  # (2, n_aug, n_aug): energy forms over H 2^-k
-    jerk_norm: FloatArray  # (J,) |w_j^T A^3| in scaled variables
+    norm: float  # |a|_F >= |a|_2
+    jerk_rows: FloatArray  # (J, n_aug) w_j^T A^3 (plain bound: |rows| |y| growth)
     growth: float  # exp(mu(A) H) >= sup |exp(A tau)| on [0, H]
+    modal_inverse: NDArray[np.complex128] | None  # V^-1, or None when V is ill-conditioned
+    modal_weights: FloatArray | None  # (J, n_aug) |w_j v_k| |lambda_k|^3 max(1, e^(Re lambda_k H))
 
 
 class _Flow:
@@ -172,59 +178,67 @@ class _Flow:
         gen[2 * n + 1, 2 * n] = -self.omega
         a = gen * self.scale[:, None] / self.scale[None, :]
         h = self.base_step
-        e = [scipy.linalg.expm(a * (h / 2.0**lev)) for lev in range(LEVELS + 1)]
-        # energy forms at the finest level by Taylor series, then doubled up
-        fine = h / 2.0**LEVELS
-        powers = [np.eye(n_aug)]
-        for i in range(1, TAYLOR_TERMS):
-            powers.append(powers[-1] @ a * (fine / i))
-        w_fine = np.zeros((2, n_aug, n_aug))
-        for p_i in range(TAYLOR_TERMS):
-            for p_j in range(TAYLOR_TERMS):
-                w_fine += (powers[p_i].T @ self.q @ powers[p_j]) * (fine / (p_i + p_j + 1))
-        w = [w_fine]
-        for lev in range(LEVELS, 0, -1):
-            prev = w[0]
-            w.insert(0, prev + e[lev].T @ prev @ e[lev])
+        norm = float(np.linalg.norm(a))  # Frobenius: an upper bound of the 2-norm
         jerk = self.delta_rows @ np.linalg.matrix_power(a, 3)
         mu = float(np.linalg.eigvalsh(0.5 * (a + a.T))[-1])
+        # the modal bound: the jerk is sum_k (w_j v_k) lambda_k^3 c_k e^(lambda_k t)
+        lam, vec = np.linalg.eig(a)
+        modal_inverse: NDArray[np.complex128] | None = None
+        modal_weights: FloatArray | None = None
+        try:
+            inverse = np.linalg.inv(vec)
+        except np.linalg.LinAlgError:
+            inverse = None
+        condition = (
+            np.inf
+            if inverse is None
+            else float(np.linalg.norm(vec, 1) * np.linalg.norm(inverse, 1))
+        )
+        if inverse is not None and condition < MODAL_CONDITION_LIMIT:
+            modal_inverse = inverse
+            growth_k = np.exp(np.maximum(lam.real, 0.0) * h)
+            modal_weights = np.abs(self.delta_rows @ vec) * (np.abs(lam) ** 3 * growth_k)
         pat = _Pattern(
             a=a,
-            e=e,
-            w=w,
-            jerk_norm=np.linalg.norm(jerk, axis=1),
+            norm=norm,
+            jerk_rows=jerk,
             growth=math.exp(max(mu, 0.0) * h),
+            modal_inverse=modal_inverse,
+            modal_weights=modal_weights,
         )
         self.patterns[key] = pat
         return pat
+
+    def jerk_bound(self, pat: _Pattern, y: FloatArray) -> FloatArray:
+        """(J,) bounds on each joint's third derivative of delta over the next base step."""
+        norms = np.linalg.norm(pat.jerk_rows, axis=1)
+        plain: FloatArray = norms * (pat.growth * float(np.linalg.norm(y)))
+        if pat.modal_weights is None or pat.modal_inverse is None:
+            return plain
+        modal = pat.modal_weights @ np.abs(pat.modal_inverse @ y)
+        # round-off in the eigenvectors: keep a sliver of the plain bound as a margin
+        bound: FloatArray = np.minimum(modal * (1.0 + 1e-9) + 1e-9 * plain, plain)
+        return bound
 
     def propagate(
         self, pat: _Pattern, y: FloatArray, tau: float, energy: FloatArray | None
     ) -> FloatArray:
         """y (scaled) after tau in [0, H]; adds the energy integrals to ``energy`` if given."""
-        fine = self.base_step / 2.0**LEVELS
-        count = min(int(tau / fine), 2**LEVELS)
-        rest = max(tau - count * fine, 0.0)
-        if count == 2**LEVELS:
-            levels = [0]
-        else:
-            levels = [lev for lev in range(1, LEVELS + 1) if (count >> (LEVELS - lev)) & 1]
-        for lev in levels:
-            if energy is not None:
-                energy += np.einsum("i,kij,j->k", y, pat.w[lev], y)
-            y = pat.e[lev] @ y
-        if rest > 0.0:
-            terms = [y]
-            for i in range(1, TAYLOR_TERMS):
-                terms.append(pat.a @ terms[-1] * (rest / i))
-            d = np.array(terms)
-            if energy is not None:
-                gram = np.einsum("mi,kij,nj->kmn", d, self.q, d)
-                order = np.arange(TAYLOR_TERMS)
-                weights = rest / (order[:, None] + order[None, :] + 1.0)
-                energy += np.einsum("kmn,mn->k", gram, weights)
-            y = d.sum(axis=0)
-        return y
+        if tau <= 0.0:
+            return y
+        terms = [y]
+        size = float(np.abs(y).max())
+        while len(terms) < TAYLOR_TERMS:
+            terms.append(pat.a @ terms[-1] * (tau / len(terms)))
+            if float(np.abs(terms[-1]).max()) <= 1e-18 * size and pat.norm * tau < len(terms):
+                break
+        d = np.array(terms)
+        if energy is not None:
+            gram = (d @ self.q) @ d.T  # (2, K, K)
+            order = np.arange(d.shape[0])
+            weights = tau / (order[:, None] + order[None, :] + 1.0)
+            energy += np.sum(gram * weights, axis=(1, 2))
+        return np.asarray(d.sum(axis=0), dtype=np.float64)
 
     # ---- conversions --------------------------------------------------------------------
 
@@ -447,13 +461,14 @@ def _run(
         g0[1::2] = np.where(open_ | tens, sign_t * (d[:, 0] + flow.g_t), 1e300)
         g1[1::2] = sign_t * d[:, 1]
         g2[1::2] = sign_t * d[:, 2]
-        bound = pat.jerk_norm * (pat.growth * float(np.linalg.norm(y)))
+        bound = flow.jerk_bound(pat, y)
         bounds[0::2] = bound
         bounds[1::2] = bound
         remaining = duration - t
         h_max = min(h_base, remaining)
         h, which = _first_event(g0, g1, g2, bounds, h_max)
-        event = which >= 0 and h <= eps
+        # an event when the certified step has shrunk to round-off of the step or of t
+        event = which >= 0 and h <= max(eps, 8.0 * math.ulp(t))
         if not event and which >= 0:
             which = -1  # a certified step short of the event
         # samples that fall inside [t, t + h)
