@@ -190,7 +190,7 @@ def main() -> None:
         compression_stiffness=1e8,
         tension_stiffness=1e8,
     )
-    omega, periods = 1.0, 2
+    omega, periods = 1.0, 1
     duration = periods * 2 * math.pi / omega
     print(f"stiff contact, k_contact/k0 = 1e8, e = 0.8, F0 = 1, {periods} forcing periods:")
     truth = reference_time_response(stiff, 1.0, omega, periods, restitution=0.8, rtol=1e-13)
@@ -198,7 +198,7 @@ def main() -> None:
     t_ed, motion = best_of(lambda: time_response(stiff, 1.0, omega, duration, restitution=0.8))
     err_ed = abs(motion.final_state[0] - truth.strobe[-1, 0]) / 0.1  # type: ignore[attr-defined]
     print(f"  time_response: {t_ed * 1e3:.2f} ms, error {err_ed:.1e} (relative to the gap edge)")
-    for rtol in (1e-8, 1e-10):
+    for rtol in (1e-10,):
         start = time.perf_counter()
         ref = reference_time_response(stiff, 1.0, omega, periods, restitution=0.8, rtol=rtol)
         t_ref = time.perf_counter() - start
@@ -211,6 +211,10 @@ def main() -> None:
     print(
         f"  time_response over 100 periods: {time.perf_counter() - start:.3f} s, "
         f"{long.impact_times.size} impacts, ledger balance {long.energy.balance_error:.1e}"
+    )
+    print(
+        "  (solve_ivp is the project's reference: each step capped at the shortest period of "
+        "the system / 20, here the contact period, also in the free flights)"
     )
     print(
         "targets: curve >= 300 points; >= 20x faster than pyHarm and than frequency_sweep; "

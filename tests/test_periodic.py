@@ -131,7 +131,10 @@ def test_curve_turns_back_at_two_folds_through_an_unstable_branch(
     upper, lower = sorted(folds, key=lambda e: -e.amplitude)
     assert upper.omega > lower.omega
     assert upper.omega == pytest.approx(curve.omega[curve.amplitude > 0.3].max(), rel=1e-4)
-    assert lower.omega == pytest.approx(curve.omega[~curve.stable].min(), rel=2e-3)
+    # the lower fold is the kink where the middle branch meets the linear orbit that just
+    # touches the edges: F0 / |1 - w^2 + 0.05 i w| = 0.1745 (closed form)
+    w2 = 1.0 + math.sqrt((F0 / PYHARM.compression_gap) ** 2 - 0.05**2 * 1.0785**2)
+    assert lower.omega == pytest.approx(math.sqrt(w2), rel=1e-3)
     # between the folds the orbits are unstable with a real multiplier > 1 (saddle)
     unstable = ~curve.stable
     assert unstable.sum() > 20
@@ -148,6 +151,14 @@ def test_grazing_kink_is_reported_and_crossed(curve: FrequencyResponse) -> None:
     assert len(grazings) == 2  # the lower branch leaves the gap on the way up, re-enters after
     for event in grazings:
         assert event.amplitude == pytest.approx(PYHARM.compression_gap, rel=1e-3)
+    # where the linear orbit reaches the edges: F0 / |1 - w^2 + 0.05 i w| = 0.1745
+    touch = [
+        float(w)
+        for w in np.linspace(0.8, 1.2, 400001)
+        if abs(F0 / math.hypot(1.0 - w * w, 0.05 * w) - PYHARM.compression_gap) < 2e-6
+    ]
+    assert grazings[0].omega == pytest.approx(min(touch), rel=2e-3)
+    assert grazings[1].omega == pytest.approx(max(touch), rel=2e-3)
     # inside the gap the orbit is linear: X = F0 / |k0 - m w^2 + i c w| exactly
     inside = curve.amplitude < PYHARM.compression_gap * 0.999
     w = curve.omega[inside]

@@ -230,6 +230,22 @@ def _modes_parser(sub: Any) -> None:
     p.add_argument("--plot", help="draw frequency and damping against amplitude (.png)")
     p.add_argument("--json", action="store_true", help="print the mode as one JSON object")
     p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
+def _structure_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "structure",
+        help="modes, forced response or free decay of a structure with many joints (MODEL 5.2)",
+        description=(
+            "Read a structure study (TOML with units, see clearjoint.structure.study) and "
+            "compute its linear modes with every joint closed and open (modes), its exact "
+            "forced response (respond) or its exact free decay and backbone (decay)."
+        ),
+    )
+    p.add_argument("study", help="structure study TOML file")
+    p.add_argument("task", choices=("modes", "respond", "decay"), help="what to compute")
+    p.add_argument("--out", required=True, help="netCDF results file (.nc)")
+    p.add_argument("--plot", help="also draw a figure into this PNG")
+    p.add_argument("--json", action="store_true", help="print a JSON summary")
+    p.add_argument("--force", action="store_true", help="overwrite existing output")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -246,6 +262,7 @@ def build_parser() -> argparse.ArgumentParser:
     _report_parser(sub)
     _frf_parser(sub)
     _modes_parser(sub)
+    _structure_parser(sub)
     return parser
 
 
@@ -781,6 +798,84 @@ def _run_modes(args: argparse.Namespace) -> int:
         )
         return 0
     print("\n".join([f"study: {study.source}", repr(mode), f"wrote {args.out}"]))
+def _run_structure(args: argparse.Namespace) -> int:
+    import math
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import xarray as xr
+
+    from clearjoint import _checks
+    from clearjoint.structure import decay_backbone, free_decay, time_response
+    from clearjoint.structure.study import load_structure_study
+
+    out = Path(args.out)
+    outputs = [out] + ([Path(args.plot)] if args.plot else [])
+    _checks.refuse_to_overwrite(outputs, force=args.force)
+    study = load_structure_study(args.study)
+    s = study.structure
+    summary: dict[str, Any] = {"structure": repr(s)}
+    fig = None
+    if args.task == "modes":
+        closed, opened = s.modes("closed"), s.modes("open")
+        data = xr.concat(
+            [closed.to_xarray(), opened.to_xarray()],
+            dim=xr.DataArray(["closed", "open"], dims="pattern"),
+        )
+        summary["closed_hz"] = closed.frequency_hz[:6].tolist()
+        summary["open_hz"] = opened.frequency_hz[:6].tolist()
+        if args.plot:
+            fig, axes = plt.subplots(1, 2, figsize=(9, 6))
+            closed.plot(axes[0])
+            opened.plot(axes[1])
+    elif args.task == "respond":
+        if study.omega is None or study.force is None:
+            raise ParameterError(f"{study.source}: respond needs an [excitation] section")
+        duration = study.periods * 2.0 * math.pi / study.omega
+        motion = time_response(
+            s, study.force, study.omega, duration, samples_per_period=study.samples_per_period
+        )
+        data = motion.to_xarray()
+        summary |= {
+            "events": motion.events,
+            "patterns": motion.patterns_visited,
+            "energy_j": motion.energy.as_dict(),
+            "balance_error": motion.balance_error,
+            "max_displacement_m": float(np.abs(motion.u).max()),
+        }
+        if args.plot:
+            fig = motion.plot().figure
+    else:
+        if study.decay_initial is None or study.decay_duration is None:
+            raise ParameterError(f"{study.source}: decay needs a [decay] section")
+        motion = free_decay(
+            s,
+            (study.decay_initial, np.zeros(s.n_dof)),
+            study.decay_duration,
+            samples_per_period=max(study.samples_per_period, 64),
+        )
+        backbone = decay_backbone(motion, int(study.decay_dof or 0))
+        data = xr.merge([motion.to_xarray(), backbone.to_xarray()], combine_attrs="drop_conflicts")
+        summary |= {
+            "events": motion.events,
+            "balance_error": motion.balance_error,
+            "amplitude_m": backbone.amplitude.tolist(),
+            "frequency_hz": (backbone.omega / (2.0 * math.pi)).tolist(),
+            "damping_ratio": [None if math.isnan(z) else z for z in backbone.damping_ratio],
+        }
+        if args.plot:
+            fig = backbone.plot().figure
+    data.to_netcdf(out, engine="h5netcdf")
+    if fig is not None:
+        fig.savefig(args.plot, dpi=120)
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        for key, value in summary.items():
+            print(f"{key}: {value}")
+        print(f"wrote {out}" + (f" and {args.plot}" if args.plot else ""))
     return 0
 
 
@@ -798,6 +893,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "report": _run_report,
         "frf": _run_frf,
         "modes": _run_modes,
+        "structure": _run_structure,
     }
     try:
         return runners[args.command](args)

@@ -58,6 +58,11 @@ class ContinuationSettings:
     growth : float
     max_turn : float
         Largest angle between successive tangents, rad, before the step is cut.
+    chord_parameter : bool
+        Ask for dR/dlambda only at the first corrector iteration of each step and
+        keep it (a chord in that one column): the residual is then called as
+        ``residual(u, lam, False)`` after the first iteration and may return None
+        for dR/dlambda. Worth it when that derivative costs a second evaluation.
     """
 
     step: float = 0.01
@@ -70,6 +75,7 @@ class ContinuationSettings:
     hard: int = 5
     growth: float = 1.5
     max_turn: float = 0.3
+    chord_parameter: bool = False
 
     def __post_init__(self) -> None:
         if not 0.0 < self.min_step <= self.step <= self.max_step:
@@ -151,12 +157,17 @@ def _correct(
     rhs = np.empty(d + 1)
     for iteration in range(settings.max_iterations + 1):
         try:
-            r, jac_u, r_lam, data = residual(y[:d] * u_scale, float(y[d] * scale[d]))
+            if settings.chord_parameter and iteration > 0:
+                r, jac_u, _, data = residual(  # type: ignore[call-arg]
+                    y[:d] * u_scale, float(y[d] * scale[d]), False
+                )
+            else:
+                r, jac_u, r_lam, data = residual(y[:d] * u_scale, float(y[d] * scale[d]))
+                system[:d, d] = r_lam * (scale[d] / u_scale)
         except ClearjointError:
             return None
         # rows scaled by the unknowns' sizes, columns by the scaled unknowns
         system[:d, :d] = jac_u * (u_scale / u_scale[:, None])
-        system[:d, d] = r_lam * (scale[d] / u_scale)
         rs = r / u_scale
         size = float(np.max(np.abs(rs)))
         if not math.isfinite(size) or not math.isfinite(float(system.sum())):

@@ -13,7 +13,7 @@ unstable alike, through folds. The derivative of the map in the parameter is
 a finite difference of the exact map; the one in the state is exact. Events:
 
 - fold: the parameter component of the tangent changes sign (a multiplier
-  passes +1);
+  passes +1); it is placed at the bracketing point where the parameter is extreme;
 - period doubling: 1 + tr M + det M (the characteristic polynomial at -1)
   changes sign (a multiplier passes -1); a period-2 branch is born there and is
   not followed;
@@ -426,11 +426,13 @@ def _map_residual(p: FloatArray, parameter: str) -> Any:
     """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
     code = 0 if parameter == "omega" else 1
 
-    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
+    def residual(
+        u: FloatArray, lam: float, derivative: bool = True
+    ) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
         if not lam > 0.0:
             raise SimulationError(f"the parameter left the positive range ({lam!r})")
-        out = np.empty(N_RES)
-        status = map_residual(p, code, float(u[0]), float(u[1]), lam, out)
+        out = np.zeros(N_RES)
+        status = map_residual(p, code, float(u[0]), float(u[1]), lam, out, derivative)
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
         return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
@@ -543,6 +545,7 @@ def frequency_response(
             max_step=0.023,
             max_points=max_points,
             tolerance=1e-11,
+            chord_parameter=True,
         ),
     )
     rows = np.array(branch.data)
@@ -605,6 +608,12 @@ def _events(
         kind = "grazing" if name.startswith("grazing") else name
         for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
             frac = float(g[i] / (g[i] - g[i + 1]))
+            if kind == "fold":
+                # the parameter is extreme at a fold: take the bracketing point that is further
+                # out (a linear interpolation of the tangent is wrong at a grazing kink)
+                lam = omega if np.ptp(omega) > 0.0 else force
+                turn = float(np.sign(lam[i + 1] - lam[i]) * np.sign(g[i]))
+                frac = 1.0 if turn > 0 else 0.0
 
             def at(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
                 return float(a[i] + frac * (a[i + 1] - a[i]))

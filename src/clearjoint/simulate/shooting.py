@@ -341,13 +341,20 @@ def _set_parameter(p: np.ndarray, parameter: int, value: float) -> None:
 
 @njit(cache=True)
 def map_residual(
-    p: np.ndarray, parameter: int, x: float, v: float, lam: float, out: np.ndarray
+    p: np.ndarray,
+    parameter: int,
+    x: float,
+    v: float,
+    lam: float,
+    out: np.ndarray,
+    derivative: bool = True,
 ) -> int:
     """R = P_1(z) - z at parameter ``lam`` (0: omega, 1: F0), dR/dz and dR/dlam, in one call.
 
     ``out`` receives R (2), dR/dz = M - I row by row (4), dR/dlam (2) by a forward
     difference of the exact map with step 1e-7 lam, then x_max, x_min, the
-    smallest approach speed at an edge and the number of events. Returns a
+    smallest approach speed at an edge and the number of events. Without
+    ``derivative`` dR/dlam is not computed (left as it is in ``out``). Returns a
     kernel status code.
     """
     q = p.copy()
@@ -358,22 +365,23 @@ def map_residual(
     status = shoot_map(q, state, 1, o1)
     if status != kn.STATUS_OK:
         return status
-    delta = 1e-7 * lam
-    _set_parameter(q, parameter, lam + delta)
-    shifted = np.zeros(4)
-    start_state(q, x, v, shifted)
-    o2 = np.zeros(N_OUT)
-    status = shoot_map(q, shifted, 1, o2)
-    if status != kn.STATUS_OK:
-        return status
+    if derivative:
+        delta = 1e-7 * lam
+        _set_parameter(q, parameter, lam + delta)
+        shifted = np.zeros(4)
+        start_state(q, x, v, shifted)
+        o2 = np.zeros(N_OUT)
+        status = shoot_map(q, shifted, 1, o2)
+        if status != kn.STATUS_OK:
+            return status
+        out[R_DLAM] = (shifted[kn.S_X] - state[kn.S_X]) / delta
+        out[R_DLAM + 1] = (shifted[kn.S_V] - state[kn.S_V]) / delta
     out[R_RES] = state[kn.S_X] - x
     out[R_RES + 1] = state[kn.S_V] - v
     out[R_JAC] = o1[O_M00] - 1.0
     out[R_JAC + 1] = o1[O_M01]
     out[R_JAC + 2] = o1[O_M10]
     out[R_JAC + 3] = o1[O_M11] - 1.0
-    out[R_DLAM] = (shifted[kn.S_X] - state[kn.S_X]) / delta
-    out[R_DLAM + 1] = (shifted[kn.S_V] - state[kn.S_V]) / delta
     out[R_XMAX] = o1[O_XMAX]
     out[R_XMIN] = o1[O_XMIN]
     out[R_EDGE] = o1[O_EDGE_SPEED]

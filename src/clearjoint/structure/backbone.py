@@ -91,7 +91,7 @@ class Backbone:
                 "amplitude": ("cycle", self.amplitude, {"units": "m"}),
                 "omega": ("cycle", self.omega, {"units": "rad/s"}),
                 "damping_ratio": ("cycle", self.damping_ratio, {"units": "1"}),
-                "time": ("cycle", self.time, {"units": "s"}),
+                "cycle_time": ("cycle", self.time, {"units": "s"}),
             },
             attrs={
                 "dof": self.dof,

@@ -1,0 +1,141 @@
+"""The structure solver against solve_ivp, side by side, and its cost with the mast's size.
+
+Run on demand::
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_structure.py [--mast-periods 200]
+        [--ivp-periods 2] [--bays 5,10,20,40] [--scaling-periods 1]
+
+(one BLAS thread: the matrices are small, and threads fight over a shared machine.)
+
+1. Accuracy: a 3-link chain with 2 joints (asymmetric, k0 > 0, off-centre gaps, restitution
+   on the rigid link) against scipy's solve_ivp (DOP853, rtol 1e-12, an event on every gap
+   edge), 20 forcing periods: largest difference relative to the largest motion.
+2. Speed: the 10-bay mast with 20 hinge joints forced at its tip, both solvers over
+   ``--ivp-periods`` periods (time ratio, difference), then the exact solver alone over
+   ``--mast-periods`` periods (events per second).
+3. Cost against the number of bays (``--bays``), ``--scaling-periods`` periods each.
+4. Linear checks: a uniform fixed-free bar's first modes against
+   (2k - 1) (pi / 2L) sqrt(E / rho) as n grows; a two-mass chain against its closed form.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import numpy as np
+
+from clearjoint import ClearanceJoint
+from clearjoint.structure import Member, Structure, chain, mast, time_response
+from clearjoint.structure.reference import reference_response
+
+
+def _three_links() -> Structure:
+    hit = ClearanceJoint(
+        1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=2e-5, restitution=0.7
+    )
+    series = ClearanceJoint(1.5e-4, 5e7, tension_stiffness=9e7, gap_stiffness=2e6, gap_offset=-4e-5)
+    return chain(
+        [2.0, 1.5, 1.0], [math.inf, 6e7, 4e7], [hit, series, None], dampers=[50.0, 30.0, 20.0]
+    )
+
+
+def _side_by_side(s: Structure, force: np.ndarray, omega: float, periods: int) -> None:
+    duration = periods * 2.0 * math.pi / omega
+    start = time.perf_counter()
+    mine = time_response(s, force, omega, duration, samples_per_period=32)
+    t_mine = time.perf_counter() - start
+    start = time.perf_counter()
+    u, v, events = reference_response(s, force, omega, mine.t)
+    t_ivp = time.perf_counter() - start
+    du = np.max(np.abs(mine.u - u)) / np.max(np.abs(u))
+    dv = np.max(np.abs(mine.v - v)) / np.max(np.abs(v))
+    print(
+        f"  exact {t_mine:8.2f} s, solve_ivp {t_ivp:8.2f} s, ratio {t_ivp / t_mine:6.2f}x; "
+        f"events {mine.events} / {events}; max |du|/max|u| = {du:.2e}, |dv| = {dv:.2e}; "
+        f"ledger balance {mine.balance_error:.1e}"
+    )
+
+
+def _mast_case(bays: int) -> tuple[Structure, np.ndarray, float]:
+    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
+    s = mast(bays, joints=hinge, rayleigh=(0.0, 2e-6))
+    force = np.zeros(s.n_dof)
+    force[-2] = 20.0  # the top left node, sideways
+    omega = 0.9 * float(s.modes("closed").omega[0])
+    return s, force, omega
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mast-periods", type=int, default=200)
+    parser.add_argument("--ivp-periods", type=int, default=2)
+    parser.add_argument("--bays", default="5,10,20,40")
+    parser.add_argument("--scaling-periods", type=int, default=1)
+    args = parser.parse_args()
+
+    print("1. 3-link chain, 2 joints, 20 periods: exact vs solve_ivp (rtol 1e-12, edge events)")
+    s = _three_links()
+    force3 = np.array([500.0, -300.0, 800.0])
+    omega3 = 0.9 * float(s.modes().omega[0])
+    _side_by_side(s, force3, omega3, 20)
+    # whose error is it? solve_ivp at a tighter tolerance moves toward the exact solver
+    mine = time_response(s, force3, omega3, 20 * 2 * math.pi / omega3, samples_per_period=32)
+    tight, _, _ = reference_response(s, force3, omega3, mine.t, rtol=1e-13, atol=1e-16)
+    loose, _, _ = reference_response(s, force3, omega3, mine.t)
+    scale = np.max(np.abs(tight))
+    print(
+        f"  exact vs solve_ivp rtol 1e-13: {np.max(np.abs(mine.u - tight)) / scale:.2e}; "
+        f"solve_ivp 1e-12 vs 1e-13: {np.max(np.abs(loose - tight)) / scale:.2e}"
+    )
+
+    print(f"2. 10-bay mast, 20 joints, {args.ivp_periods} periods side by side")
+    s, force, omega = _mast_case(10)
+    _side_by_side(s, force, omega, args.ivp_periods)
+    if args.mast_periods:
+        start = time.perf_counter()
+        motion = time_response(
+            s, force, omega, args.mast_periods * 2 * math.pi / omega, samples_per_period=16
+        )
+        spent = time.perf_counter() - start
+        print(
+            f"  exact alone, {args.mast_periods} periods: {spent:.1f} s, {motion.events} events "
+            f"({motion.events / spent:.0f} events/s), {motion.patterns_visited} patterns"
+        )
+
+    print(f"3. cost against bays, {args.scaling_periods} forcing period(s) each")
+    for bays in (int(b) for b in args.bays.split(",")):
+        s, force, omega = _mast_case(bays)
+        start = time.perf_counter()
+        motion = time_response(
+            s, force, omega, args.scaling_periods * 2 * math.pi / omega, samples_per_period=16
+        )
+        spent = time.perf_counter() - start
+        print(
+            f"  {bays:3d} bays ({s.n_dof:4d} DOF, {2 * bays:3d} joints): {spent:7.2f} s, "
+            f"{motion.events:6d} events, {motion.patterns_visited:6d} patterns"
+        )
+
+    print("4. linear modes")
+    length, e, rho, area = 2.0, 7e10, 2700.0, 1e-4
+    exact = (2 * np.arange(1, 4) - 1) * math.pi / (2 * length) * math.sqrt(e / rho)
+    for n in (10, 20, 40, 80, 160):
+        masses = np.full(n + 1, rho * area * length / n)
+        masses[-1] *= 0.5
+        members = tuple(Member(i, i + 1, youngs_modulus=e, area=area) for i in range(n))
+        bar = Structure(np.linspace(0, length, n + 1), masses, members, supports=(0,))
+        error = bar.modes(count=3).omega / exact - 1.0
+        shown = np.array2string(error, precision=2)
+        print(f"  bar, n = {n:4d}: relative error of modes 1-3 = {shown}")
+    m1, m2, k1, k2 = 2.0, 0.5, 3e6, 1e6
+    a = (k1 + k2) / m1 + k2 / m2
+    root = math.sqrt(a * a - 4 * k1 * k2 / (m1 * m2))
+    closed = np.sqrt([(a - root) / 2, (a + root) / 2])
+    got = chain([m1, m2], [k1, k2]).modes().omega
+    worst = np.max(np.abs(got / closed - 1))
+    print(f"  two-mass chain: {got} rad/s vs closed form {closed}: {worst:.1e}")
+
+
+if __name__ == "__main__":
+    main()

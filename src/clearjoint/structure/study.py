@@ -1,0 +1,263 @@
+"""A structure study in one TOML file, with units: build, then modes / respond / decay.
+
+A thin reader: every quantity may carry a unit (``"50um"``, ``"5e7N/m"``, ``"15Hz"``) or be
+a bare SI number, read by :func:`clearjoint.units.parse_quantity` as the simulation study
+does; an unknown section or key is an error. Example (a 10-bay mast)::
+
+    [structure]
+    kind = "mast"            # "mast" or "chain"
+    bays = 10
+    width = "0.5m"
+    bay_height = "0.5m"
+    longeron_rigidity = "2e7N"   # EA
+    node_mass = "0.5kg"
+    rayleigh_beta = "2e-6s"
+
+    [joint]                  # the same hinge joint in every longeron
+    clearance = "50um"
+    compression_stiffness = "5e7N/m"
+    gap_stiffness = "1e5N/m"
+
+    [excitation]             # for "respond"
+    frequency = "15Hz"
+    force_dof = "n21x"
+    force_amplitude = "20N"
+    periods = 50
+
+    [decay]                  # for "decay": deflect along closed mode 1
+    dof = "n21x"
+    initial_amplitude = "3mm"
+    mode = 1
+    duration = "1s"
+
+A chain takes ``masses``, ``stiffnesses`` (``"inf"`` for a rigid link), ``dampers`` (N s/m)
+as lists and ``joints`` as a list of true/false (the [joint] on that link or none).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from clearjoint.errors import ClearjointError
+from clearjoint.joint import ClearanceJoint
+from clearjoint.structure.builders import chain, mast
+from clearjoint.structure.model import Structure
+from clearjoint.units import parse_quantity
+
+KEYS: dict[str, dict[str, str]] = {
+    "structure": {
+        "kind": "text",
+        "bays": "count",
+        "width": "length",
+        "bay_height": "length",
+        "longeron_rigidity": "force",
+        "batten_rigidity": "force",
+        "diagonal_rigidity": "force",
+        "node_mass": "mass",
+        "tip_mass": "mass",
+        "member_damping": "dimensionless",
+        "rayleigh_alpha": "frequency",
+        "rayleigh_beta": "time",
+        "masses": "mass list",
+        "stiffnesses": "stiffness list",
+        "dampers": "dimensionless list",
+        "joints": "flag list",
+    },
+    "joint": {
+        "clearance": "length",
+        "compression_stiffness": "stiffness",
+        "tension_stiffness": "stiffness",
+        "gap_stiffness": "stiffness",
+        "gap_offset": "length",
+        "restitution": "dimensionless",
+    },
+    "excitation": {
+        "frequency": "frequency",
+        "force_dof": "text",
+        "force_amplitude": "force",
+        "periods": "count",
+    },
+    "decay": {
+        "dof": "text",
+        "initial_amplitude": "length",
+        "mode": "count",
+        "duration": "time",
+    },
+    "output": {"samples_per_period": "count"},
+}
+
+
+class StructureStudyError(ClearjointError, ValueError):
+    """A structure study file is missing, unreadable or holds a bad value."""
+
+
+@dataclass(frozen=True)
+class StructureStudy:
+    """A parsed structure study (SI; omega in rad/s)."""
+
+    structure: Structure
+    omega: float | None
+    force: np.ndarray | None
+    periods: int
+    decay_dof: int | None
+    decay_initial: np.ndarray | None
+    decay_duration: float | None
+    samples_per_period: int
+    source: str
+
+
+def _value(where: str, section: str, key: str, raw: Any) -> Any:
+    kind = KEYS[section][key]
+    name = f"{where}: [{section}] {key}"
+    if kind == "text":
+        if not isinstance(raw, str):
+            raise StructureStudyError(f"{name} must be text, got {raw!r}")
+        return raw
+    if kind == "count":
+        if isinstance(raw, bool) or not isinstance(raw, int):
+            raise StructureStudyError(f"{name} must be a whole number, got {raw!r}")
+        return raw
+    if kind.endswith(" list"):
+        if not isinstance(raw, list):
+            raise StructureStudyError(f"{name} must be a list, got {raw!r}")
+        inner = kind.removesuffix(" list")
+        if inner == "flag":
+            if not all(isinstance(v, bool) for v in raw):
+                raise StructureStudyError(f"{name} must be a list of true/false")
+            return raw
+        return [_number(name, inner, v) for v in raw]
+    return _number(name, kind, raw)
+
+
+def _number(name: str, kind: str, raw: Any) -> float:
+    if isinstance(raw, str) and raw.strip().lower() == "inf":
+        return math.inf
+    if isinstance(raw, bool):
+        raise StructureStudyError(f"{name} must be a number or a quantity, got {raw!r}")
+    if isinstance(raw, int | float):
+        return float(raw)
+    if isinstance(raw, str):
+        return parse_quantity(raw, kind, name=name)
+    raise StructureStudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
+
+
+def load_structure_study(path: str | Path) -> StructureStudy:
+    """Read and validate a structure study TOML file (see the module docstring)."""
+    path = Path(path)
+    where = str(path)
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise StructureStudyError(f"study file {where} not found; check the path") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise StructureStudyError(f"{where} is not valid TOML: {exc}") from None
+    values: dict[str, dict[str, Any]] = {}
+    for section, body in raw.items():
+        if section not in KEYS or not isinstance(body, dict):
+            raise StructureStudyError(
+                f"{where}: unknown section [{section}]; sections are {', '.join(KEYS)}"
+            )
+        values[section] = {}
+        for key, item in body.items():
+            if key not in KEYS[section]:
+                raise StructureStudyError(
+                    f"{where}: unknown key {key!r} in [{section}]; "
+                    f"keys are {', '.join(KEYS[section])}"
+                )
+            values[section][key] = _value(where, section, key, item)
+    return _build(values, where)
+
+
+def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
+    st = values.get("structure", {})
+    joint_values = values.get("joint")
+    joint = None
+    if joint_values is not None:
+        for key in ("clearance", "compression_stiffness"):
+            if key not in joint_values:
+                raise StructureStudyError(f"{where}: [joint] {key} is required")
+        joint = ClearanceJoint(**joint_values)
+    kind = st.get("kind", "mast")
+    rayleigh = (st.get("rayleigh_alpha", 0.0), st.get("rayleigh_beta", 0.0))
+    if kind == "mast":
+        if "bays" not in st:
+            raise StructureStudyError(f"{where}: [structure] bays is required for a mast")
+        options = {
+            k: st[k]
+            for k in (
+                "width",
+                "bay_height",
+                "longeron_rigidity",
+                "batten_rigidity",
+                "diagonal_rigidity",
+                "node_mass",
+                "tip_mass",
+                "member_damping",
+            )
+            if k in st
+        }
+        structure = mast(st["bays"], joints=joint, rayleigh=rayleigh, **options)
+    elif kind == "chain":
+        for key in ("masses", "stiffnesses"):
+            if key not in st:
+                raise StructureStudyError(f"{where}: [structure] {key} is required for a chain")
+        flags = st.get("joints")
+        joints = None if flags is None else [joint if f else None for f in flags]
+        if flags is not None and any(flags) and joint is None:
+            raise StructureStudyError(f"{where}: [structure] joints asks for joints; add [joint]")
+        structure = chain(st["masses"], st["stiffnesses"], joints, st.get("dampers"))
+    else:
+        raise StructureStudyError(
+            f"{where}: [structure] kind must be 'mast' or 'chain', got {kind!r}"
+        )
+    names = structure.dof_names
+
+    def dof_index(section: str, name: str) -> int:
+        if name not in names:
+            raise StructureStudyError(
+                f"{where}: [{section}] names DOF {name!r}, which does not exist; "
+                f"DOFs are {', '.join(names[:3])} ... {names[-1]}"
+            )
+        return names.index(name)
+
+    ex = values.get("excitation", {})
+    omega = force = None
+    if ex:
+        for key in ("frequency", "force_dof", "force_amplitude"):
+            if key not in ex:
+                raise StructureStudyError(f"{where}: [excitation] {key} is required")
+        omega = 2.0 * math.pi * ex["frequency"]
+        force = np.zeros(structure.n_dof)
+        force[dof_index("excitation", ex["force_dof"])] = ex["force_amplitude"]
+    de = values.get("decay", {})
+    decay_dof = initial = duration = None
+    if de:
+        for key in ("dof", "initial_amplitude", "duration"):
+            if key not in de:
+                raise StructureStudyError(f"{where}: [decay] {key} is required")
+        decay_dof = dof_index("decay", de["dof"])
+        shape = structure.modes("closed").shapes[:, de.get("mode", 1) - 1]
+        if shape[decay_dof] == 0.0:
+            raise StructureStudyError(
+                f"{where}: [decay] mode {de.get('mode', 1)} does not move {de['dof']}; "
+                "choose another dof or mode"
+            )
+        initial = de["initial_amplitude"] * shape / shape[decay_dof]
+        duration = de["duration"]
+    return StructureStudy(
+        structure=structure,
+        omega=omega,
+        force=force,
+        periods=ex.get("periods", 20),
+        decay_dof=decay_dof,
+        decay_initial=initial,
+        decay_duration=duration,
+        samples_per_period=values.get("output", {}).get("samples_per_period", 64),
+        source=where,
+    )

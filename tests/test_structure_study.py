@@ -1,0 +1,96 @@
+"""Structure study TOML and `clearjoint structure`: units, outputs, one-line errors."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+import xarray as xr
+
+from clearjoint.cli import main
+from clearjoint.structure.study import StructureStudyError, load_structure_study
+
+CHAIN = """
+[structure]
+kind = "chain"
+masses = ["2kg", "1.5kg"]
+stiffnesses = ["inf", "6e7N/m"]
+dampers = [50.0, 30.0]
+joints = [true, false]
+
+[joint]
+clearance = "0.1mm"
+compression_stiffness = "8e7N/m"
+gap_stiffness = "1e6N/m"
+
+[excitation]
+frequency = "600Hz"
+force_dof = "n2x"
+force_amplitude = "500N"
+periods = 4
+
+[decay]
+dof = "n2x"
+initial_amplitude = "0.5mm"
+duration = "20ms"
+"""
+
+
+def _write(tmp_path: Path, text: str = CHAIN) -> Path:
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    return path
+
+
+def test_study_reads_units_into_si(tmp_path: Path) -> None:
+    study = load_structure_study(_write(tmp_path))
+    assert study.omega == pytest.approx(2 * math.pi * 600.0)
+    assert study.force is not None
+    assert study.force.tolist() == [0.0, 500.0]
+    law = study.structure.joint_laws[0]
+    assert law.clearance == pytest.approx(1e-4)
+    assert study.decay_initial is not None
+    assert study.decay_initial[1] == pytest.approx(5e-4)
+
+
+@pytest.mark.parametrize("task", ["modes", "respond", "decay"])
+def test_cli_writes_netcdf_and_json(
+    tmp_path: Path, task: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / f"{task}.nc"
+    code = main(["structure", str(_write(tmp_path)), task, "--out", str(out), "--json"])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert "structure" in summary
+    with xr.open_dataset(out, engine="h5netcdf") as data:
+        assert len(data.data_vars) > 0
+    if task == "respond":
+        assert summary["balance_error"] < 1e-9
+    assert main(["structure", str(_write(tmp_path)), task, "--out", str(out)]) == 2  # no overwrite
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (('force_dof = "n2x"', 'force_dof = "n9x"'), "names DOF 'n9x', which does not exist"),
+        (('kind = "chain"', 'kind = "tower"'), "kind must be 'mast' or 'chain'"),
+        (('clearance = "0.1mm"', 'clearance = "0.1N"'), "clearance"),
+        (("dampers = [50.0, 30.0]", "dampers = [50.0]"), "dampers must have one entry per link"),
+        (("[decay]", "[decays]"), "unknown section [decays]"),
+    ],
+)
+def test_cli_bad_study_is_one_line_and_exit_2(
+    tmp_path: Path, change: tuple[str, str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _write(tmp_path, CHAIN.replace(*change))
+    code = main(["structure", str(path), "modes", "--out", str(tmp_path / "x.nc")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err
+    assert err.count("\n") == 1
+
+
+def test_study_error_is_a_value_error() -> None:
+    assert issubclass(StructureStudyError, ValueError)
