@@ -230,6 +230,8 @@ def _modes_parser(sub: Any) -> None:
     p.add_argument("--plot", help="draw frequency and damping against amplitude (.png)")
     p.add_argument("--json", action="store_true", help="print the mode as one JSON object")
     p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
+
+
 def _structure_parser(sub: Any) -> None:
     p = sub.add_parser(
         "structure",
@@ -637,9 +639,7 @@ def _run_frf(args: argparse.Namespace) -> int:
         from clearjoint import harmonic
 
         h = 7 if args.harmonics is None else args.harmonics
-        frequency_response = functools.partial(
-            harmonic.frequency_response, harmonics=h
-        )
+        frequency_response = functools.partial(harmonic.frequency_response, harmonics=h)
     elif args.harmonics is not None:
         raise ParameterError("--harmonics goes with --method harmonic; drop it or add that")
     if args.parameter == "force":
@@ -798,6 +798,9 @@ def _run_modes(args: argparse.Namespace) -> int:
         )
         return 0
     print("\n".join([f"study: {study.source}", repr(mode), f"wrote {args.out}"]))
+    return 0
+
+
 def _run_structure(args: argparse.Namespace) -> int:
     import math
 
