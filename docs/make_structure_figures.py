@@ -20,13 +20,13 @@ from clearjoint import ClearanceJoint
 from clearjoint.structure import decay_backbone, free_decay, mast
 
 OUT = Path(__file__).parent / "figures"
-CYCLES = 25
+CYCLES = 80
 
 
 def main() -> None:
     OUT.mkdir(exist_ok=True)
     hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
-    tower = mast(10, joints=hinge, rayleigh=(4.0, 2e-6))
+    tower = mast(10, joints=hinge, rayleigh=(0.5, 2e-6))
 
     fig, ax = plt.subplots(figsize=(3.5, 6))
     tower.draw(ax, color="k", lw=1)

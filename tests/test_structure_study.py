@@ -75,7 +75,7 @@ def test_cli_writes_netcdf_and_json(
     ("change", "message"),
     [
         (('force_dof = "n2x"', 'force_dof = "n9x"'), "names DOF 'n9x', which does not exist"),
-        (('kind = "chain"', 'kind = "tower"'), "kind must be 'mast' or 'chain'"),
+        (('kind = "chain"', 'kind = "tower"'), "kind must be 'mast', 'chain' or 'truss'"),
         (('clearance = "0.1mm"', 'clearance = "0.1N"'), "clearance"),
         (("dampers = [50.0, 30.0]", "dampers = [50.0]"), "dampers must have one entry per link"),
         (("[decay]", "[decays]"), "unknown section [decays]"),
@@ -94,3 +94,27 @@ def test_cli_bad_study_is_one_line_and_exit_2(
 
 def test_study_error_is_a_value_error() -> None:
     assert issubclass(StructureStudyError, ValueError)
+
+
+def test_truss_study_with_units_and_a_joint(tmp_path: Path) -> None:
+    text = """
+[structure]
+kind = "truss"
+nodes = [["0m", "0m"], ["1m", "0m"], ["0m", "1000mm"], ["1m", "1m"]]
+members = [[0, 2], [1, 3], [1, 2], [2, 3]]
+supports = [0, 1]
+member_stiffness = "1e7N/m"
+masses = ["0kg", "0kg", "2kg", "2kg"]
+joint_members = [0]
+
+[joint]
+clearance = "0.1mm"
+compression_stiffness = "8e7N/m"
+"""
+    study = load_structure_study(_write(tmp_path, text))
+    s = study.structure
+    assert s.n_dof == 4
+    assert s.joint_members == (0,)
+    assert s.nodes[2].tolist() == [0.0, 1.0]
+    # the joint in series with member 0: closed stiffness k k_m / (k + k_m)
+    assert s.joint_laws[0].compression_stiffness == pytest.approx(8e7 * 1e7 / 9e7)

@@ -12,17 +12,17 @@ structure and damping), so |A_s tau| is of order one and the Taylor series of
 exp(A_s tau) y, summed until its terms fall below 1e-18 of y, is the exact flow to
 round-off. The same series carries the energy integrals exactly: the input power
 F.v sin(w t) and the viscous power v^T C v are quadratic forms of y, integrated term by
-term. Per visited pattern only its generator and eigen-decomposition (for the event
-bound below) are cached.
+term. Per visited pattern its generator is cached, and, once the motion has spent
+MODAL_AFTER_STEPS steps in it, its eigen-decomposition (for the event bound below).
 
 Events (a joint's shortening delta_j reaches a gap edge) are found by *certified
 marching*, as in the one-joint kernel: from the state at tau = 0 the event function
 g = distance to the edge satisfies g(tau) >= g + g' tau + g'' tau^2/2 - B tau^3/6 on the
 whole base step, where B bounds |g'''|: g''' = w_j^T A^3 y(tau), so
 |g'''| <= sum_k |w_j^T v_k| |lambda_k|^3 |c_k| max(1, exp(Re lambda_k H)) over the modes
-(v_k, lambda_k) of A_s with y = sum_k c_k v_k (falling back, when the eigenvectors are
-ill-conditioned, to |w_j^T A^3| exp(mu(A) H) |y(0)|, mu the logarithmic norm of A in
-scaled variables). Stepping to the first
+(v_k, lambda_k) of A_s with y = sum_k c_k v_k, or, for a pattern met only briefly or with
+ill-conditioned eigenvectors, |w_j^T A^3| exp(mu H) |y(0)|, mu a Gershgorin bound of the
+logarithmic norm of A in scaled variables. Stepping to the first
 root of that lower bound never passes a root, grazing included; near a transversal
 crossing the steps shrink like Newton's. Restitution on a joint that links two masses
 directly (a rigid member) applies an impulse along b_j that takes the relative speed
@@ -59,6 +59,9 @@ FloatArray = NDArray[np.float64]
 
 #: Largest number of Taylor terms for a step shorter than the base step.
 TAYLOR_TERMS = 60
+#: A pattern gets its modal jerk bound (an eigen-decomposition) after this many steps in it;
+#: before, the plain norm bound (cheap, but shorter steps) is used.
+MODAL_AFTER_STEPS = 16
 #: Above this condition number of the pattern's eigenvectors, the modal jerk bound gives
 #: way to the plain norm bound.
 MODAL_CONDITION_LIMIT = 1e10
@@ -94,6 +97,8 @@ class _Pattern:
     growth: float  # exp(mu(A) H) >= sup |exp(A tau)| on [0, H]
     modal_inverse: NDArray[np.complex128] | None  # V^-1, or None when V is ill-conditioned
     modal_weights: FloatArray | None  # (J, n_aug) |w_j v_k| |lambda_k|^3 max(1, e^(Re lambda_k H))
+    uses: int = 0
+    modal_tried: bool = False
 
 
 class _Flow:
@@ -180,39 +185,42 @@ class _Flow:
         h = self.base_step
         norm = float(np.linalg.norm(a))  # Frobenius: an upper bound of the 2-norm
         jerk = self.delta_rows @ np.linalg.matrix_power(a, 3)
-        mu = float(np.linalg.eigvalsh(0.5 * (a + a.T))[-1])
-        # the modal bound: the jerk is sum_k (w_j v_k) lambda_k^3 c_k e^(lambda_k t)
-        lam, vec = np.linalg.eig(a)
-        modal_inverse: NDArray[np.complex128] | None = None
-        modal_weights: FloatArray | None = None
-        try:
-            inverse = np.linalg.inv(vec)
-        except np.linalg.LinAlgError:
-            inverse = None
-        condition = (
-            np.inf
-            if inverse is None
-            else float(np.linalg.norm(vec, 1) * np.linalg.norm(inverse, 1))
-        )
-        if inverse is not None and condition < MODAL_CONDITION_LIMIT:
-            modal_inverse = inverse
-            growth_k = np.exp(np.maximum(lam.real, 0.0) * h)
-            modal_weights = np.abs(self.delta_rows @ vec) * (np.abs(lam) ** 3 * growth_k)
+        # logarithmic norm mu_2(a) <= largest Gershgorin bound of the symmetric part
+        sym = 0.5 * (a + a.T)
+        mu = float(np.max(np.diag(sym) + np.sum(np.abs(sym), axis=1) - np.abs(np.diag(sym))))
         pat = _Pattern(
             a=a,
             norm=norm,
             jerk_rows=jerk,
             growth=math.exp(max(mu, 0.0) * h),
-            modal_inverse=modal_inverse,
-            modal_weights=modal_weights,
+            modal_inverse=None,
+            modal_weights=None,
         )
         self.patterns[key] = pat
         return pat
+
+    def _modal(self, pat: _Pattern) -> None:
+        """Add the modal jerk bound to a pattern used long enough to repay its cost."""
+        pat.modal_tried = True
+        # the jerk is sum_k (w_j v_k) lambda_k^3 c_k e^(lambda_k t)
+        lam, vec = np.linalg.eig(pat.a)
+        try:
+            inverse = np.linalg.inv(vec)
+        except np.linalg.LinAlgError:
+            return
+        condition = float(np.linalg.norm(vec, 1) * np.linalg.norm(inverse, 1))
+        if condition < MODAL_CONDITION_LIMIT:
+            growth_k = np.exp(np.maximum(lam.real, 0.0) * self.base_step)
+            pat.modal_inverse = inverse
+            pat.modal_weights = np.abs(self.delta_rows @ vec) * (np.abs(lam) ** 3 * growth_k)
 
     def jerk_bound(self, pat: _Pattern, y: FloatArray) -> FloatArray:
         """(J,) bounds on each joint's third derivative of delta over the next base step."""
         norms = np.linalg.norm(pat.jerk_rows, axis=1)
         plain: FloatArray = norms * (pat.growth * float(np.linalg.norm(y)))
+        pat.uses += 1
+        if pat.uses > MODAL_AFTER_STEPS and not pat.modal_tried:
+            self._modal(pat)
         if pat.modal_weights is None or pat.modal_inverse is None:
             return plain
         modal = pat.modal_weights @ np.abs(pat.modal_inverse @ y)

@@ -5,7 +5,7 @@ a bare SI number, read by :func:`clearjoint.units.parse_quantity` as the simulat
 does; an unknown section or key is an error. Example (a 10-bay mast)::
 
     [structure]
-    kind = "mast"            # "mast" or "chain"
+    kind = "mast"            # "mast", "chain" or "truss"
     bays = 10
     width = "0.5m"
     bay_height = "0.5m"
@@ -30,8 +30,11 @@ does; an unknown section or key is an error. Example (a 10-bay mast)::
     mode = 1
     duration = "1s"
 
-A chain takes ``masses``, ``stiffnesses`` (``"inf"`` for a rigid link), ``dampers`` (N s/m)
-as lists and ``joints`` as a list of true/false (the [joint] on that link or none).
+A truss takes ``nodes`` (a list of coordinates, with units), ``members`` (pairs of node
+indices), ``supports``, ``member_stiffness``, ``masses`` (one per node, or one for all) and
+``joint_members`` (indices of the members that carry the [joint]). A chain takes
+``masses``, ``stiffnesses`` (``"inf"`` for a rigid link), ``dampers`` (N s/m) as lists
+and ``joints`` as a list of true/false (the [joint] on that link or none).
 """
 
 from __future__ import annotations
@@ -46,8 +49,8 @@ import numpy as np
 
 from clearjoint.errors import ClearjointError
 from clearjoint.joint import ClearanceJoint
-from clearjoint.structure.builders import chain, mast
-from clearjoint.structure.model import Structure
+from clearjoint.structure.builders import chain, mast, truss
+from clearjoint.structure.model import Member, Structure
 from clearjoint.units import parse_quantity
 
 KEYS: dict[str, dict[str, str]] = {
@@ -68,6 +71,11 @@ KEYS: dict[str, dict[str, str]] = {
         "stiffnesses": "stiffness list",
         "dampers": "dimensionless list",
         "joints": "flag list",
+        "nodes": "points",
+        "members": "pairs",
+        "supports": "index list",
+        "member_stiffness": "stiffness",
+        "joint_members": "index list",
     },
     "joint": {
         "clearance": "length",
@@ -122,6 +130,20 @@ def _value(where: str, section: str, key: str, raw: Any) -> Any:
     if kind == "count":
         if isinstance(raw, bool) or not isinstance(raw, int):
             raise StructureStudyError(f"{name} must be a whole number, got {raw!r}")
+        return raw
+    if kind in ("points", "pairs"):
+        if not isinstance(raw, list) or not all(isinstance(p, list) for p in raw):
+            raise StructureStudyError(f"{name} must be a list of lists, got {raw!r}")
+        if kind == "pairs":
+            if not all(len(p) == 2 and all(isinstance(i, int) for i in p) for p in raw):
+                raise StructureStudyError(f"{name} must be pairs of node indices [start, end]")
+            return [tuple(p) for p in raw]
+        return [[_number(name, "length", v) for v in p] for p in raw]
+    if kind == "index list":
+        if not isinstance(raw, list) or not all(
+            isinstance(i, int) and not isinstance(i, bool) for i in raw
+        ):
+            raise StructureStudyError(f"{name} must be a list of whole numbers, got {raw!r}")
         return raw
     if kind.endswith(" list"):
         if not isinstance(raw, list):
@@ -212,9 +234,30 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
         if flags is not None and any(flags) and joint is None:
             raise StructureStudyError(f"{where}: [structure] joints asks for joints; add [joint]")
         structure = chain(st["masses"], st["stiffnesses"], joints, st.get("dampers"))
+    elif kind == "truss":
+        for key in ("nodes", "members", "supports", "member_stiffness"):
+            if key not in st:
+                raise StructureStudyError(f"{where}: [structure] {key} is required for a truss")
+        with_joint = set(st.get("joint_members", []))
+        if with_joint and joint is None:
+            raise StructureStudyError(f"{where}: [structure] joint_members needs a [joint]")
+        members = [
+            Member(
+                a,
+                b,
+                stiffness=st["member_stiffness"],
+                joint=joint if i in with_joint else None,
+                damping=st.get("member_damping", 0.0),
+            )
+            for i, (a, b) in enumerate(st["members"])
+        ]
+        masses = st.get("masses", [st.get("node_mass", 1.0)] * len(st["nodes"]))
+        if len(masses) == 1:
+            masses = masses * len(st["nodes"])
+        structure = truss(st["nodes"], members, st["supports"], masses=masses, rayleigh=rayleigh)
     else:
         raise StructureStudyError(
-            f"{where}: [structure] kind must be 'mast' or 'chain', got {kind!r}"
+            f"{where}: [structure] kind must be 'mast', 'chain' or 'truss', got {kind!r}"
         )
     names = structure.dof_names
 
