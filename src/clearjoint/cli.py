@@ -227,6 +227,13 @@ def _frf_parser(sub: Any) -> None:
     p.add_argument("--frequency", help="fixed frequency with --parameter force, e.g. 400Hz")
     p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
     p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
+    p.add_argument(
+        "--method",
+        choices=["shooting", "harmonic"],
+        default="shooting",
+        help="exact shooting (default) or harmonic balance (clearjoint.harmonic)",
+    )
+    p.add_argument("--harmonics", type=int, help="H with --method harmonic (default 7)")
 
 
 #: Figure formats ``--plot`` writes (matplotlib picks the format from the suffix).
@@ -295,6 +302,29 @@ def _sweep_parser(sub: Any) -> None:
     p.add_argument("--plot", nargs=2, metavar=("STORE", "VAR"), help="draw VAR of a store")
 
 
+def _modes_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "modes",
+        help="nonlinear mode: frequency and damping ratio against amplitude (EPMC)",
+        description=(
+            "Nonlinear mode of the joint in STUDY.toml (joint and losses; its excitation is "
+            "not used) by harmonic balance and the extended periodic motion concept, at "
+            "--points amplitudes spaced logarithmically over --amplitude."
+        ),
+    )
+    p.add_argument("study", help="study file (TOML), as for clearjoint simulate")
+    p.add_argument("--mode", type=int, default=1, help="mode number (default 1)")
+    p.add_argument(
+        "--amplitude", required=True, help="modal amplitude range, e.g. 1um..1mm (or one value)"
+    )
+    p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
+    p.add_argument("--harmonics", type=int, default=7, help="H (default 7)")
+    p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
+    p.add_argument("--plot", help="draw frequency and damping against amplitude (.png)")
+    p.add_argument("--json", action="store_true", help="print the mode as one JSON object")
+    p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
+
+
 def _structure_parser(sub: Any) -> None:
     p = sub.add_parser(
         "structure",
@@ -327,6 +357,7 @@ def build_parser() -> argparse.ArgumentParser:
     _report_parser(sub)
     _frf_parser(sub)
     _sweep_parser(sub)
+    _modes_parser(sub)
     _structure_parser(sub)
     return parser
 
@@ -844,6 +875,15 @@ def _run_frf(args: argparse.Namespace) -> int:
         "friction": study.friction,
         "restitution": study.restitution,
     }
+    if args.method == "harmonic":
+        import functools
+
+        from clearjoint import harmonic
+
+        h = 7 if args.harmonics is None else args.harmonics
+        frequency_response = functools.partial(harmonic.frequency_response, harmonics=h)
+    elif args.harmonics is not None:
+        raise ParameterError("--harmonics goes with --method harmonic; drop it or add that")
     if args.parameter == "force":
         frequency = (
             parse_quantity(args.frequency, "frequency", name="--frequency")
@@ -1020,6 +1060,87 @@ def _refuse_file_as_folder(path: str, option: str) -> None:
             return
 
 
+def _amplitude_range(text: str, points: int) -> Any:
+    """'1um..1mm' -> ``points`` values spaced logarithmically (m); one value -> itself."""
+    import numpy as np
+
+    from clearjoint.units import parse_quantity
+
+    if points < 1:
+        raise ParameterError(f"--points must be >= 1, got {points}")
+    parts = text.split("..")
+    if len(parts) > 2:
+        raise ParameterError(f"--amplitude: write a range like 1um..1mm, got {text!r}")
+    values = [parse_quantity(part, "length", name="--amplitude") for part in parts]
+    if any(not value > 0.0 for value in values):
+        raise ParameterError(
+            f"--amplitude must start above zero (a mode has no amplitude 0), got {text!r}; "
+            "write it like 1um..1mm"
+        )
+    if len(values) == 1:
+        return np.array(values)
+    if values[0] == values[1]:
+        raise ParameterError(f"--amplitude range {text!r} has zero width; give two values")
+    return np.geomspace(values[0], values[1], points)
+
+
+def _run_modes(args: argparse.Namespace) -> int:
+    import math
+
+    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.harmonic import nonlinear_modes
+    from clearjoint.simulate.study import load_study
+
+    study = load_study(args.study)
+    outputs = [Path(args.out)] + ([Path(args.plot)] if args.plot else [])
+    refuse_to_overwrite(outputs, force=args.force)
+    amplitudes = _amplitude_range(args.amplitude, args.points)
+    mode = nonlinear_modes(
+        study.joint,
+        args.mode,
+        amplitudes,
+        harmonics=args.harmonics,
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+    )
+    data = mode.to_xarray()
+    data.attrs["study"] = study.source
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    data.to_netcdf(args.out, engine="h5netcdf")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        figure: Any = mode.plot().figure
+        figure.savefig(args.plot, dpi=120, bbox_inches="tight")
+    missing = int((~mode.converged).sum())
+    if missing:
+        print(
+            f"clearjoint modes: warning: no mode found at {missing} of {mode.amplitude.size} "
+            "amplitudes (NaN there; e.g. a mass floating in its gap)",
+            file=sys.stderr,
+        )
+
+    def finite(values: Any) -> list[float | None]:
+        return [float(v) if math.isfinite(v) else None for v in values]
+
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "amplitude_m": mode.amplitude.tolist(),
+                    "frequency_hz": finite(mode.frequency / (2 * math.pi)),
+                    "damping_ratio": finite(mode.damping_ratio),
+                    "energy_per_cycle_j": finite(mode.energy_per_cycle),
+                }
+            )
+        )
+        return 0
+    print("\n".join([f"study: {study.source}", repr(mode), f"wrote {args.out}"]))
+    return 0
+
+
 def _run_structure(args: argparse.Namespace) -> int:
     import math
 
@@ -1115,6 +1236,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "report": _run_report,
         "frf": _run_frf,
         "sweep": _run_sweep,
+        "modes": _run_modes,
         "structure": _run_structure,
     }
     try:

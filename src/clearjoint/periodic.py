@@ -267,6 +267,12 @@ class FrequencyResponse:
     parameter : {"omega", "force"}
     stop_reason : str
         Why the continuation stopped ("reached" when it got to the end).
+    coefficients : ndarray, optional
+        Harmonic balance only (``method == "harmonic"``): the harmonic coefficients
+        a_0, a_1, b_1, ..., a_H, b_H of each point, m, (n, 2H + 1) for a Joint and
+        (n, 2H + 1, N) for a Structure (whose x_max, x_min, amplitude are then (n, N)).
+    method : {"shooting", "harmonic"}
+        Exact shooting (this module) or harmonic balance (``clearjoint.harmonic``).
     """
 
     omega: FloatArray
@@ -281,6 +287,8 @@ class FrequencyResponse:
     parameter: str
     stop_reason: str
     settings: dict[str, Any] = field(repr=False, default_factory=dict)
+    coefficients: FloatArray | None = field(repr=False, default=None)
+    method: str = "shooting"
 
     def __repr__(self) -> str:
         kinds = ", ".join(
@@ -297,6 +305,11 @@ class FrequencyResponse:
 
     def cycle(self, index: int) -> SteadyState:
         """The orbit at point ``index`` as a SteadyState (stages, energy ledger), re-run exactly."""
+        if self.method != "shooting":
+            raise ParameterError(
+                "cycle() re-runs exact orbits of a shooting curve; for a harmonic-balance point "
+                "use clearjoint.periodic.periodic_orbit(..., initial=initial_state[index])"
+            )
         s = self.settings
         p = _parameters(
             s["joint"],
@@ -362,16 +375,21 @@ class FrequencyResponse:
         """The curve as an xarray Dataset over ``point`` (and ``event``), units in attrs."""
         import xarray as xr
 
-        return xr.Dataset(
+        # harmonic balance of a Structure: per-DOF extremes (n, N), u(0) then u'(0) (n, 2N)
+        per = ("point",) if self.x_max.ndim == 1 else ("point", "dof")
+        n_dof = 1 if self.x_max.ndim == 1 else self.x_max.shape[1]
+        x0 = self.initial_state[:, :n_dof].reshape(self.x_max.shape)
+        v0 = self.initial_state[:, n_dof:].reshape(self.x_max.shape)
+        ds = xr.Dataset(
             {
-                "x_max": ("point", self.x_max, {"units": "m"}),
-                "x_min": ("point", self.x_min, {"units": "m"}),
-                "amplitude": ("point", self.amplitude, {"units": "m"}),
+                "x_max": (per, self.x_max, {"units": "m"}),
+                "x_min": (per, self.x_min, {"units": "m"}),
+                "amplitude": (per, self.amplitude, {"units": "m"}),
                 "stable": ("point", self.stable.astype(np.int8), {"units": "1 stable, 0 not"}),
                 "multiplier_real": (("point", "multiplier"), self.multipliers.real.copy()),
                 "multiplier_imag": (("point", "multiplier"), self.multipliers.imag.copy()),
-                "initial_displacement": ("point", self.initial_state[:, 0], {"units": "m"}),
-                "initial_velocity": ("point", self.initial_state[:, 1], {"units": "m/s"}),
+                "initial_displacement": (per, x0, {"units": "m"}),
+                "initial_velocity": (per, v0, {"units": "m/s"}),
                 "event_kind": ("event", np.array([e.kind for e in self.events], dtype=str)),
                 "event_frequency": (
                     "event",
@@ -398,8 +416,18 @@ class FrequencyResponse:
                 "title": "clearjoint frequency response (exact periodic orbits, continuation)",
                 "parameter": self.parameter,
                 "stop_reason": self.stop_reason,
+                "method": self.method,
             },
         )
+        if self.coefficients is not None:
+            dims = ("point", "coefficient", "dof")[: self.coefficients.ndim]
+            ds["coefficients"] = (
+                dims,
+                self.coefficients,
+                {"units": "m", "order": "a_0, a_1, b_1, ..., a_H, b_H of cos/sin(h w t)"},
+            )
+            ds.attrs["title"] = "clearjoint frequency response (harmonic balance, continuation)"
+        return ds
 
 
 def _map_residual(p: FloatArray, parameter: str) -> Any:

@@ -1,0 +1,350 @@
+"""Nonlinear modes by the extended periodic motion concept (EPMC, MODEL.md 5.4).
+
+Krack, Computers & Structures 154 (2015): the damped free motion is made periodic
+by an artificial negative damping -xi M u'. With harmonic balance the unknowns are
+the coefficients Q, w and xi, and two conditions close the system at a prescribed
+modal amplitude a: the fundamental cosine coefficient of the mode's reference DOF
+is a, its sine coefficient 0 (the phase). Then
+
+    natural frequency w(a),   damping ratio zeta(a) = xi / (2 w),
+    energy dissipated per cycle = xi * integral of u'^T M u' dt over one period.
+
+For one joint without losses xi = 0 and w(a) is the paper's 2 pi / T(A) of
+section 1 (the dynamic stiffness is the backbone of the mode).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from clearjoint.errors import ParameterError, ParameterTypeError
+from clearjoint.harmonic import aft
+from clearjoint.harmonic.solve import newton
+from clearjoint.harmonic.system import HarmonicError, LinearSystem, build, scale_length
+from clearjoint.joint import Friction
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.axes import Axes
+
+FloatArray = NDArray[np.float64]
+
+#: Solutions with w below this fraction of the closed-pattern frequency are not modes.
+_LOWEST = 1e-3
+
+
+@dataclass(frozen=True)
+class NonlinearMode:
+    """One nonlinear mode's properties against its amplitude (EPMC, MODEL.md 5.4).
+
+    Attributes
+    ----------
+    amplitude : (n,) ndarray
+        The modal amplitude a, m: the fundamental harmonic's amplitude on the
+        mode's reference DOF (``reference_dof``), ascending.
+    x_max, x_min : ndarray
+        Extremes of the motion per DOF, m: (n,) for a Joint, (n, N) for a Structure.
+    frequency : (n,) ndarray
+        Natural frequency w(a), rad/s.
+    damping_ratio : (n,) ndarray
+        zeta(a) = xi / (2 w).
+    energy_per_cycle : (n,) ndarray
+        Energy the losses dissipate per cycle, xi * integral u'^T M u' dt, J.
+    harmonic_shapes : ndarray
+        The harmonic coefficients a_0, a_1, b_1, ..., a_H, b_H, m: (n, 2H + 1) for
+        a Joint, (n, 2H + 1, N) for a Structure.
+    converged : (n,) ndarray of bool
+        False where no mode was found at that amplitude (e.g. a mass that stays in
+        a gap without restoring force, which would give w -> 0: solutions below
+        1e-3 of the closed-pattern frequency are refused); the other arrays hold
+        NaN there.
+    mode : int
+        The mode number (1 = lowest of the closed pattern).
+    harmonics : int
+        H.
+    reference_dof : str
+        The DOF the amplitude is measured on.
+    """
+
+    amplitude: FloatArray
+    x_max: FloatArray = field(repr=False)
+    x_min: FloatArray = field(repr=False)
+    frequency: FloatArray = field(repr=False)
+    damping_ratio: FloatArray = field(repr=False)
+    energy_per_cycle: FloatArray = field(repr=False)
+    harmonic_shapes: FloatArray = field(repr=False)
+    converged: NDArray[np.bool_] = field(repr=False)
+    mode: int = 1
+    harmonics: int = 7
+    reference_dof: str = "x"
+
+    def __repr__(self) -> str:
+        ok = self.converged
+        f = self.frequency[ok] / (2.0 * math.pi)
+        z = self.damping_ratio[ok]
+        span = f"{f.min():.4g}-{f.max():.4g} Hz, zeta {z.min():.3g}-{z.max():.3g}" if f.size else ""
+        return (
+            f"NonlinearMode(mode {self.mode}, H={self.harmonics}, {self.amplitude.size} amplitudes "
+            f"{self.amplitude.min():.3g}-{self.amplitude.max():.3g} m on {self.reference_dof}, "
+            f"{span}, {int(np.sum(~ok))} not converged)"
+        )
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Plot frequency (Hz, solid) and damping ratio (dashed, right axis) against amplitude.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The frequency axes (the damping ratio is on its twin).
+        """
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6.4, 4.0))
+        a_um = self.amplitude * 1e6
+        ax.plot(a_um, self.frequency / (2.0 * math.pi), "-", color="C0", label="frequency")
+        ax.set_xlabel(f"modal amplitude on {self.reference_dof} (um)")
+        ax.set_ylabel("natural frequency (Hz)", color="C0")
+        if self.amplitude.size > 1 and self.amplitude.max() > 10.0 * self.amplitude.min():
+            ax.set_xscale("log")
+        if np.any(self.damping_ratio[self.converged] > 0.0):
+            twin = ax.twinx()
+            twin.plot(a_um, self.damping_ratio, "--", color="C3", label="damping ratio")
+            twin.set_ylabel("damping ratio", color="C3")
+        ax.set_title(f"nonlinear mode {self.mode} (EPMC, H = {self.harmonics})")
+        return ax
+
+    def to_xarray(self) -> xr.Dataset:
+        """The mode as an xarray Dataset over ``amplitude`` (and ``dof``), units in attrs."""
+        import xarray as xr
+
+        per = ("amplitude",) if self.x_max.ndim == 1 else ("amplitude", "dof")
+        shape_dims = ("amplitude", "coefficient", "dof")[: self.harmonic_shapes.ndim]
+        return xr.Dataset(
+            {
+                "frequency": ("amplitude", self.frequency / (2.0 * math.pi), {"units": "Hz"}),
+                "omega": ("amplitude", self.frequency, {"units": "rad/s"}),
+                "damping_ratio": ("amplitude", self.damping_ratio, {"units": "1"}),
+                "energy_per_cycle": ("amplitude", self.energy_per_cycle, {"units": "J"}),
+                "x_max": (per, self.x_max, {"units": "m"}),
+                "x_min": (per, self.x_min, {"units": "m"}),
+                "harmonic_shapes": (
+                    shape_dims,
+                    self.harmonic_shapes,
+                    {"units": "m", "order": "a_0, a_1, b_1, ..., a_H, b_H of cos/sin(h w t)"},
+                ),
+                "converged": ("amplitude", self.converged.astype(np.int8), {"units": "1 yes"}),
+            },
+            coords={"amplitude": ("amplitude", self.amplitude, {"units": "m"})},
+            attrs={
+                "title": "clearjoint nonlinear mode (EPMC, harmonic balance)",
+                "mode": self.mode,
+                "harmonics": self.harmonics,
+                "reference_dof": self.reference_dof,
+            },
+        )
+
+
+def _amplitudes(amplitudes: ArrayLike) -> FloatArray:
+    try:
+        a = np.atleast_1d(np.asarray(amplitudes, dtype=np.float64))
+    except (TypeError, ValueError):
+        raise ParameterTypeError(
+            f"amplitudes must be an array of modal amplitudes in m, got {amplitudes!r}"
+        ) from None
+    if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)):
+        raise ParameterError("amplitudes must be a non-empty 1-D array of finite values (m)")
+    if np.any(a <= 0.0):
+        raise ParameterError(
+            f"amplitudes must be > 0 (m); the range starts at {float(a.min())!r}: "
+            "start it above zero (e.g. 1 um)"
+        )
+    return np.sort(a)
+
+
+def _reference(model: LinearSystem, mode: int) -> tuple[int, float, FloatArray]:
+    """(reference DOF, closed-pattern frequency, shape) of linear mode ``mode``."""
+    import scipy.linalg
+
+    n = model.n_dof
+    if isinstance(mode, bool) or not isinstance(mode, int | np.integer) or not 1 <= mode <= n:
+        what = "a Joint has only mode 1" if model.is_joint else f"the structure has modes 1 to {n}"
+        raise ParameterError(f"mode must be an integer from 1 to {n} ({what}), got {mode!r}")
+    w2, shapes = scipy.linalg.eigh(model.closed_stiffness(), model.mass)
+    shape = shapes[:, int(mode) - 1]
+    ref = int(np.argmax(np.abs(shape)))
+    return ref, math.sqrt(max(float(w2[int(mode) - 1]), 0.0)), shape / shape[ref]
+
+
+def nonlinear_modes(
+    system: Any,
+    mode: int = 1,
+    amplitudes: ArrayLike | None = None,
+    *,
+    harmonics: int = 7,
+    samples: int | None = None,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+) -> NonlinearMode:
+    """Return a nonlinear mode's frequency, damping and shape against amplitude (MODEL.md 5.4).
+
+    EPMC with harmonic balance: at each modal amplitude a, solve for Q, w and the
+    negative damping xi that makes the free motion periodic. Amplitudes are solved
+    from the largest down, each from the one before.
+
+    Parameters
+    ----------
+    system : Joint or Structure
+    mode : int
+        Mode number, 1 to N, counted on the closed pattern (all joints in contact);
+        it also picks the reference DOF, where that linear mode moves most.
+    amplitudes : (n,) array_like, optional
+        Modal amplitudes a > 0, m: the fundamental harmonic's amplitude on the
+        reference DOF. Default: 40 values from c/2 to 20 c (c the largest clearance).
+    harmonics : int
+        H >= 1.
+    samples : int, optional
+        N_t, as for :func:`clearjoint.harmonic.frequency_response`.
+    damping_ratio : float
+        zeta of a Joint's linear part (c_v = 2 zeta sqrt(m k_c)).
+    friction, restitution
+        Refused (HarmonicError): friction is not carried by EPMC here yet, and
+        impacts need :mod:`clearjoint.periodic`.
+
+    Returns
+    -------
+    NonlinearMode
+
+    Raises
+    ------
+    ParameterError
+        A mode the system does not have, an amplitude at or below zero.
+    HarmonicError
+        Bad harmonics or samples, friction or restitution.
+    """
+    h, n_t = aft.check_harmonics(harmonics, samples)
+    if friction is not None and friction.force > 0.0:
+        raise HarmonicError(
+            "nonlinear_modes does not carry Coulomb friction yet; set friction=None, or use "
+            "clearjoint.harmonic.frequency_response (regularised) or clearjoint.periodic"
+        )
+    model = build(system, damping_ratio, friction, restitution)
+    ref, omega_lin, shape = _reference(model, mode)
+    length = scale_length(model)
+    amps = _amplitudes(
+        np.geomspace(0.5 * length, 20.0 * length, 40) if amplitudes is None else amplitudes
+    )
+    basis = aft.Basis.make(h, n_t)
+    n, n_c = model.n_dof, 2 * h + 1
+    n_u = n_c * n
+    k_ref = model.reference_stiffness
+    zero_force = np.zeros(n)
+
+    def solve_at(a: float, guess: FloatArray) -> FloatArray | None:
+        w_scale = max(omega_lin, 1e-300)
+
+        def function(z: FloatArray) -> tuple[FloatArray, FloatArray]:
+            q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
+            ev = aft.evaluate(model, basis, q, w, zero_force, negative_damping=xi)
+            d_xi = -w * ((basis.derivative @ q.reshape(n_c, n)) @ model.mass).ravel()
+            r = np.empty(n_u + 2)
+            r[:n_u] = ev.residual / (k_ref * a)
+            r[n_u] = z[n + ref] - 1.0  # a_1 on the reference DOF = a
+            r[n_u + 1] = z[2 * n + ref]  # b_1 there = 0 (phase)
+            jac = np.zeros((n_u + 2, n_u + 2))
+            jac[:n_u, :n_u] = ev.jacobian / k_ref
+            jac[:n_u, n_u] = ev.d_omega * w_scale / (k_ref * a)
+            jac[:n_u, n_u + 1] = d_xi * w_scale / (k_ref * a)
+            jac[n_u, n + ref] = 1.0
+            jac[n_u + 1, 2 * n + ref] = 1.0
+            return r, jac
+
+        found = newton(function, guess, 1.0)
+        if found is None:
+            return None
+        z = found[0]
+        # w -> 0 is no mode: a mass floating in a gap with no restoring force (k0 = 0)
+        if not (z[n_u] > _LOWEST and np.all(np.isfinite(z))):
+            return None
+        return z
+
+    results: dict[int, FloatArray] = {}
+    guess = _first_guess(model, basis, shape, omega_lin, n_u)
+    for i in range(amps.size - 1, -1, -1):
+        z = solve_at(float(amps[i]), guess)
+        if z is None and i == amps.size - 1:
+            continue
+        if z is not None:
+            results[i] = z
+            guess = z
+    return _mode(model, basis, amps, results, int(mode), ref, omega_lin)
+
+
+def _first_guess(
+    model: LinearSystem, basis: aft.Basis, shape: FloatArray, omega: float, n_u: int
+) -> FloatArray:
+    """The closed-pattern linear mode at unit amplitude: a_1 = shape, w = w_closed, xi = 0."""
+    n = model.n_dof
+    z = np.zeros(n_u + 2)
+    z[n : 2 * n] = shape
+    z[n_u] = 1.0
+    return z
+
+
+def _mode(
+    model: LinearSystem,
+    basis: aft.Basis,
+    amps: FloatArray,
+    results: dict[int, FloatArray],
+    mode: int,
+    ref: int,
+    omega_lin: float,
+) -> NonlinearMode:
+    n, n_c = model.n_dof, 2 * basis.harmonics + 1
+    n_u = n_c * n
+    count = amps.size
+    coef = np.full((count, n_c, n), np.nan)
+    omega = np.full(count, np.nan)
+    xi = np.full(count, np.nan)
+    for i, z in results.items():
+        coef[i] = (z[:n_u] * amps[i]).reshape(n_c, n)
+        omega[i] = z[n_u] * omega_lin
+        xi[i] = z[n_u + 1] * omega_lin
+    converged = np.isfinite(omega)
+    x_max = np.full((count, n), np.nan)
+    x_min = np.full((count, n), np.nan)
+    energy = np.full(count, np.nan)
+    ok = np.flatnonzero(converged)
+    if ok.size:
+        cols = coef[ok].transpose(1, 0, 2).reshape(n_c, ok.size * n)
+        top, bottom = basis.extremes(cols)
+        x_max[ok] = top.reshape(ok.size, n)
+        x_min[ok] = bottom.reshape(ok.size, n)
+        # integral of u'^T M u' dt over T = 2 pi / w, from the velocity coefficients
+        vel = omega[ok, None, None] * np.einsum("cd,pdn->pcn", basis.derivative, coef[ok])
+        weights = np.full(n_c, 0.5)
+        weights[0] = 1.0
+        mean_square = np.einsum("c,pcn,nm,pcm->p", weights, vel, model.mass, vel)
+        energy[ok] = xi[ok] * mean_square * (2.0 * math.pi / omega[ok])
+    shapes = coef
+    if model.is_joint:
+        x_max, x_min, shapes = x_max[:, 0], x_min[:, 0], coef[:, :, 0]
+    return NonlinearMode(
+        amplitude=amps,
+        x_max=x_max,
+        x_min=x_min,
+        frequency=omega,
+        damping_ratio=xi / (2.0 * omega),
+        energy_per_cycle=energy,
+        harmonic_shapes=shapes,
+        converged=converged,
+        mode=mode,
+        harmonics=basis.harmonics,
+        reference_dof=model.dof_names[ref],
+    )

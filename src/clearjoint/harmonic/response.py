@@ -1,0 +1,412 @@
+"""Frequency-response curves by harmonic balance with pseudo-arclength continuation (MODEL.md 5.3).
+
+The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the force
+amplitude) by the same continuation as the exact shooting of
+:mod:`clearjoint.periodic`, and returned as the same
+:class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
+kept. Stability comes from Hill's method; events are located as in
+:mod:`clearjoint.periodic`: folds where the parameter component of the tangent
+changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
+through -1), grazings where a joint's extreme relative displacement crosses a gap
+edge.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from clearjoint import _checks
+from clearjoint.continuation import ContinuationSettings, continue_branch
+from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.harmonic import aft
+from clearjoint.harmonic.solve import TOLERANCE, linear_guess, newton
+from clearjoint.harmonic.system import (
+    HarmonicError,
+    LinearSystem,
+    build,
+    force_vector,
+    friction_speed,
+    scale_length,
+)
+from clearjoint.joint import Friction
+from clearjoint.periodic import FrequencyResponse, ResponseEvent
+
+FloatArray = NDArray[np.float64]
+
+
+def _range(
+    parameter: str,
+    force_amplitude: float,
+    omega_start: float,
+    omega_stop: float | None,
+    force_stop: float | None,
+) -> tuple[float, float]:
+    if parameter == "omega":
+        if omega_stop is None:
+            raise ParameterError("omega_stop is required with parameter='omega' (rad/s)")
+        w1 = _checks.positive("omega_stop", omega_stop, unit="rad/s")
+        if w1 == omega_start:
+            raise ParameterError(
+                f"the omega range has zero width ({omega_start!r} to {w1!r} rad/s); give two values"
+            )
+        return omega_start, w1
+    if force_stop is None:
+        raise ParameterError(
+            "force_stop is required with parameter='force': give the end of the force range (N)"
+        )
+    f1 = _checks.positive("force_stop", force_stop, unit="N")
+    if f1 == force_amplitude:
+        raise ParameterError(
+            f"the force range has zero width ({force_amplitude!r} to {f1!r} N); give two values"
+        )
+    return force_amplitude, f1
+
+
+def frequency_response(
+    system: Any,
+    force: float | ArrayLike,
+    omega_start: float,
+    omega_stop: float | None,
+    *,
+    harmonics: int = 7,
+    samples: int | None = None,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+    parameter: Literal["omega", "force"] = "omega",
+    force_stop: float | None = None,
+    max_points: int = 2000,
+    max_step: float = 0.02,
+    friction_regularization: float | None = None,
+) -> FrequencyResponse:
+    """Return the frequency-response curve by harmonic balance and continuation (MODEL.md 5.3).
+
+    The periodic response to F sin(w t), truncated to ``harmonics`` harmonics plus
+    the mean, followed by pseudo-arclength continuation from ``omega_start`` to
+    ``omega_stop`` through folds, stable and unstable alike (Hill's method). With
+    ``parameter="force"`` it continues in the force amplitude from ``force`` to
+    ``force_stop`` at the fixed ``omega_start``.
+
+    Parameters
+    ----------
+    system : Joint or Structure
+    force : float or (N,) array_like
+        F0 > 0 in N for a Joint; the amplitude per DOF (N,) in N for a Structure
+        (with ``parameter="force"`` the curve scales this pattern, and
+        ``force_amplitude`` is its largest entry).
+    omega_start, omega_stop : float
+        rad/s, either order.
+    harmonics : int
+        H >= 1.
+    samples : int, optional
+        N_t time samples per period for AFT, >= 2 (2H + 1); default 32 (2H + 1)
+        rounded up to a power of two (fewer samples leave the sampled law's kinks
+        visible as small zigzags of the curve near a fold).
+    damping_ratio : float
+        zeta of a Joint's linear part, c_v = 2 zeta sqrt(m k_c).
+    friction : Friction, optional
+        Coulomb friction of a Joint over its whole path (region "everywhere"),
+        regularised as mu_s P tanh(v / v_eps); its error against the exact
+        stick-slip orbits of :mod:`clearjoint.periodic` is in docs/harmonic.md.
+        Friction over the free-play stroke only is refused.
+    restitution : float
+        Must be 1: impacts need :func:`clearjoint.periodic.frequency_response`.
+    parameter : {"omega", "force"}
+    force_stop : float, optional
+        End of the force range, N (largest entry for a Structure).
+    max_points : int
+        Largest number of points on the curve.
+    max_step : float
+        Largest arclength step in scaled coordinates (smaller: more points).
+    friction_regularization : float, optional
+        v_eps in m/s; default 1e-3 * omega_start * c (c the joint's clearance).
+
+    Returns
+    -------
+    FrequencyResponse
+        ``method == "harmonic"``; ``coefficients`` holds the harmonic coefficients,
+        (n, 2H + 1) for a Joint and (n, 2H + 1, N) for a Structure, rows a_0, a_1,
+        b_1, ..., a_H, b_H in m. For a Structure ``x_max``, ``x_min``,
+        ``amplitude`` are (n, N), ``multipliers`` (n, 2N) and ``initial_state``
+        (n, 2N): u(0) then u'(0).
+
+    Raises
+    ------
+    HarmonicError
+        Bad harmonics or samples, friction or restitution, no solution at the start.
+    ParameterError
+        A range of zero width, a value not finite and positive, a force of the wrong shape.
+    """
+    if parameter not in ("omega", "force"):
+        raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
+    h, n_t = aft.check_harmonics(harmonics, samples)
+    w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
+    model = build(
+        system,
+        damping_ratio,
+        friction,
+        restitution,
+        friction_speed(system, w0, friction_regularization),
+    )
+    pattern = force_vector(model, force)
+    peak = float(np.max(np.abs(pattern)))
+    start, stop = _range(parameter, peak, w0, omega_stop, force_stop)
+    unit_force = pattern / peak
+    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
+        raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
+    basis = aft.Basis.make(h, n_t)
+    k_ref = model.reference_stiffness
+
+    def at(lam: float) -> tuple[float, FloatArray]:
+        if parameter == "omega":
+            return lam, pattern
+        return w0, lam * unit_force
+
+    q0 = _start(model, basis, w0, pattern, k_ref)
+    x_scale = max(0.5 * scale_length(model), float(np.max(np.abs(q0))))
+
+    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
+        if not lam > 0.0:
+            raise HarmonicError(f"the parameter left the positive range ({lam!r})")
+        w, f = at(lam)
+        ev = aft.evaluate(model, basis, u, w, f)
+        if parameter == "omega":
+            d_lam = ev.d_omega
+        else:
+            d_lam = np.zeros_like(ev.residual)
+            d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
+        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, None
+
+    branch = continue_branch(
+        residual,
+        q0,
+        start,
+        stop,
+        u_scale=np.full(q0.size, x_scale),
+        lam_scale=abs(stop - start),
+        settings=ContinuationSettings(
+            step=min(0.002, max_step),
+            min_step=1e-7,
+            max_step=max_step,
+            max_points=max_points,
+            tolerance=TOLERANCE,
+        ),
+    )
+    return _response(
+        model,
+        basis,
+        branch.u,
+        branch.lam,
+        parameter,
+        w0,
+        pattern,
+        unit_force,
+        branch.reason,
+        {"system": system, "harmonics": h, "samples": n_t, "damping_ratio": damping_ratio},
+    )
+
+
+def _start(
+    model: LinearSystem, basis: aft.Basis, omega: float, force: FloatArray, k_ref: float
+) -> FloatArray:
+    """Solve HB at the start: Newton from the open and the closed linear responses, else a
+    continuation in the force from a level where the open linear response fits the gaps."""
+    scale = 0.5 * scale_length(model)
+
+    def function(q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        ev = aft.evaluate(model, basis, q, omega, force)
+        return ev.residual / k_ref, ev.jacobian / k_ref
+
+    for stiffness in (model.open_stiffness(), model.closed_stiffness()):
+        guess = linear_guess(model, basis, omega, force, stiffness)
+        found = newton(function, guess, max(scale, float(np.max(np.abs(guess)))))
+        if found is not None:
+            return found[0]
+    # Homotopy: from a force small enough for the open (all joints in free-play) linear
+    # response to stay inside every gap, follow the solution up to the full force.
+    open_guess = linear_guess(model, basis, omega, force, model.open_stiffness())
+    coef = open_guess.reshape(2 * basis.harmonics + 1, model.n_dof)
+    reach = np.hypot(coef[1], coef[2]) @ np.abs(model.directions.T)
+    room = np.minimum(model.g_c, model.g_t)
+    if reach.size and np.all(np.isfinite(reach)) and np.max(reach) > 0.0 and np.all(room > 0):
+        fraction = min(0.5 * float(np.min(room / np.maximum(reach, 1e-300))), 0.5)
+
+        def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
+            ev = aft.evaluate(model, basis, u, omega, lam * force)
+            d_lam = np.zeros_like(ev.residual)
+            d_lam.reshape(2 * basis.harmonics + 1, -1)[2] = -force
+            return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, None
+
+        try:
+            branch = continue_branch(
+                residual,
+                fraction * open_guess,
+                fraction,
+                1.0,
+                u_scale=np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess))))),
+                lam_scale=1.0,
+                settings=ContinuationSettings(
+                    step=0.01, min_step=1e-7, max_step=0.1, max_points=2000, tolerance=TOLERANCE
+                ),
+            )
+        except ClearjointError:
+            branch = None
+        if branch is not None and branch.reason == "reached":
+            return np.asarray(branch.u[-1], dtype=np.float64)
+    raise HarmonicError(
+        f"harmonic balance found no periodic response at omega_start = {omega!r} rad/s; "
+        "start the curve at another frequency"
+    )
+
+
+def _response(
+    model: LinearSystem,
+    basis: aft.Basis,
+    u: FloatArray,
+    lam: FloatArray,
+    parameter: str,
+    w0: float,
+    pattern: FloatArray,
+    unit_force: FloatArray,
+    reason: str,
+    settings: dict[str, Any],
+) -> FrequencyResponse:
+    n_pts = lam.size
+    n, n_c = model.n_dof, 2 * basis.harmonics + 1
+    omega = lam.copy() if parameter == "omega" else np.full(n_pts, w0)
+    peak = float(np.max(np.abs(pattern)))
+    force = lam.copy() if parameter == "force" else np.full(n_pts, peak)
+    coef = u.reshape(n_pts, n_c, n)
+    # extremes per DOF and per joint (the relative displacements, for grazing)
+    cols = coef.transpose(1, 0, 2).reshape(n_c, n_pts * n)
+    x_max, x_min = (v.reshape(n_pts, n) for v in basis.extremes(cols))
+    b = model.directions
+    rel = np.einsum("pcn,jn->cpj", coef, b).reshape(n_c, -1)
+    d_max, d_min = (v.reshape(n_pts, b.shape[0]) for v in basis.extremes(rel))
+    multipliers = np.empty((n_pts, 2 * n), dtype=np.complex128)
+    for i in range(n_pts):
+        f = pattern if parameter == "omega" else force[i] * unit_force
+        ev = aft.evaluate(model, basis, u[i], float(omega[i]), f)
+        lam_i = aft.hill_exponents(model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent)
+        multipliers[i] = aft.hill_multipliers(lam_i, float(omega[i]))
+    stable = np.max(np.abs(multipliers), axis=1) < 1.0
+    amplitude = 0.5 * (x_max - x_min)
+    x0 = coef[:, 0, :] + coef[:, 1::2, :].sum(axis=1)
+    v0 = omega[:, None] * np.einsum("c,pcn->pn", _velocity_row(basis), coef)
+    initial = np.concatenate((x0, v0), axis=1)
+    events = _events(model, lam, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1))
+    if model.is_joint:
+        x_max, x_min, amplitude, coef_out = x_max[:, 0], x_min[:, 0], amplitude[:, 0], coef[:, :, 0]
+    else:
+        coef_out = coef
+    return FrequencyResponse(
+        omega=omega,
+        force_amplitude=force,
+        x_max=x_max,
+        x_min=x_min,
+        amplitude=amplitude,
+        stable=stable,
+        multipliers=multipliers,
+        initial_state=initial,
+        events=events,
+        parameter=parameter,
+        stop_reason=reason,
+        settings=settings,
+        coefficients=coef_out.copy(),
+        method="harmonic",
+    )
+
+
+def _velocity_row(basis: aft.Basis) -> FloatArray:
+    """Row r with u'(0) / w = r . coefficients: sum over h of h b_h."""
+    row = np.zeros(2 * basis.harmonics + 1)
+    row[2::2] = np.arange(1, basis.harmonics + 1)
+    return row
+
+
+#: Reversals of the parameter smaller than this fraction of it are not folds.
+FOLD_TOLERANCE = 5e-4
+
+
+def _turning_points(lam: FloatArray, tolerance: float) -> list[int]:
+    """Indices where ``lam`` reaches an extreme and then goes back by more than ``tolerance``."""
+    points: list[int] = []
+    direction = 0.0
+    extreme = 0
+    for i in range(1, lam.size):
+        step = float(lam[i] - lam[extreme])
+        if direction == 0.0:
+            if abs(step) > tolerance:
+                direction, extreme = math.copysign(1.0, step), i
+        elif direction * step > 0.0:
+            extreme = i
+        elif -direction * step > tolerance:
+            points.append(extreme)
+            direction, extreme = -direction, i
+    return points
+
+
+def _events(
+    model: LinearSystem,
+    lam: FloatArray,
+    multipliers: NDArray[np.complex128],
+    d_max: FloatArray,
+    d_min: FloatArray,
+    omega: FloatArray,
+    force: FloatArray,
+    amplitude: FloatArray,
+) -> list[ResponseEvent]:
+    """Folds, period doublings and grazings between successive points.
+
+    Period doublings and grazings are located linearly between the points where
+    their test function changes sign. Folds are the points where the parameter
+    turns back by more than ``FOLD_TOLERANCE`` of its largest value: the sampled
+    law makes the HB branch zigzag by about 1e-4 of the parameter where it is
+    nearly flat at a fold (each sample crossing a gap edge is a tiny kink), and
+    those reversals, below the truncation error, are not folds.
+    """
+    found: list[tuple[int, ResponseEvent]] = [
+        (i, ResponseEvent("fold", float(omega[i]), float(force[i]), float(amplitude[i])))
+        for i in _turning_points(lam, FOLD_TOLERANCE * float(np.max(np.abs(lam))))
+    ]
+    tests: list[tuple[str, FloatArray, str]] = [
+        (
+            "period_doubling",
+            np.prod(1.0 + multipliers, axis=1).real,
+            "a multiplier passes -1: a period-2 branch is born here (not followed)",
+        ),
+    ]
+    for j in range(model.directions.shape[0]):
+        name = "" if model.is_joint else f" of joint {j}"
+        tests.append(("grazing", d_max[:, j] - model.g_c[j], f"touches the compression edge{name}"))
+        tests.append(("grazing", -model.g_t[j] - d_min[:, j], f"touches the tension edge{name}"))
+    for kind, g, note in tests:
+        for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
+            frac = float(g[i] / (g[i] - g[i + 1]))
+
+            def lerp(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
+                return float(a[i] + frac * (a[i + 1] - a[i]))
+
+            found.append(
+                (int(i), ResponseEvent(kind, lerp(omega), lerp(force), lerp(amplitude), note))
+            )
+    found.sort(key=lambda item: item[0])
+    merged: list[tuple[int, ResponseEvent]] = []
+    for index, event in found:
+        last = merged[-1] if merged else None
+        if last and event.kind == "grazing" and last[1].kind == "grazing" and last[0] == index:
+            both = ResponseEvent(
+                "grazing",
+                event.omega,
+                event.force_amplitude,
+                event.amplitude,
+                f"{last[1].note}; {event.note}",
+            )
+            merged[-1] = (index, both)
+            continue
+        merged.append((index, event))
+    return [e for _, e in merged]

@@ -1,0 +1,74 @@
+"""Newton's method on the harmonic-balance residual, and the linear first guesses (MODEL.md 5.3).
+
+Shared by the frequency response and the nonlinear modes. Residuals are made
+dimensionless by a reference stiffness and a length, so one tolerance serves
+every system.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from clearjoint.harmonic.aft import Basis
+from clearjoint.harmonic.system import LinearSystem
+
+FloatArray = NDArray[np.float64]
+
+#: Converged when max |R| / (k_ref x_scale) is below this.
+TOLERANCE = 1e-11
+
+
+def linear_guess(
+    system: LinearSystem, basis: Basis, omega: float, force: FloatArray, stiffness: FloatArray
+) -> FloatArray:
+    """First-harmonic response of M u'' + C u' + K_s u = F sin(w t), flattened as HB unknowns.
+
+    With X = (K_s - w^2 M + i w C)^-1 F, u = Im(X e^(i w t)), so a_1 = Im X, b_1 = Re X.
+    A singular K_s - w^2 M (a free mechanism) is solved in the least-squares sense.
+    """
+    n = system.n_dof
+    z = stiffness - omega**2 * system.mass + 1j * omega * system.damping
+    x = np.linalg.lstsq(z, force.astype(np.complex128), rcond=None)[0]
+    coef = np.zeros((2 * basis.harmonics + 1, n))
+    coef[1] = x.imag
+    coef[2] = x.real
+    return coef.ravel()
+
+
+def newton(
+    function: Callable[[FloatArray], tuple[FloatArray, FloatArray]],
+    q0: FloatArray,
+    scale: float,
+    *,
+    max_iterations: int = 80,
+) -> tuple[FloatArray, int] | None:
+    """Damped Newton on a dimensionless residual: ``function(q) -> (R, dR/dq)``.
+
+    Steps are halved (up to 12 times) until max |R| falls; ``scale`` (m) makes q
+    dimensionless in the convergence test. Returns (q, iterations) or None.
+    """
+    q = q0.copy()
+    r, jac = function(q)
+    size = float(np.max(np.abs(r)))
+    for iteration in range(max_iterations):
+        if not np.isfinite(size):
+            return None
+        if size <= TOLERANCE * scale:
+            return q, iteration
+        try:
+            dq = np.linalg.solve(jac, -r)
+        except np.linalg.LinAlgError:
+            dq = np.linalg.lstsq(jac, -r, rcond=None)[0]
+        step = 1.0
+        for _ in range(13):
+            trial = q + step * dq
+            r_t, jac_t = function(trial)
+            size_t = float(np.max(np.abs(r_t)))
+            if size_t < size or size_t <= TOLERANCE * scale:
+                break
+            step *= 0.5
+        q, r, jac, size = trial, r_t, jac_t, size_t
+    return (q, max_iterations) if size <= TOLERANCE * scale else None

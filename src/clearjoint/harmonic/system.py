@@ -1,0 +1,259 @@
+"""A joint or a structure as harmonic balance sees it: linear matrices plus joint laws.
+
+MODEL.md 5.2-5.3. Harmonic balance needs
+
+    M u'' + C u' + K u + sum_j b_j f_j(b_j^T u) = F sin(w t)
+
+with f_j the piecewise-linear law of section 0 (k0, k_c, k_t, g_c, g_t). A
+:class:`~clearjoint.Joint` is the one-DOF case (M = m, K = 0, b = 1, the whole
+restoring force in the law, C = c_v from the damping ratio); a
+:class:`~clearjoint.structure.Structure` gives its matrices, its joint directions and
+each joint's law in series with its member.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from clearjoint import _checks
+from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
+from clearjoint.joint import ClearanceJoint, Friction, Joint
+from clearjoint.stiffness import viscous_coefficient
+
+FloatArray = NDArray[np.float64]
+
+
+class HarmonicError(ClearjointError, ValueError):
+    """Harmonic balance cannot be set up or solved as asked (the message says what to change)."""
+
+
+@dataclass(frozen=True)
+class LinearSystem:
+    """The matrices and joint laws of one system, in SI, dense.
+
+    Attributes
+    ----------
+    mass, damping, stiffness : (N, N) ndarray
+        M (kg), C (N s/m), K (N/m) of the linear part (K excludes the joints' laws).
+    directions : (n_j, N) ndarray
+        Row j is b_j: delta_j = b_j . u.
+    k0, k_c, k_t, g_c, g_t : (n_j,) ndarray
+        Each joint's free-play stiffness, contact stiffnesses (N/m) and gap edges (m).
+    dof_names : list of str
+    is_joint : bool
+        True for a single :class:`Joint` (one DOF, its x).
+    source : Joint or Structure
+    friction_force : (n_j,) ndarray, optional
+        Coulomb force mu_s P of each joint, N, regularised as mu_s P tanh(v / v_eps).
+    friction_speed : float
+        The regularisation speed v_eps, m/s.
+    """
+
+    mass: FloatArray
+    damping: FloatArray
+    stiffness: FloatArray
+    directions: FloatArray
+    k0: FloatArray
+    k_c: FloatArray
+    k_t: FloatArray
+    g_c: FloatArray
+    g_t: FloatArray
+    dof_names: list[str]
+    is_joint: bool
+    source: Any
+    friction_force: FloatArray | None = None
+    friction_speed: float = 0.0
+
+    @property
+    def n_dof(self) -> int:
+        """N, the number of degrees of freedom."""
+        return int(self.mass.shape[0])
+
+    @property
+    def reference_stiffness(self) -> float:
+        """A typical stiffness (N/m) to make residuals dimensionless: the largest closed one."""
+        k_closed = np.diag(self.stiffness) + (
+            (self.k0 + np.maximum(self.k_c, self.k_t)) @ self.directions**2
+        )
+        return float(max(np.max(np.abs(k_closed)), 1e-300))
+
+    def closed_stiffness(self) -> FloatArray:
+        """K plus every joint in compression contact (its tangent k0 + k_c), N/m."""
+        b = self.directions
+        return np.asarray(self.stiffness + (b.T * (self.k0 + self.k_c)) @ b, dtype=np.float64)
+
+    def open_stiffness(self) -> FloatArray:
+        """K plus every joint in free-play (its tangent k0), N/m."""
+        b = self.directions
+        return np.asarray(self.stiffness + (b.T * self.k0) @ b, dtype=np.float64)
+
+    def joint_forces(self, delta: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Return f_j(delta) (N) and df_j/d delta (N/m) for samples ``delta`` (N_t, n_j)."""
+        over = delta - self.g_c
+        under = delta + self.g_t
+        force = (
+            self.k0 * delta + self.k_c * np.maximum(over, 0.0) + self.k_t * np.minimum(under, 0.0)
+        )
+        tangent = self.k0 + self.k_c * (over > 0.0) + self.k_t * (under < 0.0)
+        return force, tangent
+
+    def friction_forces(self, speed: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Return mu_s P tanh(v / v_eps) (N) and its derivative in v (N s/m), samples (N_t, n_j)."""
+        assert self.friction_force is not None
+        ratio = np.tanh(speed / self.friction_speed)
+        return (
+            self.friction_force * ratio,
+            (self.friction_force / self.friction_speed) * (1.0 - ratio * ratio),
+        )
+
+
+def _refuse_losses(
+    friction: Friction | None, restitution: float, where: str, *, allow_friction: bool = False
+) -> None:
+    if friction is not None and friction.force > 0.0 and friction.region != "everywhere":
+        raise HarmonicError(
+            f"Coulomb friction over the free-play stroke only ({where}) is not carried by "
+            "clearjoint.harmonic; use clearjoint.periodic, or region='everywhere'"
+        )
+    if friction is not None and friction.force > 0.0 and not allow_friction:
+        raise HarmonicError(
+            f"Coulomb friction ({where}) is not carried by clearjoint.harmonic; "
+            "use clearjoint.periodic (exact orbits with stick-slip) or set friction=None"
+        )
+    if restitution != 1.0:
+        raise HarmonicError(
+            f"restitution {restitution!r} ({where}) is an impact event that harmonic balance "
+            "cannot carry; use clearjoint.periodic.frequency_response for exact orbits with "
+            "impacts, or set restitution=1"
+        )
+
+
+def from_joint(
+    joint: Joint,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+    friction_speed: float = 0.0,
+) -> LinearSystem:
+    """The one-DOF system of a :class:`Joint` with viscous damping c_v = 2 zeta sqrt(m k_c).
+
+    Coulomb friction (region "everywhere") is regularised as mu_s P tanh(v / v_eps),
+    v_eps = ``friction_speed`` (m/s, > 0 when there is friction).
+    """
+    e = _checks.real_scalar("restitution", restitution)
+    _refuse_losses(friction, e, "on the joint", allow_friction=True)
+    force = None
+    if friction is not None and friction.force > 0.0:
+        force = np.array([friction.force])
+        friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
+    c_v = viscous_coefficient(joint, damping_ratio)
+    one = np.ones((1, 1))
+    return LinearSystem(
+        mass=joint.mass * one,
+        damping=c_v * one,
+        stiffness=np.zeros((1, 1)),
+        directions=one.copy(),
+        k0=np.array([joint.gap_stiffness]),
+        k_c=np.array([joint.compression_stiffness]),
+        k_t=np.array([joint.tension_stiffness]),
+        g_c=np.array([joint.compression_gap]),
+        g_t=np.array([joint.tension_gap]),
+        dof_names=["x"],
+        is_joint=True,
+        source=joint,
+        friction_force=force,
+        friction_speed=float(friction_speed),
+    )
+
+
+def from_structure(structure: Any) -> LinearSystem:
+    """The system of a :class:`~clearjoint.structure.Structure` (dense matrices)."""
+    from clearjoint.structure.model import OPEN
+
+    laws: tuple[ClearanceJoint, ...] = structure.joint_laws
+    for index, law in zip(structure.joint_members, laws, strict=True):
+        _refuse_losses(law.friction, law.restitution, f"joint of member {index}")
+    n_j = len(laws)
+    k_lin, _ = structure.pattern_stiffness(np.full(n_j, OPEN, dtype=np.int64))
+    # pattern_stiffness("open") holds each joint's k0; the laws carry k0 themselves.
+    b = structure.joint_directions
+    k0 = np.array([law.gap_stiffness for law in laws])
+    k_lin = k_lin - (b.T * k0) @ b
+    return LinearSystem(
+        mass=np.diag(structure.mass_diagonal()),
+        damping=np.asarray(structure.damping_matrix(), dtype=np.float64),
+        stiffness=np.asarray(k_lin, dtype=np.float64),
+        directions=np.asarray(b, dtype=np.float64).reshape(n_j, structure.n_dof),
+        k0=k0,
+        k_c=np.array([law.compression_stiffness for law in laws]),
+        k_t=np.array([law.tension_stiffness for law in laws]),
+        g_c=np.array([law.compression_gap for law in laws]),
+        g_t=np.array([law.tension_gap for law in laws]),
+        dof_names=list(structure.dof_names),
+        is_joint=False,
+        source=structure,
+    )
+
+
+def build(
+    system: Any,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+    friction_speed: float = 0.0,
+) -> LinearSystem:
+    """A :class:`LinearSystem` from a Joint (with its losses) or a Structure."""
+    if isinstance(system, Joint):
+        return from_joint(system, damping_ratio, friction, restitution, friction_speed)
+    from clearjoint.structure.model import Structure
+
+    if isinstance(system, Structure):
+        if damping_ratio or friction is not None or restitution != 1.0:
+            raise ParameterError(
+                "damping_ratio, friction and restitution apply to a Joint; a Structure carries "
+                "its own damping (Member.damping, rayleigh) and joint losses"
+            )
+        return from_structure(system)
+    raise ParameterTypeError(
+        f"system must be a clearjoint.Joint or a clearjoint.structure.Structure, got {system!r}"
+    )
+
+
+def force_vector(system: LinearSystem, force: ArrayLike, name: str = "force") -> FloatArray:
+    """The force amplitudes per DOF (N): a number for a Joint, an (N,) array for a Structure."""
+    if system.is_joint:
+        return np.array([_checks.positive(name, force, unit="N")])
+    try:
+        f = np.asarray(force, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterTypeError(
+            f"{name} must be an array of {system.n_dof} force amplitudes (N), one per DOF, "
+            f"got {force!r}"
+        ) from None
+    if f.shape != (system.n_dof,):
+        raise ParameterError(
+            f"{name} must have one amplitude per DOF, shape ({system.n_dof},) in N "
+            f"(DOFs {', '.join(system.dof_names[:4])}...), got shape {f.shape}"
+        )
+    if not np.all(np.isfinite(f)) or not np.any(f != 0.0):
+        raise ParameterError(f"{name} must be finite and not all zero (N)")
+    return f
+
+
+def scale_length(system: LinearSystem) -> float:
+    """A typical length (m): the largest clearance, or 1 um if there is none."""
+    gaps = system.g_c + system.g_t
+    return float(max(np.max(gaps, initial=0.0), 1e-6)) if gaps.size else 1e-6
+
+
+def friction_speed(system: Any, omega: float, given: float | None) -> float:
+    """The regularisation speed v_eps (m/s): ``given``, or 1e-3 * omega * c for a Joint."""
+    if given is not None:
+        return _checks.positive("friction_regularization", given, unit="m/s")
+    if isinstance(system, Joint):
+        return 1e-3 * omega * max(system.clearance, 1e-6)
+    return 0.0

@@ -1,0 +1,122 @@
+"""Harmonic balance with AFT (MODEL.md 5.3): basis, exact Jacobian, bad input, convergence."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint import Friction, Joint
+from clearjoint.harmonic import HarmonicError, aft, solve, system
+from clearjoint.periodic import periodic_orbit
+
+#: pyHarm's SDOF clearance case (issue 10): m = 1, c_v = 0.05, k0 = 1, edges +-0.1745, +3.
+PYHARM = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_stiffness=1.0)
+PYHARM_ZETA = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 2 zeta sqrt(m k_c) = 0.05
+
+
+def _finite_difference(fun, q: np.ndarray, step: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+    cols = []
+    for i in range(q.size):
+        dq = np.zeros_like(q)
+        dq[i] = step
+        cols.append((fun(q + dq) - fun(q - dq)) / (2.0 * step))
+    return np.array(cols).T
+
+
+def test_basis_round_trip_and_derivative() -> None:
+    basis = aft.Basis.make(5, 64)
+    np.testing.assert_allclose(basis.to_coefficients @ basis.to_time, np.eye(11), atol=1e-14)
+    rng = np.random.default_rng(1)
+    coef = rng.normal(size=11)
+    tau = np.linspace(0.0, 2.0 * math.pi, 7)
+    # d/dtau by the operator against a central difference of the series
+    h = 1e-6
+    numeric = (basis.evaluate(coef, tau + h) - basis.evaluate(coef, tau - h)) / (2 * h)
+    np.testing.assert_allclose(basis.evaluate(basis.derivative @ coef, tau), numeric, atol=1e-7)
+    # extremes against a dense grid
+    grid = basis.evaluate(coef, np.linspace(0.0, 2.0 * math.pi, 200_001))
+    top, bottom = basis.extremes(coef[:, None])
+    assert top[0] == pytest.approx(grid.max(), abs=1e-9)
+    assert bottom[0] == pytest.approx(grid.min(), abs=1e-9)
+
+
+@pytest.mark.parametrize(("offset", "friction"), [(0.0, None), (0.03, Friction(0.02, 1.0))])
+def test_jacobian_matches_finite_differences(offset: float, friction: Friction | None) -> None:
+    joint = Joint(
+        mass=1.5,
+        clearance=0.2,
+        compression_stiffness=3.0,
+        tension_stiffness=2.0,
+        gap_stiffness=0.5,
+        gap_offset=offset,
+    )
+    model = system.from_joint(joint, 0.02, friction, 1.0, 0.05)
+    basis = aft.Basis.make(6, 128)
+    rng = np.random.default_rng(7)
+    q = 0.1 * rng.normal(size=13)
+    q[1] = 0.3  # well into both contacts
+    omega, force = 1.1, np.array([0.05])
+    ev = aft.evaluate(model, basis, q, omega, force)
+    numeric = _finite_difference(
+        lambda x: aft.evaluate(model, basis, x, omega, force).residual, q, 1e-7
+    )
+    np.testing.assert_allclose(ev.jacobian, numeric, atol=1e-7)
+    d_omega = (
+        aft.evaluate(model, basis, q, omega + 1e-7, force).residual
+        - aft.evaluate(model, basis, q, omega - 1e-7, force).residual
+    ) / 2e-7
+    np.testing.assert_allclose(ev.d_omega, d_omega, atol=1e-7)
+
+
+def test_bad_harmonics_and_samples() -> None:
+    with pytest.raises(HarmonicError, match="harmonics must be an integer >= 1"):
+        aft.check_harmonics(0, None)
+    with pytest.raises(HarmonicError, match=r"samples must be an integer >= 2 \(2H \+ 1\) = 30"):
+        aft.check_harmonics(7, 29)
+    assert aft.check_harmonics(7, None) == (7, 512)
+
+
+def test_restitution_and_friction_are_refused_with_a_pointer() -> None:
+    with pytest.raises(HarmonicError, match=r"clearjoint\.periodic"):
+        system.build(PYHARM, 0.0, None, 0.8)
+    with pytest.raises(HarmonicError, match=r"clearjoint\.periodic"):
+        system.build(PYHARM, 0.0, Friction(0.1, 1.0, "free-play"), 1.0, 1e-3)
+
+
+def _hb_orbit(harmonics: int, omega: float, guess: np.ndarray) -> tuple[np.ndarray, aft.Basis]:
+    model = system.from_joint(PYHARM, PYHARM_ZETA, None, 1.0)
+    h, n_t = aft.check_harmonics(harmonics, None)
+    basis = aft.Basis.make(h, n_t)
+    q0 = np.zeros(2 * h + 1)
+    q0[: min(guess.size, q0.size)] = guess[: q0.size]
+
+    def function(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ev = aft.evaluate(model, basis, q, omega, np.array([0.03]))
+        return ev.residual, ev.jacobian
+
+    found = solve.newton(function, q0, 0.1)
+    assert found is not None
+    return found[0], basis
+
+
+def test_harmonic_balance_converges_to_the_exact_orbit() -> None:
+    """HB x_max tends to the exact shooting orbit's as H grows (upper branch, omega = 1.3)."""
+    omega = 1.3
+    guess = np.array([0.0, -0.3, 0.1])
+    errors = []
+    exact = None
+    for h in (3, 7, 15, 31):
+        q, basis = _hb_orbit(h, omega, guess)
+        guess = q
+        if exact is None:
+            x0 = q[0] + q[1::2].sum()
+            v0 = omega * float(np.arange(1, h + 1) @ q[2::2])
+            exact = periodic_orbit(PYHARM, 0.03, omega, damping_ratio=PYHARM_ZETA, initial=(x0, v0))
+            assert exact.x_max > PYHARM.compression_gap  # a contacting orbit
+        top, _ = basis.extremes(q[:, None])
+        errors.append(abs(top[0] - exact.x_max) / exact.amplitude)
+    assert errors[0] > 1e-4  # truncation is visible at H = 3 ...
+    assert errors[2] < 5e-5  # ... and small at 15
+    assert errors[3] < errors[1] / 10.0

@@ -1,0 +1,94 @@
+"""Harmonic balance of a Structure (MODEL.md 5.2-5.4) against its exact time response."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint import ClearanceJoint, ParameterError
+from clearjoint.harmonic import frequency_response, nonlinear_modes
+from clearjoint.structure import Structure, chain, time_response
+
+FORCE = np.array([0.0, 0.0, 40.0])
+SAMPLES = 256
+
+
+@pytest.fixture(scope="module")
+def three_links() -> Structure:
+    """Three 1 kg masses on 1 MN/m links, each with a 0.1 mm joint, dashpots across."""
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+
+
+def _exact_from(structure: Structure, omega: float, state: np.ndarray, periods: int) -> np.ndarray:
+    n = structure.n_dof
+    motion = time_response(
+        structure,
+        FORCE,
+        omega,
+        periods * 2.0 * math.pi / omega,
+        initial=(state[:n], state[n:]),
+        samples_per_period=SAMPLES,
+    )
+    return motion.u
+
+
+@pytest.mark.parametrize("omega", [200.0, 300.0, 400.0, 500.0, 800.0])
+def test_stable_steady_states_agree_with_the_exact_time_response(
+    three_links: Structure, omega: float
+) -> None:
+    """Started on the HB orbit, the exact motion stays on it: x_max per DOF agree.
+
+    At each of these frequencies some joint goes beyond a gap edge (checked on the
+    exact motion's relative displacements).
+    """
+    fr = frequency_response(three_links, FORCE, omega, 1.001 * omega, harmonics=7, max_points=2)
+    assert fr.x_max.shape == (2, 3)
+    assert fr.multipliers.shape == (2, 6)
+    assert fr.stable[0]
+    u = _exact_from(three_links, omega, fr.initial_state[0], 6)
+    last = u[-SAMPLES:]
+    scale = float(np.max(np.abs(last)))
+    assert np.max(np.abs(fr.x_max[0] - last.max(axis=0))) < 3e-3 * scale
+    assert np.max(np.abs(fr.x_min[0] - last.min(axis=0))) < 3e-3 * scale
+    relative = last @ three_links.joint_directions.T
+    assert np.max(relative) > 1.2 * three_links.joint_laws[0].compression_gap
+
+
+def test_an_orbit_hill_calls_unstable_is_left_by_the_exact_motion(three_links: Structure) -> None:
+    omega = 600.0
+    fr = frequency_response(three_links, FORCE, omega, 1.001 * omega, harmonics=7, max_points=2)
+    assert not fr.stable[0]
+    ds = fr.to_xarray()
+    assert ds["x_max"].dims == ("point", "dof")
+    assert ds["coefficients"].dims == ("point", "coefficient", "dof")
+    u = _exact_from(three_links, omega, fr.initial_state[0], 6)
+    first = np.max(np.abs(u[:SAMPLES].max(axis=0) - fr.x_max[0]))
+    last = np.max(np.abs(u[-SAMPLES:].max(axis=0) - fr.x_max[0]))
+    assert last > 5.0 * first
+
+
+def test_first_nonlinear_mode_lies_between_the_linear_bounds(three_links: Structure) -> None:
+    """MODEL.md 5.2: the all-open and all-closed linear modes bound the nonlinear one."""
+    nm = nonlinear_modes(three_links, 1, np.geomspace(2e-4, 2e-2, 6), harmonics=7)
+    assert nm.converged.all()
+    assert nm.x_max.shape == (6, 3)
+    assert nm.reference_dof == three_links.dof_names[2]
+    w_open = three_links.modes("open").omega[0]
+    w_closed = three_links.modes("closed").omega[0]
+    assert np.all(nm.frequency > w_open)
+    assert np.all(nm.frequency < w_closed)
+    assert np.all(np.diff(nm.frequency) > 0.0)  # the joints stiffen with amplitude
+    assert nm.frequency[-1] == pytest.approx(w_closed, rel=0.02)
+    assert np.all(nm.damping_ratio > 0.0)
+
+
+def test_bad_structure_input(three_links: Structure) -> None:
+    with pytest.raises(ParameterError, match=r"one amplitude per DOF, shape \(3,\)"):
+        frequency_response(three_links, [1.0, 2.0], 100.0, 200.0)
+    with pytest.raises(ParameterError, match="the structure has modes 1 to 3"):
+        nonlinear_modes(three_links, 4, [1e-3])
+    with pytest.raises(ParameterError, match="apply to a Joint"):
+        frequency_response(three_links, FORCE, 100.0, 200.0, damping_ratio=0.1)
