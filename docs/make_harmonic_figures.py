@@ -1,26 +1,20 @@
-"""Tables and pictures of docs/harmonic.md: ``python docs/make_harmonic_figures.py``.
+"""Tables of docs/harmonic.md: ``python docs/make_harmonic_figures.py``.
 
 Prints the H-convergence tables (HB against exact shooting orbits, and the EPMC
-backbone against the exact free period) and draws docs/figures/harmonic_*.png.
+backbone against the exact free period). Its pictures are drawn by
+examples/gallery/plot_harmonic.py, which the docs build runs.
 """
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
-import matplotlib
 import numpy as np
 
 from clearjoint import Joint, dissipation, stiffness
-from clearjoint.harmonic import aft, frequency_response, nonlinear_modes, solve, system
-from clearjoint.periodic import frequency_response as exact_response
+from clearjoint.harmonic import aft, nonlinear_modes, solve, system
 from clearjoint.periodic import periodic_orbit
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
-HERE = Path(__file__).parent / "figures"
 PYHARM = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_stiffness=1.0)
 ZETA = 0.05 / (2.0 * math.sqrt(3.0))
 PAPER = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
@@ -89,38 +83,7 @@ def backbone_table() -> None:
         )
 
 
-def figures() -> None:
-    HERE.mkdir(exist_ok=True)
-    hb = frequency_response(PYHARM, 0.03, 0.5, 1.8, harmonics=12, damping_ratio=ZETA, max_step=0.05)
-    ex = exact_response(PYHARM, 0.03, 0.5, 1.8, damping_ratio=ZETA)
-    fig, ax = plt.subplots(figsize=(7.0, 4.2))
-    hb.plot(ax=ax)
-    ax.plot(ex.omega / (2 * math.pi), ex.amplitude * 1e3, ":", color="k", lw=1.0, label="exact")
-    ax.legend(frameon=False, fontsize="small")
-    ax.set_title("pyHarm's SDOF clearance case: harmonic balance (H = 12) and exact shooting")
-    fig.savefig(HERE / "harmonic_frf.png", dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    amplitudes = np.geomspace(50e-6, 3e-3, 40)
-    nm = nonlinear_modes(PAPER, 1, amplitudes, harmonics=15, damping_ratio=0.02)
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    nm.plot(ax=ax)
-    a = np.geomspace(1e-6, 3e-3, 200)
-    orbit = stiffness.free_orbit(PAPER, a)
-    # the EPMC amplitude is the fundamental; place the exact backbone by its x_max
-    ax.plot(
-        np.interp(orbit.x_max, nm.x_max, nm.amplitude, left=np.nan, right=np.nan) * 1e6,
-        1.0 / stiffness.period(PAPER, a),
-        ":",
-        color="k",
-        label="2 pi / T(A) (paper, exact)",
-    )
-    ax.legend(frameon=False, fontsize="small", loc="lower right")
-    fig.savefig(HERE / "harmonic_mode.png", dpi=120, bbox_inches="tight")
-    plt.close(fig)
-
-
 if __name__ == "__main__":
     convergence_table()
     print()
     backbone_table()
-    figures()

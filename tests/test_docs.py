@@ -69,3 +69,29 @@ def test_license_file_is_the_mit_licence_pyproject_names() -> None:
     text = (ROOT / "LICENSE").read_text(encoding="utf-8")
     assert text.startswith("MIT License")
     assert "Permission is hereby granted, free of charge" in text
+
+
+def test_no_docstring_has_a_bar_pair_that_restructuredtext_reads_as_a_substitution() -> None:
+    """``|x|`` in a public docstring or a ``#:`` comment breaks the docs build: write abs(x).
+
+    The docs build (sphinx -W) runs outside the test command; this catches its commonest
+    break here. Private modules and functions (a leading _) are not in the API pages.
+    """
+    import ast
+
+    bars = re.compile(r"(?<![|\w])\|[^|\s`][^|`\n]*\|(?![|\w])")
+    kinds = ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef
+    found = []
+    for path in sorted((ROOT / "src" / "clearjoint").rglob("*.py")):
+        if path.name.startswith("_") and path.name != "__init__.py":
+            continue
+        source = path.read_text(encoding="utf-8")
+        texts = [(n, t) for n, t in enumerate(source.splitlines(), 1) if t.strip().startswith("#:")]
+        for node in ast.walk(ast.parse(source)):
+            if not isinstance(node, kinds) or getattr(node, "name", "").startswith("_"):
+                continue
+            doc = ast.get_docstring(node, clean=False)
+            if doc:
+                texts.append((node.body[0].lineno, doc))
+        found += [f"{path.name}:{n}: {m.group(0)}" for n, t in texts for m in bars.finditer(t)]
+    assert not found, f"write abs(...) instead of |...|: {found}"

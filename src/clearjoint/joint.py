@@ -43,7 +43,7 @@ class ClearanceJoint:
         Stiffness k0 inside the gap (free-play), N/m, >= 0. Default 0 (the paper's choice).
     gap_offset : float, optional
         Position d of the gap's centre relative to delta = 0 (the rest position of the
-        k0 spring), m, positive toward compression, with |d| <= c/2. Default 0.
+        k0 spring), m, positive toward compression, with abs(d) <= c/2. Default 0.
     friction : Friction, optional
         Coulomb sliding friction in the joint (MODEL.md eq 10). Default none.
     restitution : float, optional

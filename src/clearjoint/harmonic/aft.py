@@ -242,7 +242,7 @@ def hill_exponents(
 
     Linearises (Delta_0 + lambda Delta_1 + lambda^2 Delta_2) s = 0 to a standard
     eigenproblem of size 2 (2H + 1) N (M is diagonal and positive, so Delta_2 is
-    inverted exactly) and keeps the 2N eigenvalues with the smallest |Im lambda|
+    inverted exactly) and keeps the 2N eigenvalues with the smallest abs(Im lambda)
     (Lazarus & Thomas 2010).
     """
     n = system.n_dof

@@ -17,7 +17,7 @@ from clearjoint.harmonic.system import LinearSystem
 
 FloatArray = NDArray[np.float64]
 
-#: Converged when max |R| / (k_ref x_scale) is below this.
+#: Converged when max abs(R) / (k_ref x_scale) is below this.
 TOLERANCE = 1e-11
 
 
@@ -47,7 +47,7 @@ def newton(
 ) -> tuple[FloatArray, int] | None:
     """Damped Newton on a dimensionless residual: ``function(q) -> (R, dR/dq)``.
 
-    Steps are halved (up to 12 times) until max |R| falls; ``scale`` (m) makes q
+    Steps are halved (up to 12 times) until max abs(R) falls; ``scale`` (m) makes q
     dimensionless in the convergence test. Returns (q, iterations) or None.
     """
     q = q0.copy()

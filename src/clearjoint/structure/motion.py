@@ -8,7 +8,7 @@ and so is the augmented state y = (u, v, sin w t, cos w t, 1): y' = A_s y. Its f
 exp(A_s tau) is therefore exact for the forcing and the joints' constant forces alike,
 with no special case for a singular K_s (an open joint with k0 = 0), a defective A_s or
 resonance. Steps never exceed a base step H (an eighth of the shortest period of forcing,
-structure and damping), so |A_s tau| is of order one and the Taylor series of
+structure and damping), so abs(A_s tau) is of order one and the Taylor series of
 exp(A_s tau) y, summed until its terms fall below 1e-18 of y, is the exact flow to
 round-off. The same series carries the energy integrals exactly: the input power
 F.v sin(w t) and the viscous power v^T C v are quadratic forms of y, integrated term by
@@ -18,10 +18,10 @@ MODAL_AFTER_STEPS steps in it, its eigen-decomposition (for the event bound belo
 Events (a joint's shortening delta_j reaches a gap edge) are found by *certified
 marching*, as in the one-joint kernel: from the state at tau = 0 the event function
 g = distance to the edge satisfies g(tau) >= g + g' tau + g'' tau^2/2 - B tau^3/6 on the
-whole base step, where B bounds |g'''|: g''' = w_j^T A^3 y(tau), so
-|g'''| <= sum_k |w_j^T v_k| |lambda_k|^3 |c_k| max(1, exp(Re lambda_k H)) over the modes
+whole base step, where B bounds abs(g'''): g''' = w_j^T A^3 y(tau), so
+abs(g''') <= sum_k abs(w_j^T v_k) abs(lambda_k)^3 abs(c_k) max(1, exp(Re lambda_k H)) over the modes
 (v_k, lambda_k) of A_s with y = sum_k c_k v_k, or, for a pattern met only briefly or with
-ill-conditioned eigenvectors, |w_j^T A^3| exp(mu H) |y(0)|, mu a Gershgorin bound of the
+ill-conditioned eigenvectors, abs(w_j^T A^3) exp(mu H) abs(y(0)), mu a Gershgorin bound of the
 logarithmic norm of A in scaled variables. Stepping to the first
 root of that lower bound never passes a root, grazing included; near a transversal
 crossing the steps shrink like Newton's. Restitution on a joint that links two masses
@@ -314,7 +314,7 @@ class StructureMotion:
 
     @property
     def balance_error(self) -> float:
-        """|input - losses - change of mechanical energy| over the largest energy in play."""
+        """abs(input - losses - change of mechanical energy) over the largest energy in play."""
         e = self.energy
         scale = max(abs(e.input), e.losses, self.initial_energy, 1e-300)
         return abs(e.input - e.losses - e.mechanical_energy_change) / scale
