@@ -17,7 +17,7 @@ CHAIN = """
 kind = "chain"
 masses = ["2kg", "1.5kg"]
 stiffnesses = ["inf", "6e7N/m"]
-dampers = [50.0, 30.0]
+dampers = ["50N*s/m", "30N s/m"]
 joints = [true, false]
 
 [joint]
@@ -77,7 +77,18 @@ def test_cli_writes_netcdf_and_json(
         (('force_dof = "n2x"', 'force_dof = "n9x"'), "names DOF 'n9x', which does not exist"),
         (('kind = "chain"', 'kind = "tower"'), "kind must be 'mast', 'chain' or 'truss'"),
         (('clearance = "0.1mm"', 'clearance = "0.1N"'), "clearance"),
-        (("dampers = [50.0, 30.0]", "dampers = [50.0]"), "dampers must have one entry per link"),
+        (
+            ('dampers = ["50N*s/m", "30N s/m"]', 'dampers = ["50N*s/m"]'),
+            "dampers must have one entry per link",
+        ),
+        (('clearance = "0.1mm"', "clearance = 0.1"), 'clearance = 0.1: give a unit, e.g. "0.1mm"'),
+        (('"2kg", "1.5kg"', '2.0, "1.5kg"'), "masses = 2.0: give a unit"),
+        (
+            ('"50N*s/m", "30N s/m"', '50.0, "30N s/m"'),
+            'dampers = 50.0: give a unit, e.g. "50.0N*s/m"',
+        ),
+        (('dampers = ["50N*s/m", "30N s/m"]', 'dampers = ["50N", "30N"]'), "is not a damping"),
+        (("[decay]", "[decay]\nclearance_m = 1e-4"), "unknown key 'clearance_m' in [decay]"),
         (("[decay]", "[decays]"), "unknown section [decays]"),
     ],
 )
@@ -118,3 +129,44 @@ compression_stiffness = "8e7N/m"
     assert s.nodes[2].tolist() == [0.0, 1.0]
     # the joint in series with member 0: closed stiffness k k_m / (k + k_m)
     assert s.joint_laws[0].compression_stiffness == pytest.approx(8e7 * 1e7 / 9e7)
+
+
+def test_keys_that_name_their_si_unit_take_bare_numbers(tmp_path: Path) -> None:
+    """masses_kg, dampers_n_s_per_m, clearance_m: the same study as with units."""
+    bare = (
+        CHAIN.replace('masses = ["2kg", "1.5kg"]', "masses_kg = [2, 1.5]")
+        .replace('dampers = ["50N*s/m", "30N s/m"]', "dampers_n_s_per_m = [50, 30]")
+        .replace('clearance = "0.1mm"', "clearance_m = 1e-4")
+        .replace('frequency = "600Hz"', "frequency_hz = 600")
+    )
+    assert bare != CHAIN
+    a = load_structure_study(_write(tmp_path, CHAIN)).structure
+    b = load_structure_study(_write(tmp_path, bare)).structure
+    assert b.mass_matrix().diagonal().tolist() == [2.0, 1.5]
+    assert b.damping_matrix().tolist() == a.damping_matrix().tolist()
+    assert b.joint_laws[0].clearance == pytest.approx(1e-4)
+    assert load_structure_study(_write(tmp_path, bare)).omega == pytest.approx(2 * math.pi * 600)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('masses = ["2kg", "1.5kg"]\nmasses_kg = [2, 1.5]', "masses is given twice"),
+        ('masses_kg = ["2kg", "1.5kg"]', "the key names its unit, so give a bare number"),
+    ],
+)
+def test_unit_keys_are_checked(tmp_path: Path, text: str, message: str) -> None:
+    path = _write(tmp_path, CHAIN.replace('masses = ["2kg", "1.5kg"]', text))
+    with pytest.raises(StructureStudyError, match=message):
+        load_structure_study(path)
+
+
+@pytest.mark.parametrize(("make", "message"), [("folder", "is a folder"), ("", "no such")])
+def test_study_path_errors_come_from_the_one_toml_reader(
+    tmp_path: Path, make: str, message: str
+) -> None:
+    path = tmp_path / "s.toml"
+    if make == "folder":
+        path.mkdir()
+    with pytest.raises(StructureStudyError, match=message):
+        load_structure_study(path)

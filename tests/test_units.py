@@ -181,3 +181,11 @@ def test_one_over_second_is_hz_for_a_frequency_but_ambiguous_for_omega() -> None
     with pytest.raises(ParameterError, match="ambiguous for an angular frequency"):
         parse_quantity("2513 1/s", "angular_frequency", name="omega")
     assert to_si(omega_n.to("rad/s"), "rad/s", name="omega") == pytest.approx(math.sqrt(4e7))
+
+
+def test_damping_is_a_kind_of_quantity() -> None:
+    """N s/m, the unit of a dashpot (structure study dampers): 0.05 kN s/m = 50 N s/m."""
+    assert parse_quantity("0.05kN*s/m", "damping", name="d") == pytest.approx(50.0)
+    assert parse_quantity("50 N s/m", "damping", name="d") == pytest.approx(50.0)
+    with pytest.raises(ParameterError, match="is not a damping"):
+        parse_quantity("50N/m", "damping", name="d")

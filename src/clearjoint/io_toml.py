@@ -31,6 +31,7 @@ UNIT_SUFFIXES: dict[str, str] = {
     "pressure": "pa",
     "velocity": "m_per_s",
     "acceleration": "m_per_s2",
+    "damping": "n_s_per_m",
 }
 
 #: Kinds that are not quantities: checked for their type only.

@@ -39,6 +39,7 @@ SI_UNITS: dict[str, str] = {
     "pressure": "Pa",
     "velocity": "m/s",
     "acceleration": "m/s^2",
+    "damping": "N s/m",
     "dimensionless": "",
 }
 
@@ -54,6 +55,7 @@ UNIT_HINTS: dict[str, str] = {
     "pressure": "GPa",
     "velocity": "m/s",
     "acceleration": "m/s^2",
+    "damping": "N*s/m",
     "dimensionless": "",
 }
 
@@ -69,6 +71,7 @@ EXAMPLES: dict[str, str] = {
     "pressure": "206GPa",
     "velocity": "0.1m/s",
     "acceleration": "100m/s^2",
+    "damping": "50N*s/m",
     "dimensionless": "0.3",
 }
 

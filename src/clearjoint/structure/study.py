@@ -1,8 +1,10 @@
 """A structure study in one TOML file, with units: build, then modes / respond / decay.
 
-A thin reader: every quantity may carry a unit (``"50um"``, ``"5e7N/m"``, ``"15Hz"``) or be
-a bare SI number, read by :func:`clearjoint.units.parse_quantity` as the simulation study
-does; an unknown section or key is an error. Example (a 10-bay mast)::
+A thin reader on :mod:`clearjoint.io_toml`, with its rules: a dimensional value carries its
+unit (``"50um"``, ``"5e7N/m"``, ``"15Hz"``); a bare number only where the key names its SI
+unit (``clearance_m = 5e-5``, ``masses_kg = [2, 1.5]``, ``dampers_n_s_per_m = [50, 30]``),
+the quantity is dimensionless, or it is zero. An unknown section or key is an error.
+Example (a 10-bay mast)::
 
     [structure]
     kind = "mast"            # "mast", "chain" or "truss"
@@ -33,14 +35,13 @@ does; an unknown section or key is an error. Example (a 10-bay mast)::
 A truss takes ``nodes`` (a list of coordinates, with units), ``members`` (pairs of node
 indices), ``supports``, ``member_stiffness``, ``masses`` (one per node, or one for all) and
 ``joint_members`` (indices of the members that carry the [joint]). A chain takes
-``masses``, ``stiffnesses`` (``"inf"`` for a rigid link), ``dampers`` (N s/m) as lists
+``masses``, ``stiffnesses`` (``"inf"`` for a rigid link), ``dampers`` (``"50N*s/m"``) as lists
 and ``joints`` as a list of true/false (the [joint] on that link or none).
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -48,10 +49,10 @@ from typing import Any
 import numpy as np
 
 from clearjoint.errors import ClearjointError
+from clearjoint.io_toml import UNIT_SUFFIXES, quantity, read_toml
 from clearjoint.joint import ClearanceJoint
 from clearjoint.structure.builders import chain, mast, truss
 from clearjoint.structure.model import Member, Structure
-from clearjoint.units import parse_quantity
 
 KEYS: dict[str, dict[str, str]] = {
     "structure": {
@@ -64,12 +65,12 @@ KEYS: dict[str, dict[str, str]] = {
         "diagonal_rigidity": "force",
         "node_mass": "mass",
         "tip_mass": "mass",
-        "member_damping": "dimensionless",
+        "member_damping": "damping",
         "rayleigh_alpha": "frequency",
         "rayleigh_beta": "time",
         "masses": "mass list",
         "stiffnesses": "stiffness list",
-        "dampers": "dimensionless list",
+        "dampers": "damping list",
         "joints": "flag list",
         "nodes": "points",
         "members": "pairs",
@@ -120,17 +121,36 @@ class StructureStudy:
     source: str
 
 
-def _value(where: str, section: str, key: str, raw: Any) -> Any:
-    kind = KEYS[section][key]
-    name = f"{where}: [{section}] {key}"
-    if kind == "text":
-        if not isinstance(raw, str):
-            raise StructureStudyError(f"{name} must be text, got {raw!r}")
-        return raw
-    if kind == "count":
-        if isinstance(raw, bool) or not isinstance(raw, int):
-            raise StructureStudyError(f"{name} must be a whole number, got {raw!r}")
-        return raw
+def _unit_kind(kind: str) -> str:
+    """The kind of quantity each number of ``kind`` is ("mass list" -> "mass")."""
+    return "length" if kind == "points" else kind.removesuffix(" list")
+
+
+def _read_section(where: str, section: str, body: dict[str, Any]) -> dict[str, Any]:
+    """Return one [section]'s values in SI, keyed as in KEYS; refuse unknown keys."""
+    spec = KEYS[section]
+    aliases = {
+        f"{key}_{UNIT_SUFFIXES[_unit_kind(kind)]}": key
+        for key, kind in spec.items()
+        if _unit_kind(kind) in UNIT_SUFFIXES
+    }
+    out: dict[str, Any] = {}
+    for given, raw in body.items():
+        key = aliases.get(given, given)
+        if key not in spec:
+            raise StructureStudyError(
+                f"{where}: unknown key {given!r} in [{section}]; keys are {', '.join(spec)}"
+            )
+        if key in out:
+            raise StructureStudyError(
+                f"{where}: {key} is given twice ({key} and {given}); keep one"
+            )
+        name = f"{where}: [{section}] {given}"
+        out[key] = _value(name, spec[key], raw, unit_in_key=given in aliases)
+    return out
+
+
+def _value(name: str, kind: str, raw: Any, *, unit_in_key: bool) -> Any:
     if kind in ("points", "pairs"):
         if not isinstance(raw, list) or not all(isinstance(p, list) for p in raw):
             raise StructureStudyError(f"{name} must be a list of lists, got {raw!r}")
@@ -138,7 +158,7 @@ def _value(where: str, section: str, key: str, raw: Any) -> Any:
             if not all(len(p) == 2 and all(isinstance(i, int) for i in p) for p in raw):
                 raise StructureStudyError(f"{name} must be pairs of node indices [start, end]")
             return [tuple(p) for p in raw]
-        return [[_number(name, "length", v) for v in p] for p in raw]
+        return [[_number(name, "length", v, unit_in_key) for v in p] for p in raw]
     if kind == "index list":
         if not isinstance(raw, list) or not all(
             isinstance(i, int) and not isinstance(i, bool) for i in raw
@@ -153,46 +173,30 @@ def _value(where: str, section: str, key: str, raw: Any) -> Any:
             if not all(isinstance(v, bool) for v in raw):
                 raise StructureStudyError(f"{name} must be a list of true/false")
             return raw
-        return [_number(name, inner, v) for v in raw]
-    return _number(name, kind, raw)
+        return [_number(name, inner, v, unit_in_key) for v in raw]
+    if kind in ("text", "count"):
+        return quantity(raw, kind, name=name, error=StructureStudyError)
+    return _number(name, kind, raw, unit_in_key)
 
 
-def _number(name: str, kind: str, raw: Any) -> float:
+def _number(name: str, kind: str, raw: Any, unit_in_key: bool) -> float:
+    """One number in SI by io_toml's rules; ``"inf"`` (a rigid link) is taken as it is."""
     if isinstance(raw, str) and raw.strip().lower() == "inf":
         return math.inf
-    if isinstance(raw, bool):
-        raise StructureStudyError(f"{name} must be a number or a quantity, got {raw!r}")
-    if isinstance(raw, int | float):
-        return float(raw)
-    if isinstance(raw, str):
-        return parse_quantity(raw, kind, name=name)
-    raise StructureStudyError(f"{name} must be a number or a quantity with a unit, got {raw!r}")
+    return float(quantity(raw, kind, name=name, error=StructureStudyError, unit_in_key=unit_in_key))
 
 
 def load_structure_study(path: str | Path) -> StructureStudy:
     """Read and validate a structure study TOML file (see the module docstring)."""
-    path = Path(path)
     where = str(path)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise StructureStudyError(f"study file {where} not found; check the path") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise StructureStudyError(f"{where} is not valid TOML: {exc}") from None
+    raw = read_toml(path, what="structure study", error=StructureStudyError)
     values: dict[str, dict[str, Any]] = {}
     for section, body in raw.items():
         if section not in KEYS or not isinstance(body, dict):
             raise StructureStudyError(
                 f"{where}: unknown section [{section}]; sections are {', '.join(KEYS)}"
             )
-        values[section] = {}
-        for key, item in body.items():
-            if key not in KEYS[section]:
-                raise StructureStudyError(
-                    f"{where}: unknown key {key!r} in [{section}]; "
-                    f"keys are {', '.join(KEYS[section])}"
-                )
-            values[section][key] = _value(where, section, key, item)
+        values[section] = _read_section(where, section, body)
     return _build(values, where)
 
 
