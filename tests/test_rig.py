@@ -151,6 +151,13 @@ def test_bad_campaigns(tmp_path: Path, text: str, words: str) -> None:
     assert words in str(info.value)
 
 
+def test_a_bare_number_is_refused_without_pointing_to_a_unit_key(tmp_path: Path) -> None:
+    """A campaign takes no rig.mass_kg: the hint is the unit alone."""
+    with pytest.raises(CampaignError) as info:
+        load_campaign(small(tmp_path, "[rig]\nmass = 1.5\n"))
+    assert str(info.value).endswith('rig.mass = 1.5: give a unit, e.g. "1.5kg"')
+
+
 def test_missing_campaign(tmp_path: Path) -> None:
     with pytest.raises(CampaignError, match="no such campaign file"):
         load_campaign(tmp_path / "none.toml")

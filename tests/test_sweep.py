@@ -482,3 +482,27 @@ outputs = ["clearance_m", "cycles_used"]
     assert "zz_broken.nc" in results.status.values[2]
     with pytest.raises(SweepError, match="matches no file"):
         Sweep.from_toml(_files(tmp_path, 'base = "none/*.nc"\n[task]\nname = "identify"'))
+
+
+def test_a_bare_number_is_refused_without_pointing_to_a_unit_key(tmp_path: Path) -> None:
+    """A sweep has no keys that name their unit: the hint is the unit alone."""
+    text = 'base = "study.toml"\n[task]\nname = "steady_state"\n[axes.joint]\nclearance = [0.1]'
+    with pytest.raises(SweepError) as info:
+        Sweep.from_toml(_files(tmp_path, text))
+    assert str(info.value).endswith('clearance = 0.1: give a unit, e.g. "0.1mm"')
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [(None, "is a folder"), (b"", "empty file"), (b"\x00\x01\x02", "binary file")],
+)
+def test_sweep_path_errors_come_from_the_one_toml_reader(
+    tmp_path: Path, content: bytes | None, message: str
+) -> None:
+    path = tmp_path / "s.toml"
+    if content is None:
+        path.mkdir()
+    else:
+        path.write_bytes(content)
+    with pytest.raises(SweepError, match=message):
+        Sweep.from_toml(path)

@@ -86,7 +86,13 @@ def parse_toml(text: str, *, where: str, what: str, error: type[ClearjointError]
 
 
 def quantity(
-    raw: Any, kind: str, *, name: str, error: type[ClearjointError], unit_in_key: bool = False
+    raw: Any,
+    kind: str,
+    *,
+    name: str,
+    error: type[ClearjointError],
+    unit_in_key: bool = False,
+    unit_keys: bool = True,
 ) -> Any:
     """Return one value of a TOML file in SI (or as text, a whole number, a flag).
 
@@ -102,6 +108,9 @@ def quantity(
         The ClearjointError subclass to raise.
     unit_in_key : bool
         The key names the SI unit (``frequency_hz``): a bare number is that unit.
+    unit_keys : bool
+        The file takes keys that name their unit: the message for a bare number
+        suggests one. False where it does not (a sweep's axes, a campaign).
 
     Raises
     ------
@@ -125,12 +134,11 @@ def quantity(
     if isinstance(raw, int | float):
         if kind == "dimensionless" or unit_in_key or raw == 0:
             return float(raw)
-        suffix = UNIT_SUFFIXES[kind]
+        hint = f'{name} = {raw}: give a unit, e.g. "{raw}{UNIT_HINTS[kind]}"'
+        if not unit_keys:
+            raise error(hint)
         key = name.rsplit(" ", 1)[-1]
-        raise error(
-            f'{name} = {raw}: give a unit, e.g. "{raw}{UNIT_HINTS[kind]}", '
-            f"or name the SI unit in the key ({key}_{suffix} = {raw})"
-        )
+        raise error(f"{hint}, or name the SI unit in the key ({key}_{UNIT_SUFFIXES[kind]} = {raw})")
     if unit_in_key:
         raise error(f"{name} = {raw!r}: the key names its unit, so give a bare number")
     try:

@@ -216,9 +216,9 @@ def _merge(base: dict[str, Any], given: dict[str, Any], where: str, prefix: str 
 
 
 def _quantity(where: str, key: str, value: Any) -> float:
-    value = quantity(
-        value, _KINDS.get(key, "dimensionless"), name=f"{where}: {key}", error=CampaignError
-    )
+    kind = _KINDS.get(key, "dimensionless")
+    name = f"{where}: {key}"
+    value = quantity(value, kind, name=name, error=CampaignError, unit_keys=False)
     return float(value)
 
 

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -44,6 +43,7 @@ from numpy.typing import NDArray
 from scipy import special
 
 from clearjoint.errors import ClearjointError
+from clearjoint.io_toml import quantity, read_toml
 from clearjoint.sweep.tasks import TASKS, Parameter, Task
 
 __all__ = [
@@ -198,9 +198,8 @@ class Sweep:
 
 def _quantity(where: str, key: str, raw: Any, parameter: Parameter) -> float:
     """One value in SI, read as every clearjoint file reads it (clearjoint.io_toml)."""
-    from clearjoint.io_toml import quantity
-
-    return float(quantity(raw, parameter.kind, name=f"{where}: {key}", error=SweepError))
+    name = f"{where}: {key}"
+    return float(quantity(raw, parameter.kind, name=name, error=SweepError, unit_keys=False))
 
 
 def _check_range(where: str, key: str, values: FloatArray, p: Parameter, hint: str) -> None:
@@ -336,14 +335,7 @@ def _load_base(where: str, task: Task, raw: Any, folder: Path) -> Any:
 
 def _read(path: Path) -> Sweep:
     where = str(path)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SweepError(f"{where}: no such sweep file") from None
-    except (IsADirectoryError, UnicodeDecodeError):
-        raise SweepError(f"{where}: not a sweep file (TOML text)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepError(f"{where}: not valid TOML ({exc})") from None
+    raw = read_toml(path, what="sweep", error=SweepError)
     extra = sorted(set(raw) - set(_TOP_KEYS))
     if extra:
         raise SweepError(f"{where}: unknown key(s) {extra}; known: {sorted(_TOP_KEYS)}")
