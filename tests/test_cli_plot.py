@@ -70,3 +70,40 @@ def test_plot_keeps_json_output_clean(tmp_path: Path, capsys: pytest.CaptureFixt
     assert code == 0
     assert json.loads(out)["stiffness_coefficient"][0] > 0.0
     assert target.read_text(encoding="utf-8").lstrip().startswith("<?xml")
+
+
+MAST = str(ROOT / "examples" / "mast.toml")
+NEWER = {
+    "frf": ["frf", STUDY, "--from", "300Hz", "--to", "310Hz"],
+    "modes": ["modes", STUDY, "--amplitude", "0.3mm..3mm", "--points", "3"],
+    "structure": ["structure", MAST, "modes"],
+}
+
+
+@pytest.mark.parametrize("command", list(NEWER))
+@pytest.mark.parametrize(
+    ("out", "plot", "message"),
+    [
+        ("r.nc", "figure.csv", "--plot must end in .png, .pdf, .svg, got 'figure.csv'"),
+        ("r.csv", "figure.png", "writes netCDF; name the file .nc"),
+        ("r.nc", "exists.png", "will not overwrite"),
+    ],
+)
+def test_newer_commands_check_out_and_plot_before_the_work(
+    command: str,
+    out: str,
+    plot: str,
+    message: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """frf, modes and structure: --out and --plot refused in one line, and nothing written."""
+    (tmp_path / "exists.png").write_bytes(b"mine")
+    args = [*NEWER[command], "--out", str(tmp_path / out), "--plot", str(tmp_path / plot)]
+    code, stdout, err = run(args, capsys)
+    assert code == 2
+    assert stdout == ""
+    assert message in err
+    assert len(err.strip().splitlines()) == 1
+    assert not (tmp_path / out).exists()
+    assert (tmp_path / "exists.png").read_bytes() == b"mine"

@@ -59,3 +59,13 @@ def test_fig13_names_its_reference_and_puts_the_one_to_one_line_in_the_legend() 
     assert (
         law_versus_measured_figure(measured, measured).axes[0].get_xlabel().startswith("measured")
     )
+
+
+def test_structure_modes_draws_closed_and_open_side_by_side() -> None:
+    from clearjoint.figures import structure_modes
+    from clearjoint.joint import ClearanceJoint
+    from clearjoint.structure import chain
+
+    s = chain([2.0, 1.5], [1e7, 6e7], [ClearanceJoint(1e-4, 8e7, gap_stiffness=1e6), None])
+    fig = structure_modes(s.modes("closed"), s.modes("open"))
+    assert [ax.get_title() for ax in fig.axes] == ["closed pattern", "open pattern"]

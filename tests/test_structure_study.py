@@ -170,3 +170,14 @@ def test_study_path_errors_come_from_the_one_toml_reader(
         path.mkdir()
     with pytest.raises(StructureStudyError, match=message):
         load_structure_study(path)
+
+
+@pytest.mark.parametrize("task", ["modes", "respond", "decay"])
+def test_cli_plot_writes_a_figure(
+    tmp_path: Path, task: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    target = tmp_path / "figure.png"
+    args = ["structure", str(_write(tmp_path)), task, "--out", str(tmp_path / "r.nc")]
+    assert main([*args, "--plot", str(target)]) == 0
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert f"and {target}" in capsys.readouterr().out

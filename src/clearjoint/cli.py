@@ -216,7 +216,7 @@ def _frf_parser(sub: Any) -> None:
     p.add_argument("--from", dest="start", required=True, help="start: 20Hz (or 100N)")
     p.add_argument("--to", dest="stop", required=True, help="end: 900Hz (or 2kN)")
     p.add_argument("--out", required=True, help="write the curve to this netCDF file (.nc)")
-    p.add_argument("--plot", help="draw the curve to this image file (.png)")
+    _add_plot_option(p, force=False)
     p.add_argument("--json", action="store_true", help="print the curve as one JSON object")
     p.add_argument(
         "--parameter",
@@ -275,10 +275,29 @@ def _save_plot(result: Any, path: Path | None, *, quiet: bool) -> None:
 
     fig = Figure(figsize=(6.4, 4.4), layout="constrained")
     result.plot(fig.add_subplot())
+    _save_figure(fig, path, quiet=quiet)
+
+
+def _save_figure(fig: Any, path: Path, *, quiet: bool) -> None:
+    """Save a drawn Figure to the --plot file ``path`` (checked by :func:`_plot_target`)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
     if not quiet:
         print(f"wrote {path}")
+
+
+def _netcdf_target(args: argparse.Namespace) -> Path:
+    """The --out netCDF file, checked before any work: a .nc suffix, not overwritten unasked."""
+    from clearjoint._checks import refuse_to_overwrite
+
+    path = Path(args.out)
+    if path.suffix.lower() != ".nc":
+        raise ParameterError(
+            f"--out {args.out}: {args.command} writes netCDF; name the file .nc, "
+            f"e.g. {args.command}.nc"
+        )
+    refuse_to_overwrite([path], force=args.force)
+    return path
 
 
 def _sweep_parser(sub: Any) -> None:
@@ -320,7 +339,7 @@ def _modes_parser(sub: Any) -> None:
     p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
     p.add_argument("--harmonics", type=int, default=7, help="H (default 7)")
     p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
-    p.add_argument("--plot", help="draw frequency and damping against amplitude (.png)")
+    _add_plot_option(p, force=False)
     p.add_argument("--json", action="store_true", help="print the mode as one JSON object")
     p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
 
@@ -338,7 +357,7 @@ def _structure_parser(sub: Any) -> None:
     p.add_argument("study", help="structure study TOML file")
     p.add_argument("task", choices=("modes", "respond", "decay"), help="what to compute")
     p.add_argument("--out", required=True, help="netCDF results file (.nc)")
-    p.add_argument("--plot", help="also draw a figure into this PNG")
+    _add_plot_option(p, force=False)
     p.add_argument("--json", action="store_true", help="print a JSON summary")
     p.add_argument("--force", action="store_true", help="overwrite existing output")
 
@@ -849,15 +868,12 @@ def _run_report(args: argparse.Namespace) -> int:
 def _run_frf(args: argparse.Namespace) -> int:
     import math
 
-    from clearjoint._checks import refuse_to_overwrite
     from clearjoint.periodic import frequency_response
     from clearjoint.simulate.study import load_study
     from clearjoint.units import parse_quantity
 
     study = load_study(args.study)
-    if Path(args.out).suffix.lower() != ".nc":
-        raise ParameterError(f"--out {args.out}: frf writes netCDF; name the file .nc, e.g. frf.nc")
-    refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
+    _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     kind = "force" if args.parameter == "force" else "frequency"
     start = parse_quantity(args.start, kind, name="--from")
@@ -1087,13 +1103,12 @@ def _amplitude_range(text: str, points: int) -> Any:
 def _run_modes(args: argparse.Namespace) -> int:
     import math
 
-    from clearjoint._checks import refuse_to_overwrite
     from clearjoint.harmonic import nonlinear_modes
     from clearjoint.simulate.study import load_study
 
     study = load_study(args.study)
-    outputs = [Path(args.out)] + ([Path(args.plot)] if args.plot else [])
-    refuse_to_overwrite(outputs, force=args.force)
+    _netcdf_target(args)  # before the run, not after
+    plot_path = _plot_target(args)
     amplitudes = _amplitude_range(args.amplitude, args.points)
     mode = nonlinear_modes(
         study.joint,
@@ -1108,12 +1123,7 @@ def _run_modes(args: argparse.Namespace) -> int:
     data.attrs["study"] = study.source
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     data.to_netcdf(args.out, engine="h5netcdf")
-    if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        figure: Any = mode.plot().figure
-        figure.savefig(args.plot, dpi=120, bbox_inches="tight")
+    _save_plot(mode, plot_path, quiet=True)
     missing = int((~mode.converged).sum())
     if missing:
         print(
@@ -1137,30 +1147,25 @@ def _run_modes(args: argparse.Namespace) -> int:
             )
         )
         return 0
-    print("\n".join([f"study: {study.source}", repr(mode), f"wrote {args.out}"]))
+    wrote = f"wrote {args.out}" + (f" and {args.plot}" if args.plot else "")
+    print("\n".join([f"study: {study.source}", repr(mode), wrote]))
     return 0
 
 
 def _run_structure(args: argparse.Namespace) -> int:
     import math
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import xarray as xr
 
-    from clearjoint import _checks
     from clearjoint.structure import decay_backbone, free_decay, time_response
     from clearjoint.structure.study import load_structure_study
 
-    out = Path(args.out)
-    outputs = [out] + ([Path(args.plot)] if args.plot else [])
-    _checks.refuse_to_overwrite(outputs, force=args.force)
+    out = _netcdf_target(args)
+    plot_path = _plot_target(args)
     study = load_structure_study(args.study)
     s = study.structure
     summary: dict[str, Any] = {"structure": repr(s)}
-    fig = None
+    drawn: Any = None  # a result with .plot(ax), or a Figure already drawn
     if args.task == "modes":
         closed, opened = s.modes("closed"), s.modes("open")
         data = xr.concat(
@@ -1169,13 +1174,16 @@ def _run_structure(args: argparse.Namespace) -> int:
         )
         summary["closed_hz"] = closed.frequency_hz[:6].tolist()
         summary["open_hz"] = opened.frequency_hz[:6].tolist()
-        if args.plot:
-            fig, axes = plt.subplots(1, 2, figsize=(9, 6))
-            closed.plot(axes[0])
-            opened.plot(axes[1])
+        if plot_path is not None:
+            from clearjoint.figures import structure_modes
+
+            drawn = structure_modes(closed, opened)
     elif args.task == "respond":
         if study.omega is None or study.force is None:
-            raise ParameterError(f"{study.source}: respond needs an [excitation] section")
+            raise ParameterError(
+                f"{study.source}: respond needs an [excitation] section (frequency, force_dof, "
+                "force_amplitude); put it in the study file"
+            )
         duration = study.periods * 2.0 * math.pi / study.omega
         motion = time_response(
             s, study.force, study.omega, duration, samples_per_period=study.samples_per_period
@@ -1188,11 +1196,13 @@ def _run_structure(args: argparse.Namespace) -> int:
             "balance_error": motion.balance_error,
             "max_displacement_m": float(np.abs(motion.u).max()),
         }
-        if args.plot:
-            fig = motion.plot().figure
+        drawn = motion
     else:
         if study.decay_initial is None or study.decay_duration is None:
-            raise ParameterError(f"{study.source}: decay needs a [decay] section")
+            raise ParameterError(
+                f"{study.source}: decay needs a [decay] section (dof, initial_amplitude, "
+                "duration); put it in the study file"
+            )
         motion = free_decay(
             s,
             (study.decay_initial, np.zeros(s.n_dof)),
@@ -1208,11 +1218,15 @@ def _run_structure(args: argparse.Namespace) -> int:
             "frequency_hz": (backbone.omega / (2.0 * math.pi)).tolist(),
             "damping_ratio": [None if math.isnan(z) else z for z in backbone.damping_ratio],
         }
-        if args.plot:
-            fig = backbone.plot().figure
+        drawn = backbone
     data.to_netcdf(out, engine="h5netcdf")
-    if fig is not None:
-        fig.savefig(args.plot, dpi=120)
+    if plot_path is not None:
+        from matplotlib.figure import Figure
+
+        if isinstance(drawn, Figure):
+            _save_figure(drawn, plot_path, quiet=True)
+        else:
+            _save_plot(drawn, plot_path, quiet=True)
     if args.json:
         print(json.dumps(summary))
     else:

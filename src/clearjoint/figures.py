@@ -655,3 +655,23 @@ def report_figures(
             reference=reference,
         )
     return out
+
+
+def structure_modes(closed: Any, opened: Any) -> Figure:
+    """Return the closed- and open-pattern mode shapes of a structure side by side (MODEL.md 5.2).
+
+    Parameters
+    ----------
+    closed, opened : clearjoint.structure.Modes
+        The modes with every joint closed and every joint open.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two Axes, each drawn by ``Modes.plot``.
+    """
+    fig = Figure(figsize=(9.0, 6.0), layout="constrained")
+    left, right = fig.subplots(1, 2)
+    closed.plot(left)
+    opened.plot(right)
+    return fig
