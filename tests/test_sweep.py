@@ -326,6 +326,15 @@ def test_the_command_line_runs_refuses_and_plots(
     assert main(["sweep", "--plot", str(out), "nope"]) == 2
     assert "choose one of" in capsys.readouterr().err
     assert main(["sweep", str(path), "--out", str(tmp_path / "x.nc")]) == 2
+    # --out with --plot is a figure, checked as every --plot is (suffix, no overwrite)
+    picture = ["sweep", "--plot", str(out), "amplitude_m", "--out"]
+    capsys.readouterr()
+    assert main([*picture, str(tmp_path / "m.csv")]) == 2
+    assert "--out must end in .png, .pdf, .svg, got 'm.csv'" in capsys.readouterr().err
+    assert main([*picture, str(tmp_path / "r_amplitude_m.png")]) == 2
+    assert "will not overwrite" in capsys.readouterr().err
+    assert main([*picture, str(tmp_path / "m.svg")]) == 0
+    assert "<svg" in (tmp_path / "m.svg").read_text()
     assert (
         main(["sweep", str(path), "--out", str(out), "--scheduler", "tcp://x:1", "--workers", "2"])
         == 2

@@ -252,17 +252,24 @@ def _plot_target(args: argparse.Namespace) -> Path | None:
     """The --plot file, checked before any work: a figure suffix, not overwritten unasked."""
     if args.plot is None:
         return None
-    path = Path(args.plot)
+    return _figure_target(args.plot, "--plot", force=args.force)
+
+
+def _figure_target(text: str, option: str, *, force: bool) -> Path:
+    """A figure file named by ``option``: a figure suffix, not a folder, not overwritten unasked."""
+    path = Path(text)
     if path.suffix.lower() not in PLOT_SUFFIXES:
         raise ParameterError(
-            f"--plot must end in {', '.join(PLOT_SUFFIXES)}, got {path.name!r}; "
-            "e.g. --plot result.png"
+            f"{option} must end in {', '.join(PLOT_SUFFIXES)}, got {path.name!r}; "
+            f"e.g. {option} result.png"
         )
     if path.is_dir():
-        raise ParameterError(f"--plot {path} is a folder; give a file name such as {path}/plot.png")
-    if path.exists() and not args.force:
+        raise ParameterError(
+            f"{option} {path} is a folder; give a file name such as {path}/plot.png"
+        )
+    if path.exists() and not force:
         raise OutputExistsError(
-            f"will not overwrite {path}; choose another --plot file or pass --force"
+            f"will not overwrite {path}; choose another {option} file or pass --force"
         )
     return path
 
@@ -1048,19 +1055,14 @@ def _run_sweep(args: argparse.Namespace) -> int:
 
 
 def _plot_sweep(args: argparse.Namespace) -> int:
-    from clearjoint._checks import refuse_to_overwrite
     from clearjoint.sweep import open_sweep
     from clearjoint.sweep.plot import plot_sweep
 
     store, variable = args.plot
     if args.sweep is not None:
         raise ParameterError("--plot STORE VAR takes no sweep file")
-    out = (
-        Path(args.out) if args.out else Path(store).with_name(f"{Path(store).stem}_{variable}.png")
-    )
-    if out.suffix.lower() != ".png":
-        raise ParameterError(f"with --plot, --out is the picture and must end in .png, got {out}")
-    refuse_to_overwrite([out], force=args.force)
+    default = Path(store).with_name(f"{Path(store).stem}_{variable}.png")
+    out = _figure_target(args.out or str(default), "--out", force=args.force)  # the picture
     ax = plot_sweep(open_sweep(store), variable)
     ax.figure.savefig(out, dpi=110)
     print(f"wrote {out}")
