@@ -96,3 +96,23 @@ def test_stiff_contact_runs_and_closes_its_ledger() -> None:
     motion = time_response(STIFF, 1.0, omega, 100 * 2 * math.pi / omega, restitution=0.8)
     assert motion.impact_times.size > 100
     assert motion.energy.balance_error < 1e-9
+
+
+@pytest.mark.parametrize(
+    ("alpha", "kq", "tau"),
+    [
+        (-3.0, 4e4, 2e-3),  # under-damped
+        (-300.0, 4e4, 2e-3),  # over-damped, root tau >= 1/2
+        (-200.5, 4e4, 1e-3),  # over-damped, small root tau (the expm1 branch)
+        (-200.0, 4e4, 2e-3),  # critical
+    ],
+)
+def test_homogeneous_parts_are_the_matrix_exponential(alpha: float, kq: float, tau: float) -> None:
+    """x'' = 2 alpha x' - kq x: e - alpha g and g are the first row of expm(A tau)."""
+    from scipy.linalg import expm
+
+    d2 = alpha * alpha - kq
+    e_part, g_part = kn.homogeneous_parts(alpha, d2, math.sqrt(abs(d2)), tau)
+    flow = expm(np.array([[0.0, 1.0], [-kq, 2.0 * alpha]]) * tau)
+    assert e_part - alpha * g_part == pytest.approx(flow[0, 0], rel=1e-9, abs=1e-12)
+    assert g_part == pytest.approx(flow[0, 1], rel=1e-9, abs=1e-15)

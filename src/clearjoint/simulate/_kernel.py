@@ -188,17 +188,12 @@ def phase_coefficients(
 
 
 @njit(cache=True)
-def evaluate(q: np.ndarray, slip: int, tau: float) -> tuple[float, float, float, float]:
-    """x, x', x'', x''' at time tau into the state described by ``q``."""
-    if slip == 0:
-        return q[Q_XSTICK], 0.0, 0.0, 0.0
-    k = q[Q_K]
-    m = q[Q_M]
-    alpha = q[Q_ALPHA]
-    d2 = q[Q_D2]
-    root = q[Q_ROOT]
-    xh0 = q[Q_XH]
-    vh0 = q[Q_VH]
+def homogeneous_parts(alpha: float, d2: float, root: float, tau: float) -> tuple[float, float]:
+    """e(tau) and g(tau) of the homogeneous flow x_h = e x_h0 + g (v_h0 - alpha x_h0).
+
+    Under-damped (d2 < 0), over-damped (d2 > 0, with expm1 for small root tau) and
+    critical; shared by evaluate and the monodromy flow of the shooting (_shooting.py).
+    """
     if d2 < 0.0:
         ea = math.exp(alpha * tau)
         e_part = ea * math.cos(root * tau)
@@ -212,9 +207,22 @@ def evaluate(q: np.ndarray, slip: int, tau: float) -> tuple[float, float, float,
         else:
             g_part = (ep - em) / (2.0 * root)
     else:
-        ea = math.exp(alpha * tau)
-        e_part = ea
-        g_part = tau * ea
+        e_part = math.exp(alpha * tau)
+        g_part = tau * e_part
+    return e_part, g_part
+
+
+@njit(cache=True)
+def evaluate(q: np.ndarray, slip: int, tau: float) -> tuple[float, float, float, float]:
+    """x, x', x'', x''' at time tau into the state described by ``q``."""
+    if slip == 0:
+        return q[Q_XSTICK], 0.0, 0.0, 0.0
+    k = q[Q_K]
+    m = q[Q_M]
+    alpha = q[Q_ALPHA]
+    xh0 = q[Q_XH]
+    vh0 = q[Q_VH]
+    e_part, g_part = homogeneous_parts(alpha, q[Q_D2], q[Q_ROOT], tau)
     kq = k / m
     xh = e_part * xh0 + g_part * (vh0 - alpha * xh0)
     vh = e_part * vh0 + g_part * (alpha * vh0 - kq * xh0)

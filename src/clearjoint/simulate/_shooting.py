@@ -57,23 +57,7 @@ def _flow(q: np.ndarray, slip: int, tau: float, phi_out: np.ndarray) -> None:
         phi_out[1, 1] = 0.0
         return
     alpha = q[kn.Q_ALPHA]
-    d2 = q[kn.Q_D2]
-    root = q[kn.Q_ROOT]
-    if d2 < 0.0:
-        ea = math.exp(alpha * tau)
-        e_part = ea * math.cos(root * tau)
-        g_part = ea * math.sin(root * tau) / root
-    elif d2 > 0.0:
-        em = math.exp((alpha - root) * tau)
-        ep = math.exp((alpha + root) * tau)
-        e_part = 0.5 * (ep + em)
-        if 2.0 * root * tau < 1.0:
-            g_part = em * math.expm1(2.0 * root * tau) / (2.0 * root)
-        else:
-            g_part = (ep - em) / (2.0 * root)
-    else:
-        e_part = math.exp(alpha * tau)
-        g_part = tau * e_part
+    e_part, g_part = kn.homogeneous_parts(alpha, q[kn.Q_D2], q[kn.Q_ROOT], tau)
     kq = q[kn.Q_K] / q[kn.Q_M]
     phi_out[0, 0] = e_part - g_part * alpha
     phi_out[0, 1] = g_part
