@@ -33,37 +33,9 @@ from clearjoint.harmonic.system import (
     scale_length,
 )
 from clearjoint.joint import Friction
-from clearjoint.periodic import FrequencyResponse, ResponseEvent
+from clearjoint.periodic import FrequencyResponse, ResponseEvent, _parameter_range
 
 FloatArray = NDArray[np.float64]
-
-
-def _range(
-    parameter: str,
-    force_amplitude: float,
-    omega_start: float,
-    omega_stop: float | None,
-    force_stop: float | None,
-) -> tuple[float, float]:
-    if parameter == "omega":
-        if omega_stop is None:
-            raise ParameterError("omega_stop is required with parameter='omega' (rad/s)")
-        w1 = _checks.positive("omega_stop", omega_stop, unit="rad/s")
-        if w1 == omega_start:
-            raise ParameterError(
-                f"the omega range has zero width ({omega_start!r} to {w1!r} rad/s); give two values"
-            )
-        return omega_start, w1
-    if force_stop is None:
-        raise ParameterError(
-            "force_stop is required with parameter='force': give the end of the force range (N)"
-        )
-    f1 = _checks.positive("force_stop", force_stop, unit="N")
-    if f1 == force_amplitude:
-        raise ParameterError(
-            f"the force range has zero width ({force_amplitude!r} to {f1!r} N); give two values"
-        )
-    return force_amplitude, f1
 
 
 def frequency_response(
@@ -154,7 +126,7 @@ def frequency_response(
     )
     pattern = force_vector(model, force)
     peak = float(np.max(np.abs(pattern)))
-    start, stop = _range(parameter, peak, w0, omega_stop, force_stop)
+    start, stop = _parameter_range(parameter, peak, w0, omega_stop, force_stop)
     unit_force = pattern / peak
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
