@@ -181,3 +181,16 @@ def test_cli_plot_writes_a_figure(
     assert main([*args, "--plot", str(target)]) == 0
     assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert f"and {target}" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("task", "section"), [("respond", "[excitation]"), ("decay", "[decay]")])
+def test_cli_missing_section_says_to_put_it_in_the_study_file(
+    tmp_path: Path, task: str, section: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = CHAIN.split("[excitation]")[0] if task == "respond" else CHAIN.split("[decay]")[0]
+    out = tmp_path / "r.nc"
+    assert main(["structure", str(_write(tmp_path, text)), task, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"needs a{'n' if task == 'respond' else ''} {section} section" in err
+    assert "put it in the study file" in err
+    assert not out.exists()
