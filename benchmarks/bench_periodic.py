@@ -228,7 +228,7 @@ def stiff_contact() -> None:
     matched, best = None, None
     for rtol in (1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13):
         t_ref, ref = best_of(
-            lambda rtol=rtol: per_state_reference(stiff, 1.0, omega, duration, 0.8, rtol), 1
+            lambda rtol=rtol: per_state_reference(stiff, 1.0, omega, duration, 0.8, rtol)
         )
         err = abs(ref[0] - truth[0]) / 0.1  # type: ignore[index]
         print(f"    rtol {rtol:g}: {t_ref:.3f} s, error {err:.1e}, ratio {t_ref / t_ed:.0f}x")
