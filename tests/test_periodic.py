@@ -8,6 +8,7 @@ closed form inside the gap, frequency_sweep for the period-2 region, and eq 7.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -277,3 +278,73 @@ def test_result_repr_plot_and_xarray(curve: FrequencyResponse) -> None:
     assert data["frequency"].attrs["units"] == "Hz"
     assert data.sizes["point"] == curve.omega.size
     assert list(data["event_kind"].values).count("fold") == 2
+
+
+def _study_losses() -> tuple[Joint, dict[str, object]]:
+    """examples/study.toml's joint and losses, mapped as ``clearjoint frf`` maps them."""
+    from clearjoint.simulate.study import load_study
+
+    study = load_study(Path(__file__).parents[1] / "examples" / "study.toml")
+    losses = {
+        "damping_ratio": study.damping_ratio,
+        "friction": study.friction,
+        "restitution": study.restitution,
+    }
+    return study.joint, {"force": study.force_amplitude, **losses}
+
+
+def test_study_curve_crosses_the_grazing_with_impacts_near_69_hz() -> None:
+    # examples/study.toml (k0 = 0, friction, e = 0.8): near 69.4853 Hz a short free-play
+    # excursion appears inside the tension stage, and with e < 1 the map has a square-root
+    # singularity there, on which the arclength corrector fails at any step.
+    joint, kw = _study_losses()
+    force = float(kw.pop("force"))  # type: ignore[arg-type]
+    hz = 2.0 * math.pi
+    curve = frequency_response(joint, force, 20.0 * hz, 72.0 * hz, **kw)  # type: ignore[arg-type]
+    assert curve.stop_reason == "reached"
+    assert curve.omega[-1] == pytest.approx(72.0 * hz)
+    kinks = [e for e in curve.events if e.kind == "grazing" and 69.0 < e.omega / hz < 70.0]
+    assert len(kinks) == 1
+    assert kinks[0].omega / hz == pytest.approx(69.4853, abs=2e-3)
+    # past the kink the orbit has an extra free-play stage: two more events a period
+    before = curve.cycle(int(np.argmin(np.abs(curve.omega - 69.0 * hz))))
+    after = curve.cycle(int(np.argmin(np.abs(curve.omega - 69.9 * hz))))
+    assert len(after.stages) == len(before.stages) + 2
+    # every stable point past the kink, checked by time marching (no Newton) from off the orbit
+    past = np.nonzero(curve.stable & (curve.omega > 69.5 * hz))[0]
+    assert past.size > 5
+    for i in past[:: max(1, past.size // 4)]:
+        start = curve.initial_state[i] * (1.0 + 1e-6)
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        assert ss.period_multiple == 1
+        scale = curve.amplitude[i]
+        assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
+        assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
+
+
+def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
+    # e = 0.8: the impacts make the map square-root singular where the orbit first touches
+    # the edges (omega ~ 0.913) and where the unstable branch meets the lower one (~1.0785)
+    curve = frequency_response(PYHARM, F0, 0.05, 1.8, damping_ratio=ZETA, restitution=0.8)
+    assert curve.stop_reason == "reached"
+    assert curve.omega[-1] == pytest.approx(1.8)
+    grazing = sorted(e.omega for e in curve.events if e.kind == "grazing")
+    # where the linear orbit reaches the edges: F0 / |1 - w^2 + 0.05 i w| = 0.1745
+    touch = [
+        float(w)
+        for w in np.linspace(0.8, 1.2, 400001)
+        if abs(F0 / math.hypot(1.0 - w * w, 0.05 * w) - PYHARM.compression_gap) < 2e-6
+    ]
+    assert grazing[0] == pytest.approx(min(touch), rel=2e-3)
+    assert grazing[-1] == pytest.approx(max(touch), rel=2e-3)
+    # both stable branches and the unstable one are there
+    assert (~curve.stable).sum() > 10
+    stable = np.nonzero(curve.stable)[0]
+    for i in stable[:: max(1, stable.size // 6)]:
+        start = curve.initial_state[i] * (1.0 + 1e-6)
+        ss = steady_state(
+            PYHARM, F0, float(curve.omega[i]), damping_ratio=ZETA, restitution=0.8, initial=start
+        )
+        scale = curve.amplitude[i]
+        assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
+        assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9

@@ -13,6 +13,16 @@ y = (u / u_scale, lambda / lambda_scale):
   turn of the tangent sharper than ``max_turn`` (that is how the corrector is kept
   from jumping to another branch near a fold). At the smallest step a sharp turn
   is accepted: the branch has a kink there (grazing), which it must cross.
+- crossing a kink where no arclength step converges (a grazing with impacts, where the
+  map has a square-root singularity and Newton fails on it): a natural-parameter step,
+  lambda moved by a fixed increment (growing tenfold from ten times the smallest step
+  to ``max_kink_jump``), Newton at that fixed lambda from the last point's unknowns
+  (then from ``restart``'s guess, e.g. a short transient), accepted only when the
+  unknowns moved less than the largest arclength step (else it is another branch); the
+  point reached is recorded in ``Branch.kinks`` and the pseudo-arclength continuation
+  resumes from it. A jump backwards in lambda (a fold at the kink) is taken only when
+  ``differs`` says the point is on another piece of the branch than the last one. If
+  nothing converges the branch stops with the reason saying where.
 """
 
 from __future__ import annotations
@@ -40,6 +50,12 @@ FloatArray = NDArray[np.float64]
 
 #: residual(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data for the caller)
 Residual = Callable[[FloatArray, float], tuple[FloatArray, FloatArray, FloatArray, Any]]
+#: restart(u, lam) -> a fresh guess of the unknowns at lam (None: none), used at a kink
+Restart = Callable[[FloatArray, float], FloatArray | None]
+#: differs(data_last, data_new) -> True when the two points lie on different smooth pieces
+Differs = Callable[[Any, Any], bool]
+#: equivalents(u) -> other coordinates of the same solution (e.g. across a jump at the section)
+Equivalents = Callable[[FloatArray], list[FloatArray]]
 
 
 class ContinuationError(ClearjointError, RuntimeError):
@@ -66,6 +82,9 @@ class ContinuationSettings:
     growth : float
     max_turn : float
         Largest angle between successive tangents, rad, before the step is cut.
+    max_kink_jump : float
+        Largest natural-parameter step (scaled lambda) tried to cross a kink
+        where the arclength step fell below ``min_step``; 0 turns that off.
     chord_parameter : bool
         Ask for dR/dlambda only at the first corrector iteration of each step and
         keep it (a chord in that one column): the residual is then called as
@@ -83,6 +102,7 @@ class ContinuationSettings:
     hard: int = 5
     growth: float = 1.5
     max_turn: float = 0.3
+    max_kink_jump: float = 1e-4
     chord_parameter: bool = False
 
     def __post_init__(self) -> None:
@@ -112,7 +132,11 @@ class Branch:
     data : list
         What the residual returned as data at each converged point.
     reason : str
-        Why it stopped: "reached", "max_points", "step too small", "left the range".
+        Why it stopped: "reached", "max_points", "left the range", or "step too
+        small at lambda = ...: ..." (no step converged, the kink jump included).
+    kinks : (k,) ndarray of int
+        Indices of the points reached by a natural-parameter jump across a kink
+        (the kink lies between point i - 1 and point i).
     """
 
     u: FloatArray
@@ -121,6 +145,7 @@ class Branch:
     iterations: NDArray[np.int64]
     data: list[Any] = field(repr=False)
     reason: str
+    kinks: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 @njit(cache=True)
@@ -203,6 +228,9 @@ def continue_branch(
     u_scale: FloatArray,
     lam_scale: float,
     settings: ContinuationSettings | None = None,
+    restart: Restart | None = None,
+    differs: Differs | None = None,
+    equivalents: Equivalents | None = None,
 ) -> Branch:
     """Follow R(u, lambda) = 0 from (u0, lam0) until lambda reaches ``lam_stop``.
 
@@ -219,6 +247,18 @@ def continue_branch(
     lam_scale : float
         Typical size of a change of the parameter.
     settings : ContinuationSettings, optional
+    restart : callable, optional
+        restart(u, lam) -> a guess of the unknowns at ``lam`` (or None), tried at a
+        kink when Newton from the last point's unknowns fails.
+    differs : callable, optional
+        differs(data_last, data_new) -> bool: the two points lie on different
+        smooth pieces. Needed for a backward jump at a kink; without it only
+        forward jumps are tried.
+    equivalents : callable, optional
+        equivalents(u) -> other unknowns that describe the same solution as ``u``
+        (a state on a jump of the section: before and after an impact); at a
+        kink Newton starts from them too, and a point near one of them counts as
+        near the last point.
 
     Returns
     -------
@@ -248,6 +288,7 @@ def continue_branch(
     h = settings.step
     stop = lam_stop / scale[-1]
     reason = "max_points"
+    kinks: list[int] = []
     curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
     while len(ys) < settings.max_points:
         predicted = y + h * t + 0.5 * h * h * curvature
@@ -260,8 +301,50 @@ def continue_branch(
                 attempt = None
         if attempt is None:
             if h <= settings.min_step:
-                reason = "step too small"
-                break
+                # the way the branch was travelling (the tangent at a kink can point anywhere)
+                travel = float(np.sign(y[-1] - ys[-2][-1])) if len(ys) > 1 else 0.0
+                jump = _cross_kink(
+                    residual,
+                    y,
+                    travel or direction,
+                    datas[-1],
+                    scale,
+                    settings,
+                    stop,
+                    direction,
+                    restart,
+                    differs,
+                    equivalents,
+                )
+                if jump is None:
+                    reason = (
+                        f"step too small at lambda = {y[-1] * scale[-1]:.10g}: no arclength step "
+                        "converged, nor a parameter jump of up to "
+                        f"{settings.max_kink_jump * scale[-1]:.3g}"
+                    )
+                    break
+                (y_new, a_new, data_new, its), relabelled = jump
+                t_new = _tangent(a_new, t)
+                if float(t_new @ (y_new - y)) < 0.0:
+                    t_new = -t_new  # go on away from the kink (at a grazing fold: back in lambda)
+                if direction * (y_new[-1] - stop) >= 0.0:
+                    reason = "reached"
+                    if direction * (y_new[-1] - stop) == 0.0:
+                        ys.append(y_new)
+                        ts.append(t_new)
+                        datas.append(data_new)
+                        iters.append(its)
+                    break
+                if not relabelled:
+                    kinks.append(len(ys))
+                curvature = np.zeros_like(t)
+                y, t = y_new, t_new
+                ys.append(y)
+                ts.append(t)
+                datas.append(data_new)
+                iters.append(its)
+                h = settings.step
+                continue
             h = max(0.5 * h, settings.min_step)
             continue
         if direction * (y_new[-1] - stop) >= 0.0:
@@ -300,4 +383,66 @@ def continue_branch(
         iterations=np.array(iters, dtype=np.int64),
         data=datas,
         reason=reason,
+        kinks=np.array(kinks, dtype=np.int64),
     )
+
+
+def _cross_kink(
+    residual: Residual,
+    y: FloatArray,
+    forward: float,
+    data: Any,
+    scale: FloatArray,
+    settings: ContinuationSettings,
+    stop: float,
+    direction: float,
+    restart: Restart | None,
+    differs: Differs | None,
+    equivalents: Equivalents | None,
+) -> tuple[tuple[FloatArray, FloatArray, Any, int], bool] | None:
+    """A natural-parameter step across a kink: Newton at fixed lambda, smallest jump first.
+
+    Forward (``forward``: +1 or -1, the way lambda was moving) from ten times
+    ``min_step`` up to ``max_kink_jump``, tenfold each time, not past ``stop``; then
+    backward when ``differs`` is given, accepting only a point on another smooth piece
+    than the last one. Returns the point and whether it was reached through an
+    equivalent of the last one (no kink).
+    """
+    if settings.max_kink_jump <= 0.0:
+        return None
+    d = y.size - 1
+    t = np.zeros(d + 1)  # unused by Newton at fixed lambda
+    sides = [forward] if differs is None else [forward, -forward]
+    for side in sides:
+        jump = 10.0 * settings.min_step
+        while jump <= settings.max_kink_jump * (1.0 + 1e-12):
+            lam = y[-1] + side * jump
+            if side * direction > 0.0 and direction * (lam - stop) > 0.0:
+                lam = stop
+            last = y[:d] * scale[:d]
+            anchors = [last] + (equivalents(last) if equivalents is not None else [])
+            tried = 0
+            while tried <= len(anchors):
+                if tried < len(anchors):
+                    u: FloatArray | None = anchors[tried]
+                else:  # then from a fresh guess (a short transient, say)
+                    u = restart(last, float(lam * scale[-1])) if restart is not None else None
+                tried += 1
+                if u is None:
+                    continue
+                start = np.concatenate((np.asarray(u, dtype=np.float64) / scale[:d], [lam]))
+                found = _correct(residual, start, t, scale, settings, fixed_lambda=True)
+                if found is None:
+                    continue
+                gaps = [float(np.linalg.norm(found[0][:d] - a / scale[:d])) for a in anchors]
+                if min(gaps) > settings.max_step:
+                    continue  # further than any arclength step: another branch, not this one
+                if side != forward and not differs(data, found[2]):  # type: ignore[misc]
+                    continue
+                # near an equivalent of the last point, not the point itself: the same orbit
+                # written across a jump of the section, no kink of the branch
+                return found, int(np.argmin(gaps)) > 0 and gaps[0] > settings.max_step
+            if lam == stop:
+                break
+            jump *= 10.0
+    return None

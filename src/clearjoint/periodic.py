@@ -38,11 +38,13 @@ from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate._shooting import (
     N_RES,
     R_DLAM,
+    R_EVENTS,
     R_JAC,
     R_RES,
     R_XMAX,
     R_XMIN,
     Shot,
+    _set_parameter,
     map_residual,
     newton_orbit,
     start_state,
@@ -553,6 +555,33 @@ def frequency_response(
     p = _parameters(joint, f0, w0, damping_ratio, friction, restitution)
     x_scale = max(joint.clearance / 2.0, first.amplitude)
     v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
+    code = 0 if parameter == "omega" else 1
+
+    def restart(u: FloatArray, lam: float) -> FloatArray | None:
+        """A short transient at ``lam`` from ``u``: the start of Newton across a kink."""
+        q = p.copy()
+        _set_parameter(q, code, lam)
+        state = _initial_state(q, u)
+        try:
+            _run(q, state, _TRANSIENT_PERIODS, q[kn.P_TF], record=False)
+        except SimulationError:
+            return None
+        return np.asarray(state[:2], dtype=np.float64)
+
+    def differs(last: FloatArray, new: FloatArray) -> bool:
+        """Another smooth piece of the branch: the orbit meets a different number of events."""
+        return bool(last[R_EVENTS] != new[R_EVENTS])
+
+    edges = (joint.compression_gap, -joint.tension_gap)
+    e = float(restitution)
+
+    def equivalents(u: FloatArray) -> list[FloatArray]:
+        """At a gap edge the section may sit on an impact: the state before and after it."""
+        x, v = float(u[0]), float(u[1])
+        if e <= 0.0 or min(abs(x - edge) for edge in edges) > 1e-6 * x_scale:
+            return []
+        return [np.array([x, e * v]), np.array([x, v / e])]  # v+ = e v- on entering contact
+
     branch = continue_branch(
         _map_residual(p, parameter),
         np.array(first.initial_state),
@@ -568,6 +597,9 @@ def frequency_response(
             tolerance=1e-11,
             chord_parameter=True,
         ),
+        restart=restart,
+        differs=differs,
+        equivalents=equivalents,
     )
     rows = np.array(branch.data)
     n = branch.lam.size
@@ -580,7 +612,9 @@ def frequency_response(
     mu = np.take_along_axis(mu, np.argsort(-np.abs(mu), axis=1), axis=1)
     stable = np.max(np.abs(mu), axis=1) < 1.0
     amplitude = 0.5 * (x_max - x_min)
-    events = _events(joint, branch.tangent[:, -1], mono, x_max, x_min, omega, force, amplitude)
+    events = _events(
+        joint, branch.tangent[:, -1], mono, x_max, x_min, omega, force, amplitude, branch.kinks
+    )
     return FrequencyResponse(
         omega=omega,
         force_amplitude=force,
@@ -611,8 +645,15 @@ def _events(
     omega: FloatArray,
     force: FloatArray,
     amplitude: FloatArray,
+    kinks: NDArray[np.int64] | None = None,
 ) -> list[ResponseEvent]:
-    """Folds, period doublings and grazings between successive points, located linearly."""
+    """Folds, period doublings and grazings between successive points, located linearly.
+
+    A kink the continuation crossed by a parameter step (``kinks``: the index of
+    the point after it) is a grazing too: where no edge crossing of x_max or x_min
+    explains it, the orbit grazed an edge from inside contact (a short stage
+    appears or vanishes) or began to stick; it is placed at the last point before.
+    """
     trace = mono[:, 0, 0] + mono[:, 1, 1]
     det = mono[:, 0, 0] * mono[:, 1, 1] - mono[:, 0, 1] * mono[:, 1, 0]
     tests = {
@@ -640,6 +681,15 @@ def _events(
                 return float(a[i] + frac * (a[i + 1] - a[i]))
 
             events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), note)))
+    for k in kinks if kinks is not None else []:
+        before = int(k) - 1
+        if not any(index == before and e.kind == "grazing" for index, e in events):
+            note = (
+                "a kink crossed by a parameter step: a stage appears or vanishes (the orbit "
+                "grazes a gap edge from inside contact) or sticking begins"
+            )
+            where = (float(omega[before]), float(force[before]), float(amplitude[before]))
+            events.append((before, ResponseEvent("grazing", *where, note)))
     events.sort(key=lambda item: item[0])
     merged: list[tuple[int, ResponseEvent]] = []
     for index, event in events:

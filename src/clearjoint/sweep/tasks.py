@@ -17,10 +17,14 @@ library's; this module only maps a point's values onto it:
 * ``identify``: the identification of each record of a set (base: a glob of files),
   one point per file along the ``record`` axis;
 * ``rig_test``: one test of the virtual rig (clearjoint.rig), measured with the
-  point's own noise seed, then identified (clearjoint.identify): truth beside estimate.
+  point's own noise seed, then identified (clearjoint.identify): truth beside estimate;
+* ``frequency_response``: the whole curve of exact periodic orbits by continuation
+  (clearjoint.periodic, MODEL.md 5.1), reduced to its peak, folds and unstable points; a
+  curve the continuation cut short is a failed point (NaN, with where and why);
+* ``nonlinear_mode``: the joint's first nonlinear mode at one modal amplitude by harmonic
+  balance (clearjoint.harmonic, MODEL.md 5.4): frequency, damping ratio, energy per cycle.
 
-Structure, periodic-orbit and continuation frequency-response tasks register themselves the same
-way with :func:`register_task` when their features land.
+Structure tasks register themselves the same way with :func:`register_task`.
 """
 
 from __future__ import annotations
@@ -377,6 +381,126 @@ register_task(
         description=(
             "frequency-response curve by a stepped sine up and down (simulate.frequency_sweep; "
             "no pin contact friction): its peak, where, and the up/down jump"
+        ),
+    )
+)
+
+
+def _frequency_response(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.periodic import frequency_response
+    from clearjoint.simulate import SimulationError
+
+    study = study_at(base, values)
+    low, high = values["task.frequency_start"], values["task.frequency_stop"]
+    if not high > low:
+        raise ParameterError(f"task.frequency_stop must exceed frequency_start, got {low}, {high}")
+    curve = frequency_response(
+        study.joint,
+        study.force_amplitude,
+        2.0 * math.pi * low,
+        2.0 * math.pi * high,
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+        max_points=int(values["task.max_points"]),
+    )
+    if curve.stop_reason != "reached":
+        # a curve cut short has no honest peak: the point is NaN with this reason
+        last = curve.omega[-1] / (2.0 * math.pi) if curve.omega.size else low
+        raise SimulationError(f"the continuation stopped at {last:.6g} Hz ({curve.stop_reason})")
+    peak = int(np.argmax(curve.amplitude))
+    kinds = [event.kind for event in curve.events]
+    return {
+        "peak_amplitude_m": float(curve.amplitude[peak]),
+        "peak_frequency_hz": float(curve.omega[peak] / (2.0 * math.pi)),
+        "peak_x_max_m": float(curve.x_max[peak]),
+        "folds": float(kinds.count("fold")),
+        "period_doublings": float(kinds.count("period_doubling")),
+        "unstable_points": float(np.count_nonzero(~curve.stable)),
+        "points": float(curve.omega.size),
+    }
+
+
+register_task(
+    Task(
+        name="frequency_response",
+        base="study",
+        parameters={
+            **JOINT_PARAMETERS,
+            "excitation.force_amplitude": FORCING_PARAMETERS["excitation.force_amplitude"],
+        },
+        options={
+            "task.frequency_start": (None, Parameter("frequency", "Hz", open_lower=True)),
+            "task.frequency_stop": (None, Parameter("frequency", "Hz", open_lower=True)),
+            "task.max_points": (2000.0, Parameter("dimensionless", "", lower=10.0)),
+        },
+        outputs={
+            "peak_amplitude_m": "m",
+            "peak_frequency_hz": "Hz",
+            "peak_x_max_m": "m",
+            "folds": "",
+            "period_doublings": "",
+            "unstable_points": "",
+            "points": "",
+        },
+        evaluate=_frequency_response,
+        description=(
+            "whole frequency-response curve of exact periodic orbits by continuation "
+            "(clearjoint.periodic, MODEL.md 5.1): its peak, folds, doublings, unstable points"
+        ),
+    )
+)
+
+
+def _nonlinear_mode(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.harmonic import nonlinear_modes
+    from clearjoint.simulate import SimulationError
+
+    study = study_at(base, values)
+    mode = nonlinear_modes(
+        study.joint,
+        1,
+        [values["task.amplitude"]],
+        harmonics=int(values["task.harmonics"]),
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+    )
+    if not bool(mode.converged[0]):
+        raise SimulationError("the nonlinear mode did not converge at this amplitude")
+    return {
+        "frequency_hz": float(mode.frequency[0] / (2.0 * math.pi)),
+        "damping_ratio": float(mode.damping_ratio[0]),
+        "energy_per_cycle_j": float(mode.energy_per_cycle[0]),
+        "x_max_m": float(mode.x_max[0]),
+        "x_min_m": float(mode.x_min[0]),
+    }
+
+
+register_task(
+    Task(
+        name="nonlinear_mode",
+        base="study",
+        parameters=JOINT_PARAMETERS,
+        options={
+            "task.amplitude": (None, Parameter("length", "m", open_lower=True)),
+            "task.harmonics": (7.0, Parameter("dimensionless", "", lower=1.0)),
+        },
+        outputs={
+            "frequency_hz": "Hz",
+            "damping_ratio": "",
+            "energy_per_cycle_j": "J",
+            "x_max_m": "m",
+            "x_min_m": "m",
+        },
+        evaluate=_nonlinear_mode,
+        description=(
+            "the joint's nonlinear mode at modal amplitude task.amplitude by harmonic "
+            "balance (EPMC, clearjoint.harmonic, MODEL.md 5.4): frequency and damping"
         ),
     )
 )
