@@ -35,3 +35,21 @@ def test_report_on_the_lab_csv_finds_the_clearances_and_fits_eq_21(
         assert float(row["clearance_m"]) == pytest.approx(truth, rel=0.02)
     fitted = {(row["law"], row["group"]) for row in read_rows(out / "fits.csv")}
     assert ("eq 21", "joint-1, 40 Hz") in fitted
+
+
+def test_identify_step_prints_what_the_page_says_and_finds_the_clearances(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Step 2 of the page: `clearjoint identify examples/lab-csv/*.csv --out lab-results.csv`."""
+    out = tmp_path / "lab-results.csv"
+    files = sorted(str(path) for path in LAB.glob("*.csv"))
+    assert main(["identify", *files, "--out", str(out), "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    assert "identified 6 of 6 records (5 flagged, see the flag and flag_reason columns)" in printed
+    page = (ROOT / "docs" / "tutorial" / "csv-to-report.md").read_text(encoding="utf-8")
+    assert "identified 6 of 6 records (5 flagged, see the flag and flag_reason columns)" in page
+    rows = read_rows(out)
+    assert len(rows) == 6
+    for row in rows:
+        truth = TRUTH[Path(row["file"]).name.split("_")[0]]
+        assert float(row["clearance_m"]) == pytest.approx(truth, rel=0.005)

@@ -161,6 +161,16 @@ def test_text_pint_misreads_is_refused(text: str, kind: str, words: str) -> None
     assert words in str(info.value)
 
 
+def test_a_list_where_one_value_is_expected_is_not_taken_for_a_decimal_comma() -> None:
+    # '1um,5um' (as `clearjoint stiffness --amplitude` takes it) given to an option that wants
+    # one value: the old hint 'e.g. 1um.5um' was no fix
+    with pytest.raises(ParameterError) as info:
+        parse_quantity("1um,5um", "length", name="--amplitude")
+    assert str(info.value) == "--amplitude 1um,5um: give one length here, not a list, e.g. 0.106mm"
+    with pytest.raises(ParameterError, match=r"e\.g\. 0\.106 mm"):
+        parse_quantity("0,106 mm", "length", name="--x")  # a decimal comma is still one
+
+
 @pytest.mark.parametrize(
     ("text", "value"),
     [("1%", 0.01), ("80 %", 0.8), ("500 ppm", 5e-4), ("2mm/m", 2e-3), ("0.3", 0.3), ("1e-2", 0.01)],

@@ -76,6 +76,8 @@ EXAMPLES: dict[str, str] = {
 }
 
 #: The number a quantity's text must start with (pint would read "mm" as 1 mm).
+#: One comma between two digits, as in '0,106mm': a decimal comma.
+_DECIMAL_COMMA = re.compile(r"[^,]*\d,\d[^,]*")
 _LEADING_NUMBER = re.compile(r"^[+-]?((\d+\.?\d*|\.\d+)(e[+-]?\d+)?|nan|inf)", re.IGNORECASE)
 #: A second number right after the first, which pint multiplies: "1 000 mm" is 0 mm.
 _SECOND_NUMBER = re.compile(r"^\s*(?!1\s*/)[\d.(]")  # "50 1/s" is one number and a unit
@@ -172,9 +174,12 @@ def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "refuse") ->
     if not raw:
         raise ParameterError(f"{name}: empty value; give a {kind} such as {example}")
     if "," in raw:
-        raise ParameterError(
-            f"{name} {raw}: write the decimal point as '.', e.g. {raw.replace(',', '.')}"
-        )
+        if _DECIMAL_COMMA.fullmatch(raw):
+            raise ParameterError(
+                f"{name} {raw}: write the decimal point as '.', e.g. {raw.replace(',', '.')}"
+            )
+        # '1um,5um' is a list, not a decimal comma: '1um.5um' would be no fix
+        raise ParameterError(f"{name} {raw}: give one {kind} here, not a list, e.g. {example}")
     number = _LEADING_NUMBER.match(raw)
     if not number:
         raise ParameterError(
