@@ -89,6 +89,12 @@ def test_cli_writes_netcdf_and_json(
         ),
         (('dampers = ["50N*s/m", "30N s/m"]', 'dampers = ["50N", "30N"]'), "is not a damping"),
         (("[decay]", "[decay]\nclearance_m = 1e-4"), "unknown key 'clearance_m' in [decay]"),
+        (('frequency = "600Hz"', 'frequency = "0Hz"'), "frequency must be finite and > 0"),
+        (("periods = 4", "periods = 0"), "periods must be at least 1, got 0"),
+        (('dof = "n2x"\ninitial', 'dof = "n2x"\nmode = 0\ninitial'), "mode must be 1 to 2"),
+        (('dof = "n2x"\ninitial', 'dof = "n2x"\nmode = 3\ninitial'), "mode must be 1 to 2"),
+        (('initial_amplitude = "0.5mm"', 'initial_amplitude = "0mm"'), "must be finite and not 0"),
+        (('duration = "20ms"', 'duration = "0ms"'), "duration must be finite and > 0"),
         (("[decay]", "[decays]"), "unknown section [decays]"),
     ],
 )

@@ -279,6 +279,15 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
         for key in ("frequency", "force_dof", "force_amplitude"):
             if key not in ex:
                 raise StructureStudyError(f"{where}: [excitation] {key} is required")
+        if not (math.isfinite(ex["frequency"]) and ex["frequency"] > 0.0):
+            raise StructureStudyError(
+                f"{where}: [excitation] frequency must be finite and > 0, got "
+                f"{ex['frequency']:g} Hz; e.g. frequency = \"15Hz\""
+            )
+        if ex.get("periods", 20) < 1:
+            raise StructureStudyError(
+                f"{where}: [excitation] periods must be at least 1, got {ex['periods']}"
+            )
         omega = 2.0 * math.pi * ex["frequency"]
         force = np.zeros(structure.n_dof)
         force[dof_index("excitation", ex["force_dof"])] = ex["force_amplitude"]
@@ -289,10 +298,26 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
             if key not in de:
                 raise StructureStudyError(f"{where}: [decay] {key} is required")
         decay_dof = dof_index("decay", de["dof"])
-        shape = structure.modes("closed").shapes[:, de.get("mode", 1) - 1]
+        closed = structure.modes("closed")
+        mode = de.get("mode", 1)
+        if not 1 <= mode <= closed.shapes.shape[1]:
+            raise StructureStudyError(
+                f"{where}: [decay] mode must be 1 to {closed.shapes.shape[1]} (the closed "
+                f"modes, lowest first), got {mode}"
+            )
+        if not (math.isfinite(de["initial_amplitude"]) and de["initial_amplitude"] != 0.0):
+            raise StructureStudyError(
+                f"{where}: [decay] initial_amplitude must be finite and not 0 (a decay needs a "
+                f'deflection), got {de["initial_amplitude"]:g} m; e.g. initial_amplitude = "3mm"'
+            )
+        if not (math.isfinite(de["duration"]) and de["duration"] > 0.0):
+            raise StructureStudyError(
+                f"{where}: [decay] duration must be finite and > 0, got {de['duration']:g} s"
+            )
+        shape = closed.shapes[:, mode - 1]
         if shape[decay_dof] == 0.0:
             raise StructureStudyError(
-                f"{where}: [decay] mode {de.get('mode', 1)} does not move {de['dof']}; "
+                f"{where}: [decay] mode {mode} does not move {de['dof']}; "
                 "choose another dof or mode"
             )
         initial = de["initial_amplitude"] * shape / shape[decay_dof]
