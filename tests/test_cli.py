@@ -458,3 +458,17 @@ def test_an_output_folder_that_is_a_file_is_refused_before_the_work(
     assert err.strip().endswith(f"{blocker} is a file; give a folder"), err
     assert not any(line.startswith("- ") for line in err.splitlines())  # before any stage
     assert not (tmp_path / "r.csv").exists()
+
+
+def test_the_progress_bar_leaves_a_redirected_stdout_clean(tmp_path: Path) -> None:
+    """`clearjoint identify FILE > out.txt`: the output, with no line drawn by a progress bar."""
+    record = Path(__file__).parent / "data" / "brfd" / "2Hz36lbtension0.5amplitude.json"
+    command = [sys.executable, "-m", "clearjoint", "identify", str(record)]
+    result = subprocess.run(
+        [*command, "--out", str(tmp_path / "r.csv")],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[0].startswith("identified 1 of 1"), result.stdout

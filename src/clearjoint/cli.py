@@ -650,9 +650,7 @@ def _run_rig(args: argparse.Namespace) -> int:
     if args.quiet:
         manifest = run_campaign(campaign, args.out, jobs=args.jobs, force=args.force)
     else:
-        from rich.progress import Progress
-
-        with Progress(transient=True) as bar:
+        with _progress_bar() as bar:
             task = bar.add_task(f"{total} tests on {jobs} processes", total=total)
             manifest = run_campaign(
                 campaign,
@@ -686,9 +684,7 @@ def _run_identify(args: argparse.Namespace) -> int:
     if args.quiet:
         results, failures = identify_files(args.files, **options)
     else:
-        from rich.progress import Progress
-
-        with Progress(transient=True) as bar:
+        with _progress_bar() as bar:
             task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
             results, failures = identify_files(
                 args.files,
@@ -980,6 +976,16 @@ def _run_frf(args: argparse.Namespace) -> int:
     return 0
 
 
+def _progress_bar(*columns: Any) -> Any:
+    """A rich progress bar on stderr, drawn only on a terminal (stdout stays the output)."""
+    from rich.console import Console
+    from rich.progress import Progress
+
+    return Progress(
+        *columns, console=Console(stderr=True), transient=True, disable=not sys.stderr.isatty()
+    )
+
+
 def _warning_printer(command: str) -> Callable[..., None]:
     """A warnings.showwarning that prints one line, without the source file and line."""
 
@@ -1017,9 +1023,7 @@ def _run_sweep(args: argparse.Namespace) -> int:
             from rich.progress import Progress, TimeRemainingColumn
 
             bar = stack.enter_context(
-                Progress(
-                    *Progress.get_default_columns()[:-1], TimeRemainingColumn(), transient=True
-                )
+                _progress_bar(*Progress.get_default_columns()[:-1], TimeRemainingColumn())
             )
             task = bar.add_task(f"{sweep.n_points} points", total=sweep.n_points)
 
