@@ -1222,7 +1222,7 @@ def _run_structure(args: argparse.Namespace) -> int:
             "balance_error": motion.balance_error,
             "amplitude_m": backbone.amplitude.tolist(),
             "frequency_hz": (backbone.omega / (2.0 * math.pi)).tolist(),
-            "damping_ratio": [None if math.isnan(z) else z for z in backbone.damping_ratio],
+            "damping_ratio": [None if math.isnan(z) else float(z) for z in backbone.damping_ratio],
         }
         drawn = backbone
     data.to_netcdf(out, engine="h5netcdf")
