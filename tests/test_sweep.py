@@ -297,6 +297,21 @@ def test_a_stopped_sweep_resumes_with_only_the_missing_chunks(tmp_path: Path) ->
             "samples = N",
         ),
         ('base = "nothere.toml"\n[task]\nname = "steady_state"', "no such study file"),
+        (
+            'base = "study.toml"\n[task]\nname = "stepped_sine"\nfrequency_start = "300Hz"\n'
+            'frequency_stop = "900Hz"\nfrequency_steps = 0\n[axes.joint]\nmass = ["1kg"]',
+            r"\[task\] frequency_steps: 1 of 1 values lie outside its range \(>= 2",
+        ),
+        (
+            'base = "study.toml"\n[task]\nname = "stepped_sine"\nfrequency_start = "nan Hz"\n'
+            'frequency_stop = "900Hz"\n[axes.joint]\nmass = ["1kg"]',
+            r"\[task\] frequency_start: 1 of 1 values lie outside its range",
+        ),
+        (
+            'base = "study.toml"\n[task]\nname = "frequency_response"\n'
+            'frequency_start = "1300Hz"\nfrequency_stop = "900Hz"\n[axes.joint]\nmass = ["1kg"]',
+            r"frequency_stop \(900 Hz\) must exceed frequency_start \(1300 Hz\)",
+        ),
     ],
 )
 def test_bad_sweep_files_are_one_clear_error(tmp_path: Path, text: str, message: str) -> None:

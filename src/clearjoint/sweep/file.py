@@ -204,7 +204,7 @@ def _quantity(where: str, key: str, raw: Any, parameter: Parameter) -> float:
 
 def _check_range(where: str, key: str, values: FloatArray, p: Parameter, hint: str) -> None:
     low = values < p.lower if not p.open_lower else values <= p.lower
-    bad = int(np.count_nonzero(low | (values > p.upper)))
+    bad = int(np.count_nonzero(low | (values > p.upper) | np.isnan(values)))
     if bad:
         edge = f"> {p.lower:g}" if p.open_lower else f">= {p.lower:g}"
         valid = edge + (f" and <= {p.upper:g}" if math.isfinite(p.upper) else "")
@@ -380,6 +380,9 @@ def _read(path: Path) -> Sweep:
             known = ["name", "outputs", *(k.split(".", 1)[1] for k in task.options)]
             raise SweepError(f"{where}: unknown key {key!r} in [task]; known: {known}")
         fixed[full] = _quantity(where, f"[task] {key}", value, task.options[full][1])
+        _check_range(
+            where, f"[task] {key}", np.array([fixed[full]]), task.options[full][1], "change it"
+        )
     for full, (default, parameter) in task.options.items():
         if full in fixed or full in varied:
             continue
@@ -389,6 +392,13 @@ def _read(path: Path) -> Sweep:
                 f'or an [axes.task] axis, e.g. {full.split(".", 1)[1]} = "5{parameter.unit}"'
             )
         fixed[full] = default
+
+    start, stop = fixed.get("task.frequency_start"), fixed.get("task.frequency_stop")
+    if start is not None and stop is not None and not stop > start:
+        raise SweepError(
+            f"{where}: [task] frequency_stop ({stop:g} Hz) must exceed frequency_start "
+            f"({start:g} Hz)"
+        )
 
     samples = _count(where, raw, "samples", 0)
     if draws and samples < 1:
