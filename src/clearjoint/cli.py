@@ -839,10 +839,12 @@ def _print_findings(results: Path) -> None:
     """Print the findings table of a written report, one row per paper finding."""
     import json
 
+    from clearjoint.findings import testable
+
     rows = json.loads(results.read_text(encoding="utf-8"))["findings"]
     print("the paper's findings (reproduced, source): see report.html for the evidence")
     for row in rows:
-        mark = "yes" if row["reproduced"] else "NO "
+        mark = "yes" if row["reproduced"] else ("NO " if testable(row) else "n/a")
         print(f"  {mark}  {row['source']:<9}  {row['finding']}")
 
 

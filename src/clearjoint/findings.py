@@ -23,7 +23,7 @@ The rule, the same for every row (z = 2 standard errors):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -67,6 +67,18 @@ class _Check:
 
     holds: bool
     evidence: str
+    testable: bool = True  # False: the data cannot say (a law not fitted, too few tests)
+
+
+#: How a row's ``why`` begins when the data cannot test the finding (``reproduced`` is then
+#: false, and the tables print "n/a", not "NO": not shown is not refuted).
+NOT_TESTABLE = "Not testable with these data"
+
+
+def testable(row: Finding | Mapping[str, Any]) -> bool:
+    """Whether the data could test this finding (a row of the table or of results.json)."""
+    why = row.why if isinstance(row, Finding) else str(row["why"])
+    return not why.startswith(NOT_TESTABLE)
 
 
 def _sig(value: float, error: float, sign: int) -> bool:
@@ -88,7 +100,7 @@ def _per_side(
             if outcome is not None:
                 results.append((outcome[0], f"{name} {side}: {outcome[1]}"))
     if not results:
-        return _Check(False, empty)
+        return _Check(False, empty, testable=False)
     return _Check(all(r[0] for r in results), "; ".join(r[1] for r in results))
 
 
@@ -114,7 +126,7 @@ def _ordering(analysis: Analysis, column: str) -> _Check:
         holds.append(_sig(mean, se, 1))
         parts.append(f"{name}: {_mn(mean)} ± {_mn(se)} MN/m (n = {diff.size})")
     if not holds:
-        return _Check(False, "no jointed structure with both sides identified")
+        return _Check(False, "no jointed structure with both sides identified", testable=False)
     return _Check(all(holds), "; ".join(parts))
 
 
@@ -249,7 +261,7 @@ def energy_slopes(analysis: Analysis, total: bool = False) -> dict[str, tuple[fl
 def _energy_trend(analysis: Analysis, variable: str, sign: int, total: bool = False) -> _Check:
     slopes = energy_slopes(analysis, total)
     if not slopes:
-        return _Check(False, "eq 22 not fitted")
+        return _Check(False, "eq 22 not fitted", testable=False)
     value, error = slopes[variable]
     name = "A = X" if total else "A = Abar"
     unit = {"w": ("per 100 Hz", 2 * math.pi * 100), "A": ("per 10 µm", 1e-5)}
@@ -273,7 +285,7 @@ class Timing:
 
 def _speed(timing: Timing | None) -> _Check:
     if timing is None:
-        return _Check(False, "not measured here: it needs the model's exact cycles")
+        return _Check(False, "not measured here: it needs the model's exact cycles", testable=False)
     ratio = timing.integration_s / timing.law_s
     return _Check(
         ratio > 1.0,
@@ -303,6 +315,9 @@ def _row(
         evidence += f". {control_name}: {theirs.evidence}"
     if input_check is not None:
         evidence += f". Contact slopes: {input_check.evidence}"
+    if not ours.testable:
+        why = f"{NOT_TESTABLE}: {ours.evidence}. The model: {why_model}"
+        return Finding(finding, paper, False, "model", evidence, why)
     if not ours.holds:
         why = f"Not shown by these data at {Z:g} standard errors. The model: {why_model}"
         return Finding(finding, paper, False, "model", evidence, why)

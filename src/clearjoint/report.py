@@ -32,7 +32,7 @@ from matplotlib.figure import Figure
 from clearjoint import fit
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.analysis import Analysis
-from clearjoint.findings import Finding, Timing
+from clearjoint.findings import Finding, Timing, testable
 
 #: What the study assumes, stated in every report.
 ASSUMPTIONS: tuple[str, ...] = (
@@ -194,13 +194,21 @@ def _relative(path: str, folder: Path) -> str:
 # ---- the page ---------------------------------------------------------------------------------
 
 
+_CLASS = {"yes": "yes", "NO": "no", "n/a": "na"}
+
+
+def _mark(f: Finding) -> str:
+    """yes, NO (the data say otherwise or not clearly) or n/a (the data cannot test it)."""
+    return "yes" if f.reproduced else ("NO" if testable(f) else "n/a")
+
+
 def findings_html(findings: Sequence[Finding]) -> str:
     """The findings table: one row per paper finding, reproduced and source first."""
     head = "<tr><th>paper finding</th><th>reproduced</th><th>source</th><th>evidence</th></tr>"
     body = "".join(
-        f'<tr class="{"yes" if f.reproduced else "no"}"><td><b>{html.escape(f.finding)}</b><br>'
+        f'<tr class="{_CLASS[_mark(f)]}"><td><b>{html.escape(f.finding)}</b><br>'
         f"<small>{html.escape(f.paper)}</small></td>"
-        f"<td>{'yes' if f.reproduced else 'NO'}</td><td>{html.escape(f.source)}</td>"
+        f"<td>{_mark(f)}</td><td>{html.escape(f.source)}</td>"
         f"<td><small>{html.escape(f.evidence)}</small><br><i>{html.escape(f.why)}</i></td></tr>"
         for f in findings
     )
@@ -218,9 +226,12 @@ def distrust(study: Study) -> list[str]:
             + "; ".join(given)
             + "."
         )
-    missing = [f.finding for f in study.findings if not f.reproduced]
+    missing = [f.finding for f in study.findings if not f.reproduced and testable(f)]
     if missing:
         out.append("Not reproduced (see the evidence): " + "; ".join(missing) + ".")
+    untested = [f.finding for f in study.findings if not testable(f)]
+    if untested:
+        out.append("Not testable with these records (n/a): " + "; ".join(untested) + ".")
     poor = sorted(
         {
             f"{r['law']} {r['group']} (R^2 = {r['r_squared']:.2f})"
