@@ -209,3 +209,18 @@ def check_tangent_stiffness(
     assert analytic.shape == points.shape
     scale = max(float(np.max(np.abs(analytic))), 1e-300)
     np.testing.assert_allclose(analytic, numeric, rtol=0.0, atol=rtol * scale)
+
+
+#: A study file of a joint without clearance, zeta = 0.05: the forced linear oscillator
+#: (m = 2 kg, k = 80 MN/m) whose closed forms the sweep tests compare with.
+LINEAR_STUDY = """
+[joint]
+mass = "2kg"
+clearance = "0mm"
+compression_stiffness = "8e7N/m"
+[excitation]
+force_amplitude = "100N"
+frequency = "300Hz"
+[losses]
+damping_ratio = 0.05
+"""

@@ -21,18 +21,7 @@ from clearjoint.errors import OutputExistsError
 from clearjoint.parallel import StoreError, point_seed
 from clearjoint.sweep import SERIAL, TASKS, Sweep, SweepError, open_sweep, run_sweep
 from clearjoint.sweep.plot import plot_sweep
-
-LINEAR_STUDY = """
-[joint]
-mass = "2kg"
-clearance = "0mm"
-compression_stiffness = "8e7N/m"
-[excitation]
-force_amplitude = "100N"
-frequency = "300Hz"
-[losses]
-damping_ratio = 0.05
-"""
+from helpers import LINEAR_STUDY
 
 GAP_STUDY = """
 [joint]

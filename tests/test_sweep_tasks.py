@@ -15,18 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from clearjoint.sweep import SERIAL, Sweep, run_sweep
-
-LINEAR = """
-[joint]
-mass = "2kg"
-clearance = "0mm"
-compression_stiffness = "8e7N/m"
-[excitation]
-force_amplitude = "100N"
-frequency = "300Hz"
-[losses]
-damping_ratio = 0.05
-"""
+from helpers import LINEAR_STUDY
 
 LOSSLESS_GAP = """
 [joint]
@@ -49,7 +38,7 @@ def _sweep(tmp_path: Path, study: str, sweep: str) -> Path:
 def test_frequency_response_peak_is_the_linear_resonance(tmp_path: Path) -> None:
     path = _sweep(
         tmp_path,
-        LINEAR,
+        LINEAR_STUDY,
         """
 base = "study.toml"
 [task]
