@@ -171,6 +171,35 @@ def test_joint_is_a_mass_on_its_element() -> None:
     assert joint.element == _element()
 
 
+def test_element_is_built_once_and_is_not_part_of_the_value() -> None:
+    import pickle
+
+    joint = Joint(2.0, 1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=2e-5)
+    assert joint.element is joint.element  # one element, not a new one per call
+    # the gap edges g_c = c/2 + d, g_t = c/2 - d are the element's, bit for bit
+    assert (
+        (joint.compression_gap, joint.tension_gap)
+        == (0.5e-4 + 2e-5, 0.5e-4 - 2e-5)
+        == (
+            joint.element.compression_gap,
+            joint.element.tension_gap,
+        )
+    )
+    twin = Joint(2.0, 1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=2e-5)
+    assert twin == joint
+    assert hash(twin) == hash(joint)
+    assert twin.element is not joint.element
+    assert "element" not in repr(joint)
+    moved = dataclasses.replace(joint, clearance=2e-4)
+    assert moved.element.clearance == 2e-4
+    assert moved.compression_gap == 1e-4 + 2e-5
+    copy = pickle.loads(pickle.dumps(joint))
+    assert copy == joint
+    assert copy.element == joint.element
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        joint.element = _element()  # type: ignore[misc]
+
+
 def test_losses_replace_the_five_keywords_and_refuse_both() -> None:
     from clearjoint.simulate import time_response
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -36,7 +37,7 @@ def test_linear_limit_matches_the_textbook_amplitude() -> None:
 
 
 def test_orbit_inside_the_gap_is_the_linear_gap_oscillator() -> None:
-    joint = JOINT.__class__(**{**JOINT.__dict__, "gap_stiffness": 2e6})
+    joint = dataclasses.replace(JOINT, gap_stiffness=2e6)
     omega, zeta, f0 = TWO_PI * 100.0, 0.05, 50.0
     ss = steady_state(joint, f0, omega, damping_ratio=zeta)
     c_v = 2 * zeta * math.sqrt(2.0 * 8e7)

@@ -223,6 +223,12 @@ class Joint:
     ParameterError
         A value is NaN, infinite or outside its range, or its unit is not of the
         field's dimension; the message names the field.
+
+    Attributes
+    ----------
+    element : ClearanceJoint
+        The massless joint the mass sits on (no friction, restitution 1), built and
+        validated once with the Joint; left out of ``==``, ``hash`` and ``repr``.
     """
 
     mass: float
@@ -231,6 +237,7 @@ class Joint:
     tension_stiffness: float = field(default=None)  # type: ignore[assignment]
     gap_stiffness: float = 0.0
     gap_offset: float = 0.0
+    element: ClearanceJoint = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -250,27 +257,17 @@ class Joint:
             "gap_offset",
         ):
             set_(self, name, getattr(element, name))
-
-    @property
-    def element(self) -> ClearanceJoint:
-        """The massless joint this mass sits on (no friction, restitution 1)."""
-        return ClearanceJoint(
-            self.clearance,
-            self.compression_stiffness,
-            self.tension_stiffness,
-            self.gap_stiffness,
-            self.gap_offset,
-        )
+        set_(self, "element", element)
 
     @property
     def compression_gap(self) -> float:
         """Distance g_c from x = 0 to the compression gap edge, m."""
-        return 0.5 * self.clearance + self.gap_offset
+        return self.element.compression_gap
 
     @property
     def tension_gap(self) -> float:
         """Distance g_t from x = 0 to the tension gap edge, m."""
-        return 0.5 * self.clearance - self.gap_offset
+        return self.element.tension_gap
 
     @property
     def large_amplitude_stiffness(self) -> float:
