@@ -200,3 +200,238 @@ def test_cli_missing_section_says_to_put_it_in_the_study_file(
     assert f"needs a{'n' if task == 'respond' else ''} {section} section" in err
     assert "put it in the study file" in err
     assert not out.exists()
+
+
+# ---- Rayleigh damping read with its true dimensions (alpha in 1/s, beta in s) -------------
+
+TWO_MASS = """
+[structure]
+kind = "chain"
+masses = ["2kg", "1.5kg"]
+stiffnesses = ["6e7N/m", "4e7N/m"]
+{alpha}
+rayleigh_beta = "2e-6s"
+"""
+
+
+@pytest.mark.parametrize(
+    "alpha",
+    [
+        'rayleigh_alpha = "20rad/s"',
+        'rayleigh_alpha = "20/s"',
+        'rayleigh_alpha = "20 1/s"',
+        'rayleigh_alpha = "1200/min"',
+        "rayleigh_alpha_per_s = 20",
+    ],
+)
+def test_rayleigh_damping_of_a_two_mass_chain_is_the_textbook_one(
+    tmp_path: Path, alpha: str
+) -> None:
+    """zeta_k = alpha / (2 w_k) + beta w_k / 2 on the chain's closed-form modes.
+
+    w_k^2 are the roots of m1 m2 w^4 - (m1 k2 + m2 (k1 + k2)) w^2 + k1 k2 = 0; the damping
+    ratio is read from the eigenvalues of the first-order system, -zeta w +- i w sqrt(1 -
+    zeta^2), so neither side uses the structure's own modes.
+    """
+    import numpy as np
+
+    s = load_structure_study(_write(tmp_path, TWO_MASS.format(alpha=alpha))).structure
+    m1, m2, k1, k2, a, b = 2.0, 1.5, 6e7, 4e7, 20.0, 2e-6
+    assert s.rayleigh == pytest.approx((a, b), rel=1e-15)
+    w2 = np.sort(np.roots([m1 * m2, -(m1 * k2 + m2 * (k1 + k2)), k1 * k2]).real)
+    w = np.sqrt(w2)
+    textbook = a / (2 * w) + b * w / 2
+    m, c = np.diag([m1, m2]), s.damping_matrix()
+    k = np.array([[k1 + k2, -k2], [-k2, k2]])
+    system = np.block(
+        [[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(m, k), -np.linalg.solve(m, c)]]
+    )
+    poles = np.linalg.eigvals(system)
+    poles = poles[poles.imag > 0]
+    poles = poles[np.argsort(np.abs(poles))]
+    np.testing.assert_allclose(np.abs(poles), w, rtol=1e-9)
+    np.testing.assert_allclose(-poles.real / np.abs(poles), textbook, rtol=1e-9)
+    assert textbook.min() > 1e-3  # both terms matter: alpha's and beta's
+
+
+@pytest.mark.parametrize(
+    ("alpha", "message"),
+    [
+        ('rayleigh_alpha = "20Hz"', "ambiguous for a rate in 1/s"),
+        ('rayleigh_alpha = "20m"', "is not a rate"),
+        ("rayleigh_alpha = 20", 'give a unit, e.g. "20/s", or name the SI unit in the key'),
+    ],
+)
+def test_rayleigh_alpha_refuses_cycles_and_wrong_units(
+    tmp_path: Path, alpha: str, message: str
+) -> None:
+    with pytest.raises(StructureStudyError, match=message.replace("(", r"\(").replace(".", r"\.")):
+        load_structure_study(_write(tmp_path, TWO_MASS.format(alpha=alpha)))
+
+
+# ---- a [joint] that no member carries, a mast without joints ----------------------------
+
+MAST = """
+[structure]
+kind = "mast"
+bays = 2
+longeron_rigidity = "2e7N"
+node_mass = "0.5kg"
+
+[joint]
+clearance = "50um"
+compression_stiffness = "5e7N/m"
+gap_stiffness = "1e5N/m"
+"""
+
+
+def test_mast_study_with_a_joint_has_joints_whose_opening_lowers_the_modes(
+    tmp_path: Path,
+) -> None:
+    s = load_structure_study(_write(tmp_path, MAST)).structure
+    assert len(s.joint_members) == 4  # 2 bays, a hinge in each longeron
+    assert s.modes("open").omega[0] < 0.5 * s.modes("closed").omega[0]
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (MAST.split("[joint]")[0], "a mast needs a [joint] section"),
+        (CHAIN.replace("joints = [true, false]", ""), "[joint] is given but no link carries it"),
+        (CHAIN.replace("joints = [true, false]", "joints = [false, false]"), "no link carries"),
+    ],
+    ids=["mast without [joint]", "chain without joints", "chain with no joint on"],
+)
+def test_a_study_never_drops_its_joints_silently(
+    tmp_path: Path, text: str, message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(
+        ["structure", str(_write(tmp_path, text)), "modes", "--out", str(tmp_path / "x.nc")]
+    )
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err
+    assert err.count("\n") == 1
+
+
+# ---- issue 11's bad input, end to end on the command line --------------------------------
+
+TRUSS = """
+[structure]
+kind = "truss"
+nodes = [["0m", "0m"], ["1m", "0m"], ["0m", "1m"], ["1m", "1m"]]
+members = [[0, 2], [1, 3], [1, 2], [2, 3]]
+supports = [0, 1]
+member_stiffness = "1e7N/m"
+masses = ["0kg", "0kg", "2kg", "2kg"]
+joint_members = [0]
+
+[joint]
+clearance = "0.1mm"
+compression_stiffness = "8e7N/m"
+
+[excitation]
+frequency = "100Hz"
+force_dof = "n3x"
+force_amplitude = "10N"
+"""
+
+
+def test_the_truss_of_the_bad_input_cases_is_good(tmp_path: Path) -> None:
+    out = tmp_path / "x.nc"
+    assert main(["structure", str(_write(tmp_path, TRUSS)), "modes", "--out", str(out)]) == 0
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        pytest.param(
+            ('["1m", "1m"]]', '["0m", "1000mm"]]'),
+            "member 3 (nodes 2-3) has zero length; move its nodes apart",
+            id="zero-length member",
+        ),
+        pytest.param(
+            ("[1, 3], [1, 2]", "[1, 7], [1, 2]"),
+            "member 1 end names node 7, which does not exist (nodes are 0 to 3)",
+            id="unknown node",
+        ),
+        pytest.param(
+            ("supports = [0, 1]", "supports = [0, 5]"),
+            "support names node 5, which does not exist (nodes are 0 to 3)",
+            id="unknown support",
+        ),
+        pytest.param(
+            ("joint_members = [0]", "joint_members = [0, 6]"),
+            "joint_members names member 6, which does not exist (members are 0 to 3)",
+            id="unknown joint member",
+        ),
+        pytest.param(
+            ("[2, 3]]", "[2, 3], [0, 1]]", "joint_members = [0]", "joint_members = [4]"),
+            "member 4 joins two supports (nodes 0, 1), so a joint there can never move; "
+            "remove it or free one of its nodes",
+            id="joint on a support",
+        ),
+        pytest.param(
+            ("supports = [0, 1]", "supports = [0]"),
+            "node 1 is free but has mass 0.0 kg; give it a mass > 0 or make it a support",
+            id="massless free node",
+        ),
+        pytest.param(
+            (
+                'supports = [0, 1]\nmember_stiffness = "1e7N/m"\nmasses = ["0kg", "0kg",',
+                'supports = [0]\nmember_stiffness = "1e7N/m"\nmasses = ["0kg", "2kg",',
+            ),
+            "the structure is singular: it can move as a rigid body or mechanism",
+            id="singular structure",
+        ),
+        pytest.param(
+            ('force_dof = "n3x"', 'force_dof = "n1x"'),
+            "names DOF 'n1x' of node 1, a support (fixed); give a DOF of a free node",
+            id="force on a support",
+        ),
+        pytest.param(
+            ('force_dof = "n3x"', 'force_dof = "n3z"'),
+            "names DOF 'n3z', which does not exist",
+            id="force on a DOF the structure lacks",
+        ),
+        pytest.param(
+            (
+                'compression_stiffness = "8e7N/m"',
+                'compression_stiffness = "8e7N/m"\nrestitution = 0.8',
+            ),
+            "restitution 0.8 on a joint in series with a member of stiffness 10000000.0 N/m is "
+            "not defined (no mass between them to stop); set restitution=1",
+            id="restitution in series with a member",
+        ),
+        pytest.param(
+            (
+                'compression_stiffness = "8e7N/m"',
+                'compression_stiffness = "8e7N/m"\nfriction_coefficient = 0.2',
+            ),
+            "[joint] friction_coefficient: Coulomb friction in a structure's joints is not carried",
+            id="friction in a structure joint",
+        ),
+        pytest.param(
+            ('member_stiffness = "1e7N/m"', 'member_stiffness = "0N/m"'),
+            "member stiffness must be > 0",
+            id="member without stiffness",
+        ),
+    ],
+)
+def test_bad_structure_is_one_line_naming_the_item_and_the_fix(
+    tmp_path: Path, change: tuple[str, ...], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = TRUSS
+    for old, new in zip(change[::2], change[1::2], strict=True):
+        assert old in text
+        text = text.replace(old, new)
+    path = _write(tmp_path, text)
+    out = tmp_path / "x.nc"
+    code = main(["structure", str(path), "modes", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err
+    assert err.startswith(f"clearjoint structure: error: {path}: ")
+    assert err.count("\n") == 1
+    assert "Traceback" not in err
+    assert not out.exists()

@@ -32,6 +32,7 @@ UNIT_SUFFIXES: dict[str, str] = {
     "velocity": "m_per_s",
     "acceleration": "m_per_s2",
     "damping": "n_s_per_m",
+    "rate": "per_s",
 }
 
 #: Kinds that are not quantities: checked for their type only.

@@ -40,6 +40,7 @@ SI_UNITS: dict[str, str] = {
     "velocity": "m/s",
     "acceleration": "m/s^2",
     "damping": "N s/m",
+    "rate": "1/s",
     "dimensionless": "",
 }
 
@@ -56,6 +57,7 @@ UNIT_HINTS: dict[str, str] = {
     "velocity": "m/s",
     "acceleration": "m/s^2",
     "damping": "N*s/m",
+    "rate": "/s",
     "dimensionless": "",
 }
 
@@ -72,6 +74,7 @@ EXAMPLES: dict[str, str] = {
     "velocity": "0.1m/s",
     "acceleration": "100m/s^2",
     "damping": "50N*s/m",
+    "rate": "0.5/s",
     "dimensionless": "0.3",
 }
 
@@ -118,6 +121,8 @@ def _convert(quantity: Any, kind: str, name: str, raw: str) -> Any:
     root = quantity.to_root_units()
     turns = dict(root.unit_items()).get("radian", 0)
     try:
+        if kind == "rate":
+            return _rate(quantity, root, turns, name, raw)
         if kind in ("frequency", "angular_frequency") and turns == 1:
             radians_per_second = root.to("radian / second").magnitude
             return radians_per_second / _TWO_PI if kind == "frequency" else radians_per_second
@@ -139,6 +144,25 @@ def _convert(quantity: Any, kind: str, name: str, raw: str) -> Any:
             f"{name}: {raw!r} is not a {kind_words} (its unit is {quantity.units:~}); "
             f"write it like {example}"
         ) from None
+
+
+def _rate(quantity: Any, root: Any, turns: int, name: str, raw: str) -> Any:
+    """Magnitude in 1/s of a rate such as Rayleigh's alpha (it multiplies M, as omega does).
+
+    The radian is a pure number here (alpha = 2 zeta omega is in rad/s, which is 1/s), so
+    "2rad/s" and "2/s" are both 2 /s; Hz counts cycles and is refused as ambiguous by 2 pi.
+    """
+    import pint
+
+    if any("hertz" in unit for unit, _ in quantity.unit_items()):
+        raise ParameterError(
+            f"{name}: {raw!r} is ambiguous for a rate in 1/s (Hz counts cycles, 2 pi apart "
+            f"from rad/s); write it in 1/s or rad/s, like {EXAMPLES['rate']}"
+        )
+    if turns not in (0, 1):
+        raise pint.errors.DimensionalityError(quantity.units, "1/s")
+    plain = root / registry().radian if turns == 1 else root
+    return plain.to("1/s").magnitude
 
 
 def parse_quantity(text: str, kind: str, *, name: str, bare: Bare = "refuse") -> float:

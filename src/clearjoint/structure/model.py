@@ -231,7 +231,7 @@ class Structure:
         for i in range(n_nodes):
             if i not in supports and not (math.isfinite(masses[i]) and masses[i] > 0.0):
                 raise StructureError(
-                    f"node {i} is free but has mass {masses[i]!r} kg; give it a mass > 0 "
+                    f"node {i} is free but has mass {float(masses[i])!r} kg; give it a mass > 0 "
                     "or make it a support"
                 )
         alpha, beta = (float(v) for v in self.rayleigh)

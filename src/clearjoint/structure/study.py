@@ -13,9 +13,10 @@ Example (a 10-bay mast)::
     bay_height = "0.5m"
     longeron_rigidity = "2e7N"   # EA
     node_mass = "0.5kg"
-    rayleigh_beta = "2e-6s"
+    rayleigh_alpha = "0.5/s"     # multiplies M: a rate in 1/s (or rad/s); Hz is refused
+    rayleigh_beta = "2e-6s"      # multiplies K: a time
 
-    [joint]                  # the same hinge joint in every longeron
+    [joint]                  # the same hinge joint in every longeron (a mast needs one)
     clearance = "50um"
     compression_stiffness = "5e7N/m"
     gap_stiffness = "1e5N/m"
@@ -36,23 +37,25 @@ A truss takes ``nodes`` (a list of coordinates, with units), ``members`` (pairs 
 indices), ``supports``, ``member_stiffness``, ``masses`` (one per node, or one for all) and
 ``joint_members`` (indices of the members that carry the [joint]). A chain takes
 ``masses``, ``stiffnesses`` (``"inf"`` for a rigid link), ``dampers`` (``"50N*s/m"``) as lists
-and ``joints`` as a list of true/false (the [joint] on that link or none).
+and ``joints`` as a list of true/false (the [joint] on that link or none). A [joint]
+that no member carries is refused, as is friction in it (the structure solver does not
+carry Coulomb friction).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from clearjoint.errors import ClearjointError
+from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import UNIT_SUFFIXES, quantity, read_toml
 from clearjoint.joint import ClearanceJoint
 from clearjoint.structure.builders import chain, mast, truss
-from clearjoint.structure.model import Member, Structure
+from clearjoint.structure.model import Member, Structure, StructureError
 
 KEYS: dict[str, dict[str, str]] = {
     "structure": {
@@ -66,7 +69,7 @@ KEYS: dict[str, dict[str, str]] = {
         "node_mass": "mass",
         "tip_mass": "mass",
         "member_damping": "damping",
-        "rayleigh_alpha": "frequency",
+        "rayleigh_alpha": "rate",
         "rayleigh_beta": "time",
         "masses": "mass list",
         "stiffnesses": "stiffness list",
@@ -85,6 +88,10 @@ KEYS: dict[str, dict[str, str]] = {
         "gap_stiffness": "stiffness",
         "gap_offset": "length",
         "restitution": "dimensionless",
+        # known so that they are refused with the reason, not as unknown keys:
+        "friction_coefficient": "dimensionless",
+        "lateral_load": "force",
+        "friction_region": "text",
     },
     "excitation": {
         "frequency": "frequency",
@@ -201,19 +208,47 @@ def load_structure_study(path: str | Path) -> StructureStudy:
 
 
 def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
-    st = values.get("structure", {})
-    joint_values = values.get("joint")
-    joint = None
-    if joint_values is not None:
-        for key in ("clearance", "compression_stiffness"):
-            if key not in joint_values:
-                raise StructureStudyError(f"{where}: [joint] {key} is required")
-        joint = ClearanceJoint(**joint_values)
+    joint = _joint(values.get("joint"), where)
+    try:
+        structure = _structure(values.get("structure", {}), joint, where)
+    except (StructureError, ParameterError) as exc:  # the item and its fix, in the file's words
+        raise StructureStudyError(f"{where}: {exc}") from None
+    return _tasks(values, structure, where)
+
+
+def _joint(joint_values: dict[str, Any] | None, where: str) -> ClearanceJoint | None:
+    """The [joint] of the study, or None; friction is refused with its reason."""
+    if joint_values is None:
+        return None
+    for key in ("friction_coefficient", "lateral_load", "friction_region"):
+        if key in joint_values:
+            raise StructureStudyError(
+                f"{where}: [joint] {key}: Coulomb friction in a structure's joints is not "
+                "carried (a sticking joint is a constraint the exact solver does not hold); "
+                "remove it, or study one joint with friction by `clearjoint simulate`"
+            )
+    for key in ("clearance", "compression_stiffness"):
+        if key not in joint_values:
+            raise StructureStudyError(f"{where}: [joint] {key} is required")
+    try:
+        return ClearanceJoint(**joint_values)
+    except ParameterError as exc:
+        raise StructureStudyError(f"{where}: [joint] {exc}") from None
+
+
+def _structure(st: dict[str, Any], joint: ClearanceJoint | None, where: str) -> Structure:
+    """Build the [structure] with its [joint]; a joint given and never used is refused."""
     kind = st.get("kind", "mast")
     rayleigh = (st.get("rayleigh_alpha", 0.0), st.get("rayleigh_beta", 0.0))
     if kind == "mast":
         if "bays" not in st:
             raise StructureStudyError(f"{where}: [structure] bays is required for a mast")
+        if joint is None:
+            raise StructureStudyError(
+                f"{where}: a mast needs a [joint] section (the hinge joint of its longerons, "
+                'e.g. clearance = "50um", compression_stiffness = "5e7N/m"); without one it '
+                "would have no joints"
+            )
         options = {
             k: st[k]
             for k in (
@@ -237,7 +272,14 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
         joints = None if flags is None else [joint if f else None for f in flags]
         if flags is not None and any(flags) and joint is None:
             raise StructureStudyError(f"{where}: [structure] joints asks for joints; add [joint]")
+        if joint is not None and not (flags and any(flags)):
+            raise StructureStudyError(
+                f"{where}: [joint] is given but no link carries it; say which do in "
+                "[structure], e.g. joints = [true, false], or remove [joint]"
+            )
         structure = chain(st["masses"], st["stiffnesses"], joints, st.get("dampers"))
+        if rayleigh != (0.0, 0.0):
+            structure = replace(structure, rayleigh=rayleigh)
     elif kind == "truss":
         for key in ("nodes", "members", "supports", "member_stiffness"):
             if key not in st:
@@ -245,6 +287,17 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
         with_joint = set(st.get("joint_members", []))
         if with_joint and joint is None:
             raise StructureStudyError(f"{where}: [structure] joint_members needs a [joint]")
+        if joint is not None and not with_joint:
+            raise StructureStudyError(
+                f"{where}: [joint] is given but no member carries it; list them in "
+                "[structure] joint_members (member indices), or remove [joint]"
+            )
+        unknown = sorted(i for i in with_joint if not 0 <= i < len(st["members"]))
+        if unknown:
+            raise StructureStudyError(
+                f"{where}: [structure] joint_members names member {unknown[0]}, which does "
+                f"not exist (members are 0 to {len(st['members']) - 1})"
+            )
         members = [
             Member(
                 a,
@@ -263,9 +316,20 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
         raise StructureStudyError(
             f"{where}: [structure] kind must be 'mast', 'chain' or 'truss', got {kind!r}"
         )
+    return structure
+
+
+def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) -> StructureStudy:
+    """The [excitation], [decay] and [output] of the study, on its structure."""
     names = structure.dof_names
 
     def dof_index(section: str, name: str) -> int:
+        axes = "xyz"[: structure.dim]
+        if name in {f"n{node}{axis}" for node in structure.supports for axis in axes}:
+            raise StructureStudyError(
+                f"{where}: [{section}] names DOF {name!r} of node {name[1:-1]}, a support "
+                f"(fixed); give a DOF of a free node: {', '.join(names[:3])} ... {names[-1]}"
+            )
         if name not in names:
             raise StructureStudyError(
                 f"{where}: [{section}] names DOF {name!r}, which does not exist; "
