@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from clearjoint.records import (
     CSV_MAGIC,
     Record,
     RecordError,
+    RecordWarning,
     read_brfd,
     read_record,
     resample,
@@ -427,3 +429,99 @@ def test_channels_given_as_pint_quantities_are_converted_not_stripped() -> None:
     assert (r.time[-1], r.force[0], r.displacement[0]) == pytest.approx((0.099, 1000.0, 2e-5))
     with pytest.raises(RecordError, match="is not a length"):
         Record(time=i / 100, force=i, displacement=ureg.Quantity(i, "N"))
+
+
+# ---- accelerometers speak g; a column a record has no channel for is left out -------------
+
+G_N = 9.80665  # standard gravity, m/s^2 (CGPM 1901), written here, not read from the package
+
+
+def lab_with_acceleration(unit: str, extra: str = "", extra_value: str = "") -> str:
+    """Time (s), force (kN), displacement (mm), acceleration in ``unit`` (g) and an extra column.
+
+    The acceleration is exact: x = X cos(w t) gives a = -w^2 x, written in g.
+    """
+    w = 2 * math.pi * 50
+    head = f"time [s],force [kN],displacement [mm],acceleration [{unit}]{extra}\n"
+    rows = []
+    for i in range(N_LAB):
+        t, f, x = lab_signals(i)
+        a_in_g = -(w**2) * x * 1e-3 / G_N
+        rows.append(f"{t:.6f},{f:.6f},{x:.7f},{a_in_g:.9e}{extra_value}\n")
+    return head + "".join(rows)
+
+
+@pytest.mark.parametrize("unit", ["g", "gn", "g0"])
+def test_acceleration_in_g_is_standard_gravity(tmp_path: Path, unit: str) -> None:
+    r = read_record(write_csv(tmp_path, lab_with_acceleration(unit), "acc.csv"))
+    check_lab_record(r)
+    w = 2 * math.pi * 50
+    assert r.acceleration is not None
+    exact = -(w**2) * 2e-5 * np.cos(w * np.arange(N_LAB) / RATE)  # m/s^2, as lab_signals
+    np.testing.assert_allclose(r.acceleration, exact, rtol=1e-8, atol=1e-9)
+    assert r.units["acceleration"] == unit
+
+
+@pytest.mark.parametrize(
+    ("header", "words"),
+    [
+        ("time [s],force [g],displacement [m]\n", "force is in 'g', which is not a unit of N"),
+        ("time [s],force [N],displacement [g]\n", "displacement is in 'g', which is not a unit"),
+    ],
+)
+def test_g_is_standard_gravity_for_acceleration_only(
+    tmp_path: Path, header: str, words: str
+) -> None:
+    path = write_csv(tmp_path, header + "".join(f"{t},1,1\n" for t in UNIFORM))
+    with pytest.raises(RecordError, match=re.escape(words)):
+        read_record(path)
+
+
+@pytest.mark.parametrize(
+    ("extra", "value", "shown"),
+    [
+        (",temperature [C]", ",21.5", "'temperature [C]'"),
+        (",Temperature (°C),strain [ue]", ",21.5,3", "'Temperature (°C)', 'strain [ue]'"),
+    ],
+)
+def test_a_lab_csv_with_extra_columns_reads_the_known_ones_and_warns_once(
+    tmp_path: Path, extra: str, value: str, shown: str
+) -> None:
+    path = write_csv(tmp_path, lab_with_acceleration("g", extra, value), "extra.csv")
+    with pytest.warns(RecordWarning) as caught:
+        r = read_record(path)
+    check_lab_record(r)
+    assert r.acceleration is not None
+    assert set(r.units) == {"time", "force", "displacement", "acceleration"}
+    assert len(caught) == 1
+    message = str(caught[0].message)
+    assert f"ignored column(s) {shown}" in message
+    assert str(path) in message
+    assert "\n" not in message
+
+
+def test_an_unknown_column_in_place_of_a_needed_one_is_named(tmp_path: Path) -> None:
+    body = "time [s],force [N],displacment [mm]\n" + "".join(f"{t},1,1\n" for t in UNIFORM)
+    path = write_csv(tmp_path, body)
+    with pytest.raises(
+        RecordError,
+        match=r"no displacement column, and no channel for "
+        r"'displacment \[mm\]'.*rename the column that holds displacement",
+    ):
+        read_record(path)
+
+
+@pytest.mark.filterwarnings("default::clearjoint.records.RecordWarning")
+def test_cli_warns_in_one_line_for_an_extra_column(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from clearjoint.cli import main
+
+    path = write_csv(tmp_path, lab_with_acceleration("g", ",temperature [C]", ",21.5"), "x.csv")
+    main(["identify", str(path), "--out", str(tmp_path / "out.csv")])
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if "ignored column" in line]
+    assert lines == [
+        f"clearjoint identify: warning: {path}: ignored column(s) 'temperature [C]': a record "
+        "has no such channel (it reads time, force, displacement, velocity, acceleration)"
+    ]

@@ -56,6 +56,10 @@ class RecordError(ClearjointError, ValueError):
     """A record or a record file is unusable; the message names the file and the fix."""
 
 
+class RecordWarning(UserWarning):
+    """A record file was read, but part of it was left out (the message says which)."""
+
+
 @dataclass(frozen=True)
 class Record:
     """One test record in SI units (frequencies in Hz, as in files).
@@ -242,11 +246,19 @@ FAST_FACTORS = {
 }
 
 
+#: Standard gravity, m/s^2: accelerometers speak g, where pint's "g" is the gram.
+STANDARD_GRAVITY = 9.80665
+#: Spellings of standard gravity taken for an acceleration column (and for no other).
+GRAVITY_UNITS = ("g", "gn", "g0")
+
+
 def _factor(where: str, channel: str, unit: str) -> float:
     """The factor that takes ``channel`` in ``unit`` to SI; errors name the file and channel."""
     fast = FAST_FACTORS.get((channel, unit.strip()))
     if fast is not None:
         return fast
+    if channel == "acceleration" and unit.strip() in GRAVITY_UNITS:
+        return STANDARD_GRAVITY
     import pint
 
     target = SI[channel]
@@ -483,16 +495,17 @@ def _read_csv(path: Path, resample_: bool) -> Record:
         preamble = "; ".join(notes)
         meta["notes"] = f"{meta['notes']}; {preamble}" if meta.get("notes") else preamble
     channels: list[tuple[str, str]] = []
+    ignored: list[str] = []  # columns a record has no channel for (a temperature, ...)
     for k, name_text in enumerate(names):
         match = _NAME_UNIT.match(name_text)
-        if not match:
-            raise RecordError(f"{where}: cannot read the column name {name_text!r}")
-        name = match["name"].strip().lower().replace(" ", "_")
+        name = match["name"].strip().lower().replace(" ", "_") if match else ""
+        if match is None or name not in SI:
+            ignored.append(name_text.strip())
+            channels.append(("", ""))  # keeps each channel at its column
+            continue
         unit = (match["unit"] or "").strip()
         if unit_fields is not None and not unit:
             unit = unit_fields[k].strip("[]() ")
-        if name not in SI:
-            raise RecordError(f"{where}: unknown column {name!r}; known: {', '.join(SI)}")
         if not unit:
             raise RecordError(
                 f"{where}: column {name_text!r} has no unit; name columns like "
@@ -523,8 +536,25 @@ def _read_csv(path: Path, resample_: bool) -> Record:
     columns: dict[str, FloatArray] = {}
     units: dict[str, str] = {}
     for k, (name, unit) in enumerate(channels):
-        columns[name] = table_[:, k] * _factor(where, name, unit)
-        units[name] = unit
+        if name:
+            columns[name] = table_[:, k] * _factor(where, name, unit)
+            units[name] = unit
+    if ignored:
+        missing = [c for c in ("time", "force", "displacement") if c not in columns]
+        shown = ", ".join(repr(c) for c in ignored)
+        if missing:
+            raise RecordError(
+                f"{where}: no {missing[0]} column, and no channel for {shown}; a record has "
+                f"columns {', '.join(SI)}: rename the column that holds {missing[0]}"
+            )
+        import warnings
+
+        warnings.warn(
+            f"{where}: ignored column(s) {shown}: a record has no such channel (it reads "
+            f"{', '.join(SI)})",
+            RecordWarning,
+            stacklevel=3,
+        )
     if "time" in columns:
         columns["time"] = _clock(where, columns["time"], rows, delimiter, channels, resample_)
     return _assemble(where, columns, units, meta, resample_)
