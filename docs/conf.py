@@ -68,7 +68,8 @@ sphinx_gallery_conf = {
     "examples_dirs": [str(HERE.parent / "examples" / "gallery")],
     "gallery_dirs": ["auto_examples"],
     "filename_pattern": r"/plot_",
-    "image_scrapers": ("matplotlib", "docs_figures.scraper"),
+    # docs_figures first: it draws each docs figure once (docs/_ext/docs_figures.py says why)
+    "image_scrapers": ("docs_figures.scraper", "matplotlib"),
     "reset_modules": ("matplotlib",),
     "download_all_examples": False,
     "remove_config_comments": True,

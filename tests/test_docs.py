@@ -11,6 +11,9 @@ from __future__ import annotations
 import re
 import tomllib
 from pathlib import Path
+from typing import Any
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Figures cut out of the two reports by examples/gallery/plot_report_figures.py.
@@ -95,3 +98,61 @@ def test_no_docstring_has_a_bar_pair_that_restructuredtext_reads_as_a_substituti
                 texts.append((node.body[0].lineno, doc))
         found += [f"{path.name}:{n}: {m.group(0)}" for n, t in texts for m in bars.finditer(t)]
     assert not found, f"write abs(...) instead of |...|: {found}"
+
+
+def test_a_docs_figure_is_drawn_once_so_the_build_and_make_figures_write_the_same_bytes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A constrained layout moves its text at each new draw, so the build drew the docs'
+    figures after sphinx-gallery's matplotlib scraper had drawn them once already, and
+    wrote other bytes than `python docs/make_figures.py` (and than the previous build, run
+    to run, whenever one of the two had written the file)."""
+    import io
+    import sys
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    pytest.importorskip("sphinx_gallery")
+    monkeypatch.syspath_prepend(str(ROOT / "docs" / "_ext"))
+    sys.modules.pop("docs_figures", None)
+    import docs_figures
+
+    monkeypatch.setattr(docs_figures, "FIGURES", tmp_path / "figures")
+    monkeypatch.setattr(docs_figures, "_shown", set())
+
+    def figure() -> Any:
+        fig, ax = plt.subplots(figsize=(4.0, 3.0), layout="constrained")
+        mesh = ax.pcolormesh([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]])
+        fig.colorbar(mesh, ax=ax, label="peak amplitude (um)")
+        ax.set_title("peak of the stepped-sine response")
+        ax.set_xlabel("joint.clearance (um)")
+        return fig
+
+    alone = docs_figures.save("a.png", figure()).read_bytes()  # as make_figures.py does
+    again = figure()
+    again.savefig(io.BytesIO(), format="png", dpi=100)  # a first draw by another scraper
+    assert docs_figures.png(again) != alone  # the trap is real
+
+    built = figure()
+    gallery_image = tmp_path / "sphx_glr_x_001.png"
+    rst = docs_figures.scraper(
+        None,
+        {
+            "example_globals": {"DOCS_FIGURES": {"a.png": built}},
+            "src_file": str(tmp_path / "plot_x.py"),
+            "image_path_iterator": iter([str(gallery_image)]),
+        },
+        {"src_dir": str(tmp_path)},
+    )
+    assert (tmp_path / "figures" / "a.png").read_bytes() == alone
+    assert gallery_image.read_bytes() == alone
+    assert "sphx_glr_x_001.png" in rst
+    assert not plt.fignum_exists(built.number)  # the matplotlib scraper will not draw it again
+    conf = (ROOT / "docs" / "conf.py").read_text(encoding="utf-8")
+    scrapers = re.search(r'"image_scrapers": \(([^)]*)\)', conf)
+    assert scrapers is not None
+    assert scrapers[1].split(",")[0].strip() == '"docs_figures.scraper"'
+    plt.close("all")
