@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.sparse
 
-from clearjoint import ClearanceJoint
+from clearjoint import ClearanceJoint, ParameterError
 from clearjoint.structure import Member, Structure, StructureError, chain, truss
 
 
@@ -112,3 +112,17 @@ def test_bad_structures_are_refused_with_one_line_naming_the_item(build, message
     text = str(info.value)
     assert message in text
     assert "\n" not in text
+
+
+def test_rayleigh_takes_alpha_as_a_rate_and_beta_as_a_time_with_units() -> None:
+    """alpha multiplies M (1/s: "20rad/s" is 20 /s), beta multiplies K (s); Hz is refused."""
+    nodes = [[0.0], [-1.0]]
+    member = [Member(0, 1, stiffness=4e7)]
+    given = Structure(nodes, [0.0, 2.0], member, supports=(0,), rayleigh=("20rad/s", "2e-6s"))
+    assert given.rayleigh == (20.0, 2e-6)
+    # C = alpha M + beta K on the one DOF: 20 * 2 + 2e-6 * 4e7
+    assert given.damping_matrix().tolist() == [[20.0 * 2.0 + 2e-6 * 4e7]]
+    with pytest.raises(ParameterError, match="ambiguous for a rate in 1/s"):
+        Structure(nodes, [0.0, 2.0], member, supports=(0,), rayleigh=("20Hz", 0.0))
+    with pytest.raises(StructureError, match=r"rayleigh must be \(alpha, beta\)"):
+        Structure(nodes, [0.0, 2.0], member, supports=(0,), rayleigh=0.5)  # type: ignore[arg-type]

@@ -187,7 +187,8 @@ class Structure:
         Nodes fixed in every direction.
     rayleigh : (alpha, beta)
         Rayleigh damping C += alpha M + beta K_closed (1/s, s), with K_closed the
-        stiffness with every joint in compression contact. Default none.
+        stiffness with every joint in compression contact. Default none. Each may be a
+        pint Quantity or unit text ("0.5/s" or "0.5rad/s", the same rate; "2e-6s").
 
     Raises
     ------
@@ -234,9 +235,13 @@ class Structure:
                     f"node {i} is free but has mass {float(masses[i])!r} kg; give it a mass > 0 "
                     "or make it a support"
                 )
-        alpha, beta = (float(v) for v in self.rayleigh)
-        _checks.non_negative("rayleigh alpha", alpha, unit="1/s")
-        _checks.non_negative("rayleigh beta", beta, unit="s")
+        if not isinstance(self.rayleigh, tuple | list) or len(self.rayleigh) != 2:
+            raise StructureError(
+                f"rayleigh must be (alpha, beta) in (1/s, s), got {self.rayleigh!r}"
+            )
+        # alpha multiplies M: a rate (1/s; "0.5rad/s" is 0.5 /s, Hz is refused); beta is a time
+        alpha = _checks.non_negative("rayleigh alpha", self.rayleigh[0], unit="1/s")
+        beta = _checks.non_negative("rayleigh beta", self.rayleigh[1], unit="s")
         set_(self, "rayleigh", (alpha, beta))
         members = tuple(self.members)
         if not members:
