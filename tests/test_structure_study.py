@@ -435,3 +435,30 @@ def test_bad_structure_is_one_line_naming_the_item_and_the_fix(
     assert err.count("\n") == 1
     assert "Traceback" not in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            CHAIN.replace('kind = "chain"', 'kind = "chain"\nbays = 3'),
+            "bays is not read for a chain",
+        ),
+        (MAST.replace("bays = 2", 'bays = 2\nmasses = ["1kg"]'), "masses is not read for a mast"),
+        (
+            TRUSS.replace("supports = [0, 1]", 'supports = [0, 1]\nstiffnesses = ["1N/m"]'),
+            "stiffnesses is not read for a truss",
+        ),
+        (
+            CHAIN.replace('kind = "chain"', 'kind = "chain"\nmember_damping = "5N*s/m"'),
+            "member_damping is not read for a chain; a chain takes masses, stiffnesses, "
+            "dampers, joints",
+        ),
+    ],
+    ids=["bays in a chain", "masses in a mast", "stiffnesses in a truss", "damping in a chain"],
+)
+def test_a_structure_key_of_another_kind_is_refused_not_dropped(
+    tmp_path: Path, text: str, message: str
+) -> None:
+    with pytest.raises(StructureStudyError, match=message):
+        load_structure_study(_write(tmp_path, text))

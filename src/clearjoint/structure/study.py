@@ -109,6 +109,33 @@ KEYS: dict[str, dict[str, str]] = {
 }
 
 
+#: The [structure] keys each kind reads (besides kind and the Rayleigh pair).
+KIND_KEYS: dict[str, tuple[str, ...]] = {
+    "mast": (
+        "bays",
+        "width",
+        "bay_height",
+        "longeron_rigidity",
+        "batten_rigidity",
+        "diagonal_rigidity",
+        "node_mass",
+        "tip_mass",
+        "member_damping",
+    ),
+    "chain": ("masses", "stiffnesses", "dampers", "joints"),
+    "truss": (
+        "nodes",
+        "members",
+        "supports",
+        "member_stiffness",
+        "masses",
+        "node_mass",
+        "joint_members",
+        "member_damping",
+    ),
+}
+
+
 class StructureStudyError(ClearjointError, ValueError):
     """A structure study file is missing, unreadable or holds a bad value."""
 
@@ -240,6 +267,15 @@ def _structure(st: dict[str, Any], joint: ClearanceJoint | None, where: str) -> 
     """Build the [structure] with its [joint]; a joint given and never used is refused."""
     kind = st.get("kind", "mast")
     rayleigh = (st.get("rayleigh_alpha", 0.0), st.get("rayleigh_beta", 0.0))
+    if kind in KIND_KEYS:
+        known = ("kind", "rayleigh_alpha", "rayleigh_beta", *KIND_KEYS[kind])
+        other = [key for key in st if key not in known]
+        if other:  # read by another kind: it would be dropped without a word
+            raise StructureStudyError(
+                f"{where}: [structure] {other[0]} is not read for a {kind}; a {kind} takes "
+                f"{', '.join(KIND_KEYS[kind])} (and rayleigh_alpha, rayleigh_beta): remove "
+                "it or change kind"
+            )
     if kind == "mast":
         if "bays" not in st:
             raise StructureStudyError(f"{where}: [structure] bays is required for a mast")
