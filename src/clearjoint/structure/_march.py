@@ -30,6 +30,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from clearjoint.simulate._kernel import certified_step
+
 #: Most Taylor terms per step; a step that needs more is halved.
 MAX_TERMS = 60
 #: Terms are summed until they fall below this fraction of the state.
@@ -52,42 +54,42 @@ def _apply(
     omega: float,
     omega_ref: float,
     v_ref: float,
-    m_inv: np.ndarray,
-    force: np.ndarray,
-    kp: np.ndarray,
-    ki: np.ndarray,
-    kd: np.ndarray,
-    cp: np.ndarray,
-    ci: np.ndarray,
-    cd: np.ndarray,
+    force_m: np.ndarray,
+    ap: np.ndarray,
+    ai: np.ndarray,
+    a_u: np.ndarray,
+    a_v: np.ndarray,
     bp: np.ndarray,
     bi: np.ndarray,
     bd: np.ndarray,
+    bd_m: np.ndarray,
     k_now: np.ndarray,
     r_now: np.ndarray,
 ) -> None:
-    """out = A_s y in scaled variables (sparse, matrix-free)."""
+    """out = A_s y in scaled variables (sparse, matrix-free).
+
+    Row i of the acceleration: force_m[i] sin - sum_p (a_u[p] y_u + a_v[p] y_v)[ai[p]]
+    over the plain members' stiffness and the damping (one sparsity pattern, M^-1 and
+    the scaling folded in), then each joint's force along bd_m = M^-1 b_j (``k_now`` is
+    the joints' stiffness over omega_ref, as y holds omega_ref u).
+    """
     sin_ = y[2 * n] / v_ref
     cos_ = y[2 * n + 1] / v_ref
     one = y[2 * n + 2] / v_ref
-    inv_ref = 1.0 / omega_ref
     for i in range(n):
         out[i] = omega_ref * y[n + i]
-        acc = force[i] * sin_
-        for p in range(kp[i], kp[i + 1]):
-            acc -= kd[p] * y[ki[p]] * inv_ref
-        for p in range(cp[i], cp[i + 1]):
-            acc -= cd[p] * y[n + ci[p]]
+        acc = force_m[i] * sin_
+        for p in range(ap[i], ap[i + 1]):
+            q = ai[p]
+            acc -= a_u[p] * y[q] + a_v[p] * y[n + q]
         out[n + i] = acc
     for j in range(k_now.shape[0]):
         delta = 0.0
         for p in range(bp[j], bp[j + 1]):
             delta += bd[p] * y[bi[p]]
-        f = k_now[j] * delta * inv_ref - r_now[j] * one
+        f = k_now[j] * delta - r_now[j] * one
         for p in range(bp[j], bp[j + 1]):
-            out[n + bi[p]] -= bd[p] * f
-    for i in range(n):
-        out[n + i] *= m_inv[i]
+            out[n + bi[p]] -= bd_m[p] * f
     out[2 * n] = v_ref * omega * cos_
     out[2 * n + 1] = -v_ref * omega * sin_
     out[2 * n + 2] = 0.0
@@ -115,8 +117,10 @@ def _horner(c: np.ndarray, deg: int, s: float) -> float:
 
 
 @njit(cache=True)
-def first_root(c: np.ndarray, deg: int, stack: np.ndarray, bounds: np.ndarray) -> float:
-    """First s in [0, 1] with Q(s) = sum_(i<=deg) c[i] s^i <= 0, from below; 2.0 if none.
+def first_root(
+    c: np.ndarray, deg: int, stack: np.ndarray, bounds: np.ndarray, limit: float = 1.0
+) -> float:
+    """First s in [0, limit] with Q(s) = sum_(i<=deg) c[i] s^i <= 0, from below; 2.0 if none.
 
     Returns s with Q > 0 on [0, s) and a point with Q <= 0 within ROOT_TOL after s (or
     s where the subdivision bottoms out). ``c[0] <= 0`` is read as a root at 0: if the
@@ -134,12 +138,22 @@ def first_root(c: np.ndarray, deg: int, stack: np.ndarray, bounds: np.ndarray) -
     d = deg - start
     if d == 0:
         return 2.0
-    # quick exclusion: Q >= c0 + sum of the negative coefficients on [0, 1]
-    low = c[start]
-    for i in range(start + 1, deg + 1):
+    # quick exclusions on [0, limit], with s^i <= s^3 limit^(i - 3) for i >= 3:
+    # Q >= c0 + c1 s + c2 s^2 - r s^3, r the sum of the negative coefficients' sizes
+    r = 0.0
+    power = 1.0
+    for i in range(start + 3, deg + 1):
+        if i - start > 3:
+            power *= limit
         if c[i] < 0.0:
-            low += c[i]
+            r -= c[i] * power
+    a0 = c[start]
+    a1 = c[start + 1] if d >= 1 else 0.0
+    a2 = c[start + 2] if d >= 2 else 0.0
+    low = a0 + min(a1, 0.0) * limit + min(a2, 0.0) * limit * limit - r * limit**3
     if low > 0.0:
+        return 2.0
+    if certified_step(a0, a1, 2.0 * a2, 6.0 * r, limit) >= limit:
         return 2.0
     # Bernstein coefficients on [0, 1]: beta_k = sum_(i<=k) C(k,i)/C(d,i) a_i
     for k in range(d + 1):
@@ -148,12 +162,12 @@ def first_root(c: np.ndarray, deg: int, stack: np.ndarray, bounds: np.ndarray) -
         ratio = 1.0  # C(i, i) / C(d, i)
         for q in range(i):
             ratio *= (q + 1.0) / (d - q)
-        a_i = c[start + i]
+        a_i = c[start + i] * limit**i
         for k in range(i, d + 1):
             stack[0, k] += ratio * a_i
             ratio *= (k + 1.0) / (k + 1.0 - i)
     bounds[0, 0] = 0.0
-    bounds[0, 1] = 1.0
+    bounds[0, 1] = limit
     top = 1
     while top > 0:
         top -= 1
@@ -167,13 +181,13 @@ def first_root(c: np.ndarray, deg: int, stack: np.ndarray, bounds: np.ndarray) -
             continue
         if beta[0] <= 0.0:
             return float(a)
-        if b - a <= ROOT_TOL or top >= MAX_DEPTH:
+        if b - a <= ROOT_TOL * limit or top >= MAX_DEPTH:
             return float(a)
         if _variations(beta, d) == 1:
             # exactly one root in (a, b]: bisect on the power form
             lo, hi = a, b
             for _ in range(200):
-                if hi - lo <= ROOT_TOL:
+                if hi - lo <= ROOT_TOL * limit:
                     break
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
@@ -224,9 +238,10 @@ def march(
     v_ref: float,
     m_inv: np.ndarray,
     force: np.ndarray,
-    kp: np.ndarray,
-    ki: np.ndarray,
-    kd: np.ndarray,
+    ap: np.ndarray,
+    ai: np.ndarray,
+    a_u: np.ndarray,
+    a_v: np.ndarray,
     cp: np.ndarray,
     ci: np.ndarray,
     cd: np.ndarray,
@@ -244,10 +259,12 @@ def march(
 ) -> tuple[Any, ...]:
     """Run the exact motion from y_start (scaled) over [0, t_end]; see the module docstring.
 
-    ``k_table`` and ``r_table`` (J, 3) give each joint's stiffness and offset in state
-    -1, 0, 1 (column state + 1). Returns (y_end, out_y (S, n_aug), out_p (S, J),
-    energy (2,) = (input, viscous), impact, event_times, event_joints, event_states,
-    status), status DONE, CHATTER (more than ``max_events``) or NO_CONVERGENCE.
+    ``ap, ai, a_u, a_v``: one CSR pattern holding M^-1 K_plain / omega_ref and M^-1 C;
+    ``cp, ci, cd``: C alone (for the viscous loss). ``k_table`` and ``r_table`` (J, 3)
+    give each joint's stiffness and offset in state -1, 0, 1 (column state + 1).
+    Returns (y_end, out_y (S, n_aug), out_p (S, J), energy (2,) = (input, viscous),
+    impact, event_times, event_joints, event_states, steps, status), status DONE,
+    CHATTER (more than ``max_events``) or NO_CONVERGENCE.
     """
     n_aug = 2 * n + 3
     n_j = states_start.shape[0]
@@ -256,8 +273,12 @@ def march(
     k_now = np.empty(n_j)
     r_now = np.empty(n_j)
     for j in range(n_j):
-        k_now[j] = k_table[j, states[j] + 1]
+        k_now[j] = k_table[j, states[j] + 1] / omega_ref
         r_now[j] = r_table[j, states[j] + 1]
+    force_m = force * m_inv
+    bd_m = np.empty_like(bd)
+    for p in range(bd.shape[0]):
+        bd_m[p] = bd[p] * m_inv[bi[p]]
     terms = np.zeros((MAX_TERMS + 1, n_aug))
     bu = np.zeros((n_j, MAX_TERMS + 1))
     coef = np.zeros(MAX_TERMS + 2)
@@ -282,7 +303,9 @@ def march(
     next_sample = 0
     t = 0.0
     status = DONE
+    steps = 0
     while t < t_end:
+        steps += 1
         y[2 * n] = v_ref * math.sin(omega * t)
         y[2 * n + 1] = v_ref * math.cos(omega * t)
         y[2 * n + 2] = v_ref
@@ -306,17 +329,15 @@ def march(
                     omega,
                     omega_ref,
                     v_ref,
-                    m_inv,
-                    force,
-                    kp,
-                    ki,
-                    kd,
-                    cp,
-                    ci,
-                    cd,
+                    force_m,
+                    ap,
+                    ai,
+                    a_u,
+                    a_v,
                     bp,
                     bi,
                     bd,
+                    bd_m,
                     k_now,
                     r_now,
                 )
@@ -342,6 +363,7 @@ def march(
                     ev_t[:n_ev],
                     ev_j[:n_ev],
                     ev_s[:n_ev],
+                    steps,
                     NO_CONVERGENCE,
                 )
         tail = top_term * rho / (1.0 - rho) / omega_ref
@@ -370,7 +392,7 @@ def march(
                 for i in range(1, n_terms + 1):
                     coef[i] = sign * bu[j, i]
                 coef[n_terms + 1] = -tail * b_l1[j]
-                s = first_root(coef, n_terms + 1, stack, bounds)
+                s = first_root(coef, n_terms + 1, stack, bounds, min(best, 1.0))
                 if s < best:
                     best = s
                     which = 2 * j + side
@@ -439,7 +461,7 @@ def march(
             states[joint] = COMPRESSION if entering else OPEN
         else:
             states[joint] = TENSION if entering else OPEN
-        k_now[joint] = k_table[joint, states[joint] + 1]
+        k_now[joint] = k_table[joint, states[joint] + 1] / omega_ref
         r_now[joint] = r_table[joint, states[joint] + 1]
         e = restitution[joint]
         if entering and e < 1.0:
@@ -459,4 +481,4 @@ def march(
         if n_ev > max_events:
             status = CHATTER
             break
-    return y, out_y, out_p, energy, impact, ev_t[:n_ev], ev_j[:n_ev], ev_s[:n_ev], status
+    return y, out_y, out_p, energy, impact, ev_t[:n_ev], ev_j[:n_ev], ev_s[:n_ev], steps, status

@@ -55,6 +55,9 @@ from clearjoint.structure.model import (
 
 FloatArray = NDArray[np.float64]
 
+#: The base step, in periods of the fastest rate (structure, forcing or damping).
+BASE_STEP_PERIODS = 1.0 / 8.0
+
 #: The most events allowed per base step on average before the run is called chattering.
 MAX_EVENTS_PER_STEP = 1000
 
@@ -93,7 +96,7 @@ class _Flow:
         rates = [self.omega_ref, omega]
         c_rate = scipy.linalg.eigh(self.c, np.diag(self.m), eigvals_only=True)
         rates.append(float(c_rate[-1]))
-        self.base_step = 2.0 * math.pi / max(rates) / 8.0
+        self.base_step = 2.0 * math.pi / max(rates) * BASE_STEP_PERIODS
         # scaling: u -> omega_ref u, v -> v, (sin, cos, 1) -> v_ref (sin, cos, 1)
         offsets = np.max(np.abs(self.r_table), axis=1)
         push_norm = float(np.linalg.norm(np.abs(force) * inv_m))
@@ -110,7 +113,6 @@ class _Flow:
             + (np.abs(force) + abs_b.T @ offsets) / self.v_ref
         ) * inv_m
         self.norm_a = float(max(self.omega_ref, omega, float(np.max(rows_v, initial=0.0))))
-        self.k_csr = scipy.sparse.csr_matrix(self.k_linear)
         self.c_csr = scipy.sparse.csr_matrix(self.c)
         self.b_csr = scipy.sparse.csr_matrix(self.b.reshape(n_j, n))
         self.scale = np.concatenate(  # y_scaled = scale * y
@@ -165,6 +167,9 @@ class StructureMotion:
         Which joint (index into ``structure.joint_members``) each event belongs to.
     patterns_visited : int
         How many distinct contact patterns were met.
+    steps : int
+        Steps of the exact flow taken (one ends at each event; the others are at most the
+        base step, an eighth of the shortest period).
     """
 
     t: FloatArray
@@ -180,6 +185,7 @@ class StructureMotion:
     structure: Structure = field(repr=False)
     omega: float = 0.0
     initial_energy: float = 0.0
+    steps: int = 0
 
     @property
     def balance_error(self) -> float:
@@ -315,8 +321,14 @@ def _run(
     y = flow.scaled(u0, v0, 0.0)
     states = flow.states_at(flow.b @ u0, flow.b @ v0)
     max_events = MAX_EVENTS_PER_STEP * (int(duration / flow.base_step) + 1)
-    k, c, b = flow.k_csr, flow.c_csr, flow.b_csr
-    y_end, out_y, out_p, energy, impact, ev_t, ev_j, ev_s, status = _march.march(
+    c, b = flow.c_csr, flow.b_csr
+    # one sparsity pattern for the plain stiffness and the damping, M^-1 and scaling in
+    a = scipy.sparse.csr_matrix((np.abs(flow.k_linear) + np.abs(flow.c)) > 0.0, dtype=np.float64)
+    a.sort_indices()
+    rows = np.repeat(np.arange(n), np.diff(a.indptr))
+    a_u = flow.k_linear[rows, a.indices] / (flow.m[rows] * flow.omega_ref)
+    a_v = flow.c[rows, a.indices] / flow.m[rows]
+    y_end, out_y, out_p, energy, impact, ev_t, ev_j, ev_s, steps, status = _march.march(
         y,
         states,
         float(duration),
@@ -328,9 +340,10 @@ def _run(
         flow.v_ref,
         1.0 / flow.m,
         np.asarray(flow.force, dtype=np.float64),
-        k.indptr.astype(np.int64),
-        k.indices.astype(np.int64),
-        k.data.astype(np.float64),
+        a.indptr.astype(np.int64),
+        a.indices.astype(np.int64),
+        a_u,
+        a_v,
         c.indptr.astype(np.int64),
         c.indices.astype(np.int64),
         c.data.astype(np.float64),
@@ -381,6 +394,7 @@ def _run(
         structure=flow.structure,
         omega=flow.omega,
         initial_energy=flow.mechanical_energy(u0, v0),
+        steps=int(steps),
     )
 
 
