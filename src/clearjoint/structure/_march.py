@@ -286,6 +286,7 @@ def march(
     bounds = np.zeros((MAX_DEPTH + 2, 2))
     cv = np.zeros((MAX_TERMS + 1, n))
     f_in = np.zeros(MAX_TERMS + 1)
+    norm_v = np.zeros(MAX_TERMS + 1)
     gram = np.zeros(2 * MAX_TERMS + 2)
     prod = np.zeros(2 * MAX_TERMS + 2)
     out_y = np.zeros((times.shape[0], n_aug))
@@ -412,17 +413,28 @@ def march(
             out_p[next_sample, :] = states
             next_sample += 1
         if s_end > 0.0:
-            # energy integrals over [0, s_end]: input F.v sin(w t), viscous v^T C v
+            # energy integrals over [0, s_end]: input F.v sin(w t), viscous v^T C v;
+            # a pair (i, k) of the viscous double sum is left out only when its bound
+            # abs(v_i) abs(C) abs(v_k) is below 1e-19 of abs(v)_max^2 abs(C)
+            top_v = 0.0
             for i in range(n_terms + 1):
                 acc = 0.0
+                size_v = 0.0
                 for q in range(n):
                     acc += force[q] * terms[i, n + q]
+                    size_v += terms[i, n + q] * terms[i, n + q]
                 f_in[i] = acc
+                norm_v[i] = math.sqrt(size_v)
+                top_v = max(top_v, norm_v[i])
+            floor = 1e-19 * top_v
+            for k in range(n_terms + 1):
+                if norm_v[k] <= floor:
+                    continue
                 for q in range(n):
                     acc = 0.0
                     for p in range(cp[q], cp[q + 1]):
-                        acc += cd[p] * terms[i, n + ci[p]]
-                    cv[i, q] = acc
+                        acc += cd[p] * terms[k, n + ci[p]]
+                    cv[k, q] = acc
             for m in range(2 * n_terms + 1):
                 gram[m] = 0.0
                 prod[m] = 0.0
@@ -430,6 +442,8 @@ def march(
                 for k in range(n_terms + 1):
                     prod[i + k] += f_in[i] * terms[k, 2 * n]
                 for k in range(i, n_terms + 1):
+                    if norm_v[i] * norm_v[k] <= floor * top_v:
+                        continue
                     acc = 0.0
                     for q in range(n):
                         acc += terms[i, n + q] * cv[k, q]
