@@ -496,3 +496,14 @@ def march(
             status = CHATTER
             break
     return y, out_y, out_p, energy, impact, ev_t[:n_ev], ev_j[:n_ev], ev_s[:n_ev], steps, status
+
+
+@njit(cache=True)
+def pattern_history(start: np.ndarray, joints: np.ndarray, new_states: np.ndarray) -> np.ndarray:
+    """(E + 1, J) int8: the contact pattern at the start and after each event."""
+    history = np.empty((joints.shape[0] + 1, start.shape[0]), dtype=np.int8)
+    history[0] = start
+    for k in range(joints.shape[0]):
+        history[k + 1] = history[k]
+        history[k + 1, joints[k]] = new_states[k]
+    return history

@@ -301,13 +301,11 @@ def _patterns_visited(
     start: NDArray[np.int8], joints: NDArray[np.int64], new_states: NDArray[np.int8]
 ) -> int:
     """How many distinct contact patterns the event sequence passes through."""
-    history = np.empty((joints.size + 1, start.size), dtype=np.int8)
-    history[0] = start
-    states = start.copy()
-    for k, (j, state) in enumerate(zip(joints, new_states, strict=True)):
-        states[j] = state
-        history[k + 1] = states
-    return int(np.unique(history, axis=0).shape[0])
+    if start.size == 0:
+        return 1
+    history = np.ascontiguousarray(_march.pattern_history(start, joints, new_states))
+    rows = history.view(np.dtype((np.void, history.shape[1])))
+    return int(np.unique(rows).size)
 
 
 def _run(
