@@ -28,8 +28,8 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from clearjoint._jit import njit  # numba.njit that survives a read-only install
 from clearjoint.simulate._kernel import certified_step
 
 #: Most Taylor terms per step; a step that needs more is halved.
