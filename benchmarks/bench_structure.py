@@ -3,18 +3,28 @@
 Run on demand::
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_structure.py [--mast-periods 200]
-        [--ivp-periods 2] [--bays 5,10,20,40] [--scaling-periods 1]
+        [--ivp-periods 2] [--bays 5,10,20,40] [--scaling-periods 5]
 
 (one BLAS thread: the matrices are small, and threads fight over a shared machine.)
+Times are CPU seconds of this process (``time.process_time``; both solvers run on one
+thread), which other jobs on a shared machine disturb far less than the wall clock; the
+wall clock of section 2 is printed beside them.
 
 1. Accuracy: a 3-link chain with 2 joints (asymmetric, k0 > 0, off-centre gaps, restitution
    on the rigid link) against scipy's solve_ivp (DOP853, rtol 1e-12, an event on every gap
    edge), 20 forcing periods: largest difference relative to the largest motion.
-2. Speed: the 10-bay mast with 20 hinge joints forced at its tip, both solvers over
-   ``--ivp-periods`` periods (time ratio, difference), then the exact solver alone over
-   ``--mast-periods`` periods (events per second).
-3. Cost against the number of bays (``--bays``), ``--scaling-periods`` periods each.
-4. Linear checks: a uniform fixed-free bar's first modes against
+2. Speed: the 10-bay mast with 20 hinge joints forced at its tip near its first closed
+   mode: the exact solver over ``--mast-periods`` periods (events per second) and
+   solve_ivp (rtol 1e-12, edge events) over the first ``--ivp-periods`` of them, timed in
+   the same run; the ratio is per forcing period. Over that common span both are also
+   compared with solve_ivp at rtol 1e-13 (largest difference and at its end), which says
+   whose error is whose.
+3. Cost against the number of bays (``--bays``): seconds and events per forcing period
+   over ``--scaling-periods`` periods.
+4. The docs' free decay of the mast run with three step sequences (base step T_min / 8,
+   / 5, / 16): how many events they share, how far apart they end, the backbone's first
+   cycle.
+5. Linear checks: a uniform fixed-free bar's first modes against
    (2k - 1) (pi / 2L) sqrt(E / rho) as n grows; a two-mass chain against its closed form.
 """
 
@@ -27,7 +37,16 @@ import time
 import numpy as np
 
 from clearjoint import ClearanceJoint
-from clearjoint.structure import Member, Structure, chain, mast, time_response
+from clearjoint.structure import (
+    Member,
+    Structure,
+    chain,
+    decay_backbone,
+    free_decay,
+    mast,
+    time_response,
+)
+from clearjoint.structure import motion as motion_module
 from clearjoint.structure.reference import reference_response
 
 
@@ -43,12 +62,12 @@ def _three_links() -> Structure:
 
 def _side_by_side(s: Structure, force: np.ndarray, omega: float, periods: int) -> None:
     duration = periods * 2.0 * math.pi / omega
-    start = time.perf_counter()
+    start = time.process_time()
     mine = time_response(s, force, omega, duration, samples_per_period=32)
-    t_mine = time.perf_counter() - start
-    start = time.perf_counter()
+    t_mine = time.process_time() - start
+    start = time.process_time()
     u, v, events = reference_response(s, force, omega, mine.t)
-    t_ivp = time.perf_counter() - start
+    t_ivp = time.process_time() - start
     du = np.max(np.abs(mine.u - u)) / np.max(np.abs(u))
     dv = np.max(np.abs(mine.v - v)) / np.max(np.abs(v))
     print(
@@ -67,18 +86,59 @@ def _mast_case(bays: int) -> tuple[Structure, np.ndarray, float]:
     return s, force, omega
 
 
+def _decay_sensitivity() -> None:
+    """The docs' free decay with three step sequences: where they part, and the backbone."""
+    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
+    tower = mast(10, joints=hinge, rayleigh=(0.5, 2e-6))
+    closed = tower.modes("closed")
+    tip = tower.dof_names.index("n21x")
+    u0 = 3e-3 * closed.shapes[:, 0] / closed.shapes[tip, 0]
+    period = 2 * math.pi / closed.omega[0]
+    default = motion_module.BASE_STEP_PERIODS
+    runs = []
+    for fraction in (default, 1.0 / 5.0, 1.0 / 16.0):
+        motion_module.BASE_STEP_PERIODS = fraction
+        try:
+            start = time.process_time()
+            decay = free_decay(
+                tower, (u0, np.zeros(tower.n_dof)), 80 * period, samples_per_period=64
+            )
+            spent = time.process_time() - start
+        finally:
+            motion_module.BASE_STEP_PERIODS = default
+        runs.append((fraction, decay, spent))
+    ref = runs[0][1]
+    f_ref = decay_backbone(ref, tip).omega[0] / (2 * math.pi)
+    for fraction, decay, spent in runs:
+        k = min(decay.events, ref.events)
+        apart = (np.abs(decay.event_times[:k] - ref.event_times[:k]) > 1e-12 * period) | (
+            decay.event_joints[:k] != ref.event_joints[:k]
+        )
+        first = int(np.argmax(apart)) if apart.any() else k
+        sep = [np.max(np.abs(decay.u[64 * p] - ref.u[64 * p])) / 3e-3 for p in (1, 3, 10)]
+        f1 = decay_backbone(decay, tip).omega[0] / (2 * math.pi)
+        print(
+            f"  base step T_min/{1 / fraction:.0f}: {spent:5.2f} s, {decay.events} events, "
+            f"{decay.patterns_visited} patterns, ledger {decay.balance_error:.0e}; same first "
+            f"{first} events; tip apart by {sep[0]:.0e} / {sep[1]:.0e} / {sep[2]:.0e} of 3 mm "
+            f"after 1 / 3 / 10 periods; backbone cycle 1 {f1:.4f} Hz "
+            f"({f1 / f_ref - 1:+.1e})"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--mast-periods", type=int, default=200)
     parser.add_argument("--ivp-periods", type=int, default=2)
     parser.add_argument("--bays", default="5,10,20,40")
-    parser.add_argument("--scaling-periods", type=int, default=1)
+    parser.add_argument("--scaling-periods", type=int, default=5)
     args = parser.parse_args()
 
     print("1. 3-link chain, 2 joints, 20 periods: exact vs solve_ivp (rtol 1e-12, edge events)")
     s = _three_links()
     force3 = np.array([500.0, -300.0, 800.0])
     omega3 = 0.9 * float(s.modes().omega[0])
+    time_response(s, force3, omega3, 0.1 / omega3)  # compile (or load the cache) untimed
     _side_by_side(s, force3, omega3, 20)
     # whose error is it? solve_ivp at a tighter tolerance moves toward the exact solver
     mine = time_response(s, force3, omega3, 20 * 2 * math.pi / omega3, samples_per_period=32)
@@ -90,34 +150,96 @@ def main() -> None:
         f"solve_ivp 1e-12 vs 1e-13: {np.max(np.abs(loose - tight)) / scale:.2e}"
     )
 
-    print(f"2. 10-bay mast, 20 joints, {args.ivp_periods} periods side by side")
+    print(
+        f"2. 10-bay mast, 20 joints: exact over {args.mast_periods} periods, solve_ivp over "
+        f"the first {args.ivp_periods}"
+    )
     s, force, omega = _mast_case(10)
-    _side_by_side(s, force, omega, args.ivp_periods)
-    if args.mast_periods:
-        start = time.perf_counter()
-        motion = time_response(
-            s, force, omega, args.mast_periods * 2 * math.pi / omega, samples_per_period=16
+    period = 2.0 * math.pi / omega
+    time_response(s, force, omega, 0.05 * period)  # compile (cached) and warm up
+    spp = 16
+    start, wall = time.process_time(), time.perf_counter()
+    motion = time_response(s, force, omega, args.mast_periods * period, samples_per_period=spp)
+    t_mine, wall_mine = time.process_time() - start, time.perf_counter() - wall
+    print(
+        f"  exact: {t_mine:.2f} s for {args.mast_periods} periods = "
+        f"{t_mine / args.mast_periods * 1e3:.1f} ms per period; {motion.events} events "
+        f"({motion.events / t_mine:.0f} events/s), {motion.steps} steps, "
+        f"{motion.patterns_visited} patterns, ledger balance {motion.balance_error:.1e}"
+    )
+    common = args.ivp_periods * spp + 1  # samples over [0, ivp_periods T], both ends
+    t_common = motion.t[:common]
+    start, wall = time.process_time(), time.perf_counter()
+    u_ivp, _, events_ivp = reference_response(s, force, omega, t_common)
+    t_ivp, wall_ivp = time.process_time() - start, time.perf_counter() - wall
+    per_mine = t_mine / args.mast_periods
+    per_ivp = t_ivp / args.ivp_periods
+    events_mine = int(np.sum(motion.event_times <= t_common[-1]))
+    print(
+        f"  solve_ivp rtol 1e-12: {t_ivp:.2f} s for {args.ivp_periods} periods = "
+        f"{per_ivp * 1e3:.0f} ms per period; ratio per period {per_ivp / per_mine:.0f}x "
+        f"(events in the common span: exact {events_mine}, solve_ivp {events_ivp})"
+    )
+    ratio_wall = (wall_ivp / args.ivp_periods) / (wall_mine / args.mast_periods)
+    print(
+        f"  wall clock: exact {wall_mine:.2f} s, solve_ivp {wall_ivp:.2f} s, ratio per period "
+        f"{ratio_wall:.0f}x (other jobs on the machine move this one)"
+    )
+    start = time.process_time()
+    u_tight, _, events_tight = reference_response(s, force, omega, t_common, rtol=1e-13, atol=1e-16)
+    per_tight = (time.process_time() - start) / args.ivp_periods
+    print(
+        f"  solve_ivp rtol 1e-13: {per_tight * 1e3:.0f} ms per period; ratio per period "
+        f"{per_tight / per_mine:.0f}x ({events_tight} events)"
+    )
+    # the same exact solver with another step sequence (base step T_min / 5, not / 8):
+    # how fast this motion itself amplifies round-off
+    default = motion_module.BASE_STEP_PERIODS
+    motion_module.BASE_STEP_PERIODS = 1.0 / 5.0
+    try:
+        other = time_response(
+            s, force, omega, (args.ivp_periods + 1) * period, samples_per_period=spp
         )
-        spent = time.perf_counter() - start
-        print(
-            f"  exact alone, {args.mast_periods} periods: {spent:.1f} s, {motion.events} events "
-            f"({motion.events / spent:.0f} events/s), {motion.patterns_visited} patterns"
-        )
+    finally:
+        motion_module.BASE_STEP_PERIODS = default
+    scale = np.max(np.abs(u_tight))
+    mine = motion.u[:common]
+    pairs = (
+        ("exact vs solve_ivp 1e-13", mine, u_tight),
+        ("solve_ivp 1e-12 vs 1e-13", u_ivp, u_tight),
+        ("exact vs solve_ivp 1e-12", mine, u_ivp),
+        ("exact vs exact, base step / 5", mine, other.u[:common]),
+    )
+    ends = [k * spp for k in range(1, args.ivp_periods + 1)]
+    print(
+        "  largest difference of u over the DOFs / largest motion, at the end of period "
+        + ", ".join(str(k) for k in range(1, args.ivp_periods + 1))
+    )
+    for name, a, b in pairs:
+        at = [np.max(np.abs(a[k] - b[k])) / scale for k in ends]
+        print(f"    {name:32s} " + "  ".join(f"{d:.1e}" for d in at))
 
-    print(f"3. cost against bays, {args.scaling_periods} forcing period(s) each")
+    print(f"3. cost against bays, over {args.scaling_periods} forcing periods each")
     for bays in (int(b) for b in args.bays.split(",")):
         s, force, omega = _mast_case(bays)
-        start = time.perf_counter()
+        period = 2.0 * math.pi / omega
+        start = time.process_time()
         motion = time_response(
-            s, force, omega, args.scaling_periods * 2 * math.pi / omega, samples_per_period=16
+            s, force, omega, args.scaling_periods * period, samples_per_period=16
         )
-        spent = time.perf_counter() - start
+        spent = time.process_time() - start
         print(
-            f"  {bays:3d} bays ({s.n_dof:4d} DOF, {2 * bays:3d} joints): {spent:7.2f} s, "
-            f"{motion.events:6d} events, {motion.patterns_visited:6d} patterns"
+            f"  {bays:3d} bays ({s.n_dof:4d} DOF, {2 * bays:3d} joints): "
+            f"{spent / args.scaling_periods * 1e3:8.1f} ms and "
+            f"{motion.events / args.scaling_periods:7.0f} events per period "
+            f"({motion.events / spent:6.0f} events/s, {motion.steps / motion.events:.2f} steps "
+            f"per event)"
         )
 
-    print("4. linear modes")
+    print("4. the mast's free decay (docs/structure.md): 80 closed-mode periods from 3 mm")
+    _decay_sensitivity()
+
+    print("5. linear modes")
     length, e, rho, area = 2.0, 7e10, 2700.0, 1e-4
     exact = (2 * np.arange(1, 4) - 1) * math.pi / (2 * length) * math.sqrt(e / rho)
     for n in (10, 20, 40, 80, 160):

@@ -114,3 +114,67 @@ def test_bad_motion_input_is_refused_with_one_line() -> None:
     rub = ClearanceJoint(1e-4, 8e7, friction=Friction(0.1, 100.0))
     with pytest.raises(StructureError, match="Coulomb friction in a joint of a structure"):
         free_decay(chain([1.0], [math.inf], [rub]), ([1e-4], [0.0]), 0.01)
+
+
+def _power_coefficients(roots: list[float], lead: float) -> np.ndarray:
+    """Coefficients c_0..c_d (rising powers) of lead * prod (s - r)."""
+    return np.asarray(np.polynomial.polynomial.polyfromroots(roots) * lead, dtype=np.float64)
+
+
+@pytest.mark.parametrize(
+    ("roots", "first", "tol"),
+    [
+        # a brief dip: two roots 2e-7 apart, each known to ~1e-16 / |Q'| = 5e-10
+        ([0.3 - 1e-7, 0.3 + 1e-7, 0.9, 1.7], 0.3 - 1e-7, 2e-9),
+        ([0.25, 0.5, 0.75, 2.5, -1.0], 0.25, 1e-14),
+        ([1.2, 1.5], None, 0.0),  # roots beyond the step
+        ([0.999999, 3.0], 0.999999, 1e-14),
+    ],
+)
+def test_first_root_of_the_edge_polynomial_is_the_first_one(
+    roots: list[float], first: float | None, tol: float
+) -> None:
+    from clearjoint.structure._march import MAX_DEPTH, MAX_TERMS, first_root
+
+    c = _power_coefficients(roots, 1.0)
+    if c[0] < 0.0:
+        c = -c
+    stack = np.zeros((MAX_DEPTH + 2, MAX_TERMS + 2))
+    bounds = np.zeros((MAX_DEPTH + 2, 2))
+    s = first_root(np.concatenate((c, [0.0])), c.size - 1, stack, bounds)
+    if first is None:
+        assert s > 1.0
+    else:  # the roots are placed by hand; the answer is approached from Q > 0
+        assert abs(s - first) <= tol
+        assert np.polynomial.polynomial.polyval(s, c) > 0.0
+
+
+def test_a_dip_that_stays_above_the_edge_is_not_an_event() -> None:
+    from clearjoint.structure._march import MAX_DEPTH, MAX_TERMS, first_root
+
+    # (s - 0.3)^2 + 1e-14 > 0 everywhere: no root, though its minimum is 1e-14
+    c = np.array([0.09 + 1e-14, -0.6, 1.0, 0.0])
+    stack = np.zeros((MAX_DEPTH + 2, MAX_TERMS + 2))
+    bounds = np.zeros((MAX_DEPTH + 2, 2))
+    assert first_root(c, 2, stack, bounds) > 1.0
+    # at the edge and moving in (c_0 = 0, c_1 < 0) is an event now; moving away is not
+    assert first_root(np.array([0.0, -1.0, 0.0]), 2, stack, bounds) == 0.0
+    assert first_root(np.array([-1e-20, 1.0, 0.5]), 2, stack, bounds) > 1.0
+
+
+def test_a_small_mast_with_rayleigh_damping_matches_solve_ivp_event_for_event() -> None:
+    # 2-D: each joint's shortening involves four DOF; damping alpha M + beta K_closed
+    from clearjoint.structure import mast
+
+    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
+    s = mast(3, joints=hinge, rayleigh=(0.5, 2e-6))
+    force = np.zeros(s.n_dof)
+    force[-2] = 20.0
+    omega = 0.9 * float(s.modes("closed").omega[0])
+    mine = time_response(s, force, omega, 2 * 2.0 * math.pi / omega, samples_per_period=32)
+    u, v, events = reference_response(s, force, omega, mine.t)
+    assert mine.events == events > 40
+    assert len(set(map(tuple, mine.pattern))) > 5
+    assert np.max(np.abs(mine.u - u)) <= 1e-9 * np.max(np.abs(u))
+    assert np.max(np.abs(mine.v - v)) <= 1e-9 * np.max(np.abs(v))
+    assert mine.balance_error < 1e-9

@@ -11,20 +11,17 @@ resonance. Steps never exceed a base step H (an eighth of the shortest period of
 structure and damping), so abs(A_s tau) is of order one and the Taylor series of
 exp(A_s tau) y, summed until its terms fall below 1e-18 of y, is the exact flow to
 round-off. The same series carries the energy integrals exactly: the input power
-F.v sin(w t) and the viscous power v^T C v are quadratic forms of y, integrated term by
-term. Per visited pattern its generator is cached, and, once the motion has spent
-MODAL_AFTER_STEPS steps in it, its eigen-decomposition (for the event bound below).
+F.v sin(w t) and the viscous power v^T C v are polynomials in tau, integrated term by
+term. A_s y is applied matrix-free from sparse pieces (the plain members' stiffness, C,
+and each joint's direction b_j with its stiffness and offset in its present state), so
+a new contact pattern costs nothing to set up; the whole march runs compiled, in one
+call (``clearjoint.structure._march``).
 
-Events (a joint's shortening delta_j reaches a gap edge) are found by *certified
-marching*, as in the one-joint kernel: from the state at tau = 0 the event function
-g = distance to the edge satisfies g(tau) >= g + g' tau + g'' tau^2/2 - B tau^3/6 on the
-whole base step, where B bounds abs(g'''): g''' = w_j^T A^3 y(tau), so
-abs(g''') <= sum_k abs(w_j^T v_k) abs(lambda_k)^3 abs(c_k) max(1, exp(Re lambda_k H)) over the modes
-(v_k, lambda_k) of A_s with y = sum_k c_k v_k, or, for a pattern met only briefly or with
-ill-conditioned eigenvectors, abs(w_j^T A^3) exp(mu H) abs(y(0)), mu a Gershgorin bound of the
-logarithmic norm of A in scaled variables. Stepping to the first
-root of that lower bound never passes a root, grazing included; near a transversal
-crossing the steps shrink like Newton's. Restitution on a joint that links two masses
+Events (a joint's shortening delta_j reaches a gap edge) are found without a miss: over
+a step each edge distance g is the polynomial given by the step's Taylor series up to a
+rigorous bound on the series' tail, and the first root of that lower bound (isolated in
+the Bernstein basis, grazing included) is never later than the first root of g; the step
+goes there and the event is declared. Restitution on a joint that links two masses
 directly (a rigid member) applies an impulse along b_j that takes the relative speed
 delta' to e delta' and removes (1 - e^2)/2 m_eff delta'^2 with m_eff = 1/(b_j^T M^-1 b_j)
 (MODEL.md eq 16 with the joint's effective mass); this is the one-joint kernel's rule.
@@ -40,69 +37,33 @@ from typing import Any
 
 import numpy as np
 import scipy.linalg
-from numba import njit
+import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import _checks
-from clearjoint.simulate._kernel import certified_step
 from clearjoint.simulate.core import EnergyLedger, SimulationError
+from clearjoint.structure import _march
 from clearjoint.structure.model import (
     COMPRESSION,
     OPEN,
     TENSION,
     Structure,
     StructureError,
+    _law_state,
     edge_positions,
 )
 
 FloatArray = NDArray[np.float64]
 
-#: Largest number of Taylor terms for a step shorter than the base step.
-TAYLOR_TERMS = 60
-#: A pattern gets its modal jerk bound (an eigen-decomposition) after this many steps in it;
-#: before, the plain norm bound (cheap, but shorter steps) is used.
-MODAL_AFTER_STEPS = 16
-#: Above this condition number of the pattern's eigenvectors, the modal jerk bound gives
-#: way to the plain norm bound.
-MODAL_CONDITION_LIMIT = 1e10
+#: The base step, in periods of the fastest rate (structure, forcing or damping).
+BASE_STEP_PERIODS = 1.0 / 8.0
 
 #: The most events allowed per base step on average before the run is called chattering.
 MAX_EVENTS_PER_STEP = 1000
 
 
-@njit(cache=True)
-def _first_event(
-    g0: np.ndarray, g1: np.ndarray, g2: np.ndarray, bound: np.ndarray, h_max: float
-) -> tuple[float, int]:
-    """The largest certified step over every event function, and which one limits it (-1)."""
-    best = h_max
-    which = -1
-    for i in range(g0.shape[0]):
-        if g0[i] > 1e299:
-            continue
-        h = certified_step(g0[i], g1[i], g2[i], bound[i], best)
-        if h < best:
-            best = h
-            which = i
-    return best, which
-
-
-@dataclass
-class _Pattern:
-    """The cached exact flow of one contact pattern, in scaled variables."""
-
-    a: FloatArray  # scaled generator (n_aug, n_aug)
-    norm: float  # |a|_F >= |a|_2
-    jerk_rows: FloatArray  # (J, n_aug) w_j^T A^3 (plain bound: |rows| |y| growth)
-    growth: float  # exp(mu(A) H) >= sup |exp(A tau)| on [0, H]
-    modal_inverse: NDArray[np.complex128] | None  # V^-1, or None when V is ill-conditioned
-    modal_weights: FloatArray | None  # (J, n_aug) |w_j v_k| |lambda_k|^3 max(1, e^(Re lambda_k H))
-    uses: int = 0
-    modal_tried: bool = False
-
-
 class _Flow:
-    """Exact pattern-by-pattern flow of a structure's augmented state, with caches."""
+    """A structure's exact flow, set up once for ``_march.march`` (sparse pieces, scales)."""
 
     def __init__(self, structure: Structure, force: FloatArray, omega: float) -> None:
         s = structure
@@ -114,7 +75,7 @@ class _Flow:
         self.b = s.joint_directions
         self.laws = s.joint_laws
         self.g_c, self.g_t = edge_positions(self.laws)
-        self.restitution = np.array([law.restitution for law in self.laws])
+        self.restitution = np.array([law.restitution for law in self.laws], dtype=np.float64)
         inv_m = 1.0 / self.m
         self.impulse_dirs = self.b * inv_m  # rows M^-1 b_j
         self.m_eff = 1.0 / np.maximum(np.einsum("jn,jn->j", self.b, self.impulse_dirs), 1e-300)
@@ -122,131 +83,41 @@ class _Flow:
         bm = s.member_directions[plain]
         self.k_linear = (bm.T * s._k_member[plain]) @ bm
         self.structure = s
-        k_closed, _ = s.pattern_stiffness(np.full(len(self.laws), COMPRESSION))
-        k_stiff = k_closed.copy()
-        for j, law in enumerate(self.laws):  # the stiffest state of every joint
-            extra = max(law.tension_stiffness - law.compression_stiffness, 0.0)
-            k_stiff += extra * np.outer(self.b[j], self.b[j])
+        n_j = len(self.laws)
+        # each joint's (stiffness, offset) in state -1, 0, 1 (column state + 1)
+        self.k_table = np.zeros((n_j, 3))
+        self.r_table = np.zeros((n_j, 3))
+        for j, law in enumerate(self.laws):
+            for state in (TENSION, OPEN, COMPRESSION):
+                self.k_table[j, state + 1], self.r_table[j, state + 1] = _law_state(law, state)
+        k_stiff = self.k_linear + (self.b.T * np.max(self.k_table, axis=1)) @ self.b
         w2 = scipy.linalg.eigh(k_stiff, np.diag(self.m), eigvals_only=True)
         self.omega_ref = math.sqrt(max(float(w2[-1]), 1e-300))
         rates = [self.omega_ref, omega]
         c_rate = scipy.linalg.eigh(self.c, np.diag(self.m), eigvals_only=True)
         rates.append(float(c_rate[-1]))
-        self.base_step = 2.0 * math.pi / max(rates) / 8.0
+        self.base_step = 2.0 * math.pi / max(rates) * BASE_STEP_PERIODS
         # scaling: u -> omega_ref u, v -> v, (sin, cos, 1) -> v_ref (sin, cos, 1)
-        offsets = [
-            max(
-                law.compression_stiffness * law.compression_gap,
-                law.tension_stiffness * law.tension_gap,
-            )
-            for law in self.laws
-        ]
-        push = np.abs(force) * inv_m
-        push_norm = float(np.linalg.norm(push))
+        offsets = np.max(np.abs(self.r_table), axis=1)
+        push_norm = float(np.linalg.norm(np.abs(force) * inv_m))
         push_norm += sum(
             o * float(np.linalg.norm(r)) for o, r in zip(offsets, self.impulse_dirs, strict=True)
         )
         self.v_ref = push_norm / self.omega_ref if push_norm > 0.0 else 1.0
+        # infinity norm of the scaled generator, bounded over every pattern
+        abs_b = np.abs(self.b)
+        k_abs = np.abs(self.k_linear) + (abs_b.T * np.max(np.abs(self.k_table), axis=1)) @ abs_b
+        rows_v = (
+            np.sum(k_abs, axis=1) / self.omega_ref
+            + np.sum(np.abs(self.c), axis=1)
+            + (np.abs(force) + abs_b.T @ offsets) / self.v_ref
+        ) * inv_m
+        self.norm_a = float(max(self.omega_ref, omega, float(np.max(rows_v, initial=0.0))))
+        self.c_csr = scipy.sparse.csr_matrix(self.c)
+        self.b_csr = scipy.sparse.csr_matrix(self.b.reshape(n_j, n))
         self.scale = np.concatenate(  # y_scaled = scale * y
             (np.full(n, self.omega_ref), np.ones(n), np.full(3, self.v_ref))
         )
-        self.patterns: dict[bytes, _Pattern] = {}
-        # energy forms on the scaled state: input F.v sin(wt), viscous v^T C v
-        n_aug = 2 * n + 3
-        q_in = np.zeros((n_aug, n_aug))
-        q_in[n : 2 * n, 2 * n] = 0.5 * force / self.v_ref
-        q_in[2 * n, n : 2 * n] = 0.5 * force / self.v_ref
-        q_visc = np.zeros((n_aug, n_aug))
-        q_visc[n : 2 * n, n : 2 * n] = self.c
-        self.q = np.stack((q_in, q_visc))
-        self.delta_rows = np.zeros((len(self.laws), n_aug))  # delta_j = rows . y_scaled
-        self.delta_rows[:, :n] = self.b / self.omega_ref
-
-    # ---- one pattern's exact flow ----------------------------------------------------------
-
-    def pattern(self, states: NDArray[np.int8]) -> _Pattern:
-        key = states.tobytes()
-        cached = self.patterns.get(key)
-        if cached is not None:
-            return cached
-        n = self.n
-        k, r = self.structure.pattern_stiffness(states)
-        n_aug = 2 * n + 3
-        gen = np.zeros((n_aug, n_aug))
-        gen[:n, n : 2 * n] = np.eye(n)
-        inv_m = 1.0 / self.m
-        gen[n : 2 * n, :n] = -(k * inv_m[:, None])
-        gen[n : 2 * n, n : 2 * n] = -(self.c * inv_m[:, None])
-        gen[n : 2 * n, 2 * n] = self.force * inv_m
-        gen[n : 2 * n, 2 * n + 2] = r * inv_m
-        gen[2 * n, 2 * n + 1] = self.omega
-        gen[2 * n + 1, 2 * n] = -self.omega
-        a = gen * self.scale[:, None] / self.scale[None, :]
-        h = self.base_step
-        norm = float(np.linalg.norm(a))  # Frobenius: an upper bound of the 2-norm
-        jerk = self.delta_rows @ np.linalg.matrix_power(a, 3)
-        # logarithmic norm mu_2(a) <= largest Gershgorin bound of the symmetric part
-        sym = 0.5 * (a + a.T)
-        mu = float(np.max(np.diag(sym) + np.sum(np.abs(sym), axis=1) - np.abs(np.diag(sym))))
-        pat = _Pattern(
-            a=a,
-            norm=norm,
-            jerk_rows=jerk,
-            growth=math.exp(max(mu, 0.0) * h),
-            modal_inverse=None,
-            modal_weights=None,
-        )
-        self.patterns[key] = pat
-        return pat
-
-    def _modal(self, pat: _Pattern) -> None:
-        """Add the modal jerk bound to a pattern used long enough to repay its cost."""
-        pat.modal_tried = True
-        # the jerk is sum_k (w_j v_k) lambda_k^3 c_k e^(lambda_k t)
-        lam, vec = np.linalg.eig(pat.a)
-        try:
-            inverse = np.linalg.inv(vec)
-        except np.linalg.LinAlgError:
-            return
-        condition = float(np.linalg.norm(vec, 1) * np.linalg.norm(inverse, 1))
-        if condition < MODAL_CONDITION_LIMIT:
-            growth_k = np.exp(np.maximum(lam.real, 0.0) * self.base_step)
-            pat.modal_inverse = inverse
-            pat.modal_weights = np.abs(self.delta_rows @ vec) * (np.abs(lam) ** 3 * growth_k)
-
-    def jerk_bound(self, pat: _Pattern, y: FloatArray) -> FloatArray:
-        """(J,) bounds on each joint's third derivative of delta over the next base step."""
-        norms = np.linalg.norm(pat.jerk_rows, axis=1)
-        plain: FloatArray = norms * (pat.growth * float(np.linalg.norm(y)))
-        pat.uses += 1
-        if pat.uses > MODAL_AFTER_STEPS and not pat.modal_tried:
-            self._modal(pat)
-        if pat.modal_weights is None or pat.modal_inverse is None:
-            return plain
-        modal = pat.modal_weights @ np.abs(pat.modal_inverse @ y)
-        # round-off in the eigenvectors: keep a sliver of the plain bound as a margin
-        bound: FloatArray = np.minimum(modal * (1.0 + 1e-9) + 1e-9 * plain, plain)
-        return bound
-
-    def propagate(
-        self, pat: _Pattern, y: FloatArray, tau: float, energy: FloatArray | None
-    ) -> FloatArray:
-        """y (scaled) after tau in [0, H]; adds the energy integrals to ``energy`` if given."""
-        if tau <= 0.0:
-            return y
-        terms = [y]
-        size = float(np.abs(y).max())
-        while len(terms) < TAYLOR_TERMS:
-            terms.append(pat.a @ terms[-1] * (tau / len(terms)))
-            if float(np.abs(terms[-1]).max()) <= 1e-18 * size and pat.norm * tau < len(terms):
-                break
-        d = np.array(terms)
-        if energy is not None:
-            gram = (d @ self.q) @ d.T  # (2, K, K)
-            order = np.arange(d.shape[0])
-            weights = tau / (order[:, None] + order[None, :] + 1.0)
-            energy += np.sum(gram * weights, axis=(1, 2))
-        return np.asarray(d.sum(axis=0), dtype=np.float64)
 
     # ---- conversions --------------------------------------------------------------------
 
@@ -295,7 +166,10 @@ class StructureMotion:
     event_joints : (E,) ndarray of int
         Which joint (index into ``structure.joint_members``) each event belongs to.
     patterns_visited : int
-        How many distinct contact patterns were met (each one cached).
+        How many distinct contact patterns were met.
+    steps : int
+        Steps of the exact flow taken (one ends at each event; the others are at most the
+        base step, an eighth of the shortest period).
     """
 
     t: FloatArray
@@ -311,6 +185,7 @@ class StructureMotion:
     structure: Structure = field(repr=False)
     omega: float = 0.0
     initial_energy: float = 0.0
+    steps: int = 0
 
     @property
     def balance_error(self) -> float:
@@ -422,6 +297,17 @@ def _sample_times(duration: float, period: float, samples_per_period: int) -> Fl
     return np.linspace(0.0, duration, n)
 
 
+def _patterns_visited(
+    start: NDArray[np.int8], joints: NDArray[np.int64], new_states: NDArray[np.int8]
+) -> int:
+    """How many distinct contact patterns the event sequence passes through."""
+    if start.size == 0:
+        return 1
+    history = np.ascontiguousarray(_march.pattern_history(start, joints, new_states))
+    rows = history.view(np.dtype((np.void, history.shape[1])))
+    return int(np.unique(rows).size)
+
+
 def _run(
     flow: _Flow,
     u0: FloatArray,
@@ -429,95 +315,66 @@ def _run(
     duration: float,
     times: FloatArray,
 ) -> StructureMotion:
-    n_j = len(flow.laws)
-    h_base = flow.base_step
-    t = 0.0
+    n = flow.n
     y = flow.scaled(u0, v0, 0.0)
-    delta0 = flow.b @ u0
-    states = flow.states_at(delta0, flow.b @ v0)
-    energy = np.zeros(2)
-    impact = 0.0
-    out_y = np.zeros((times.size, y.size))
-    out_p = np.zeros((times.size, n_j), dtype=np.int8)
-    next_sample = 0
-    event_times: list[float] = []
-    event_joints: list[int] = []
-    eps = 1e-14 * h_base
-    max_events = MAX_EVENTS_PER_STEP * (int(duration / h_base) + 1)
-    g0 = np.full(2 * n_j, 1e300)
-    g1 = np.zeros(2 * n_j)
-    g2 = np.zeros(2 * n_j)
-    bounds = np.zeros(2 * n_j)
-    open_ = states == OPEN
-    while True:
-        pat = flow.pattern(states)
-        y[-3:] = flow.scale[-3:] * np.array(
-            [math.sin(flow.omega * t), math.cos(flow.omega * t), 1.0]
+    states = flow.states_at(flow.b @ u0, flow.b @ v0)
+    max_events = MAX_EVENTS_PER_STEP * (int(duration / flow.base_step) + 1)
+    c, b = flow.c_csr, flow.b_csr
+    # one sparsity pattern for the plain stiffness and the damping, M^-1 and scaling in
+    a = scipy.sparse.csr_matrix((np.abs(flow.k_linear) + np.abs(flow.c)) > 0.0, dtype=np.float64)
+    a.sort_indices()
+    rows = np.repeat(np.arange(n), np.diff(a.indptr))
+    a_u = flow.k_linear[rows, a.indices] / (flow.m[rows] * flow.omega_ref)
+    a_v = flow.c[rows, a.indices] / flow.m[rows]
+    y_end, out_y, out_p, energy, impact, ev_t, ev_j, ev_s, steps, status = _march.march(
+        y,
+        states,
+        float(duration),
+        times,
+        flow.base_step,
+        n,
+        float(flow.omega),
+        flow.omega_ref,
+        flow.v_ref,
+        1.0 / flow.m,
+        np.asarray(flow.force, dtype=np.float64),
+        a.indptr.astype(np.int64),
+        a.indices.astype(np.int64),
+        a_u,
+        a_v,
+        c.indptr.astype(np.int64),
+        c.indices.astype(np.int64),
+        c.data.astype(np.float64),
+        b.indptr.astype(np.int64),
+        b.indices.astype(np.int64),
+        b.data.astype(np.float64),
+        flow.k_table,
+        flow.r_table,
+        flow.g_c,
+        flow.g_t,
+        flow.restitution,
+        flow.m_eff,
+        flow.norm_a,
+        max_events,
+    )
+    if status == _march.CHATTER:
+        raise SimulationError(
+            f"more than {max_events} gap-edge events in {float(ev_t[-1]):.4g} s (chattering "
+            f"at joint {int(ev_j[-1])}); add damping or a restitution below 1"
         )
-        dy = pat.a @ y
-        ddy = pat.a @ dy
-        d = flow.delta_rows @ np.column_stack((y, dy, ddy))  # (J, 3): delta, delta', delta''
-        open_ = states == OPEN
-        comp = states == COMPRESSION
-        tens = states == TENSION
-        # slot 2j: the compression edge; slot 2j + 1: the tension edge (each > 0 inside)
-        sign_c = np.where(comp, 1.0, -1.0)
-        g0[0::2] = np.where(open_ | comp, sign_c * (d[:, 0] - flow.g_c), 1e300)
-        g1[0::2] = sign_c * d[:, 1]
-        g2[0::2] = sign_c * d[:, 2]
-        sign_t = np.where(tens, -1.0, 1.0)
-        g0[1::2] = np.where(open_ | tens, sign_t * (d[:, 0] + flow.g_t), 1e300)
-        g1[1::2] = sign_t * d[:, 1]
-        g2[1::2] = sign_t * d[:, 2]
-        bound = flow.jerk_bound(pat, y)
-        bounds[0::2] = bound
-        bounds[1::2] = bound
-        remaining = duration - t
-        h_max = min(h_base, remaining)
-        h, which = _first_event(g0, g1, g2, bounds, h_max)
-        # an event when the certified step has shrunk to round-off of the step or of t
-        event = which >= 0 and h <= max(eps, 8.0 * math.ulp(t))
-        if not event and which >= 0:
-            which = -1  # a certified step short of the event
-        # samples that fall inside [t, t + h)
-        while next_sample < times.size and times[next_sample] < t + h:
-            tau = max(times[next_sample] - t, 0.0)
-            out_y[next_sample] = flow.propagate(pat, y, tau, None)
-            out_p[next_sample] = states
-            next_sample += 1
-        y = flow.propagate(pat, y, h, energy)
-        t += h
-        if h >= remaining and not event:
-            break
-        if not event:
-            continue
-        joint = which // 2
-        event_times.append(t)
-        event_joints.append(joint)
-        if len(event_times) > max_events:
-            raise SimulationError(
-                f"more than {max_events} gap-edge events in {t:.4g} s (chattering at joint "
-                f"{joint}); add damping or a restitution below 1"
-            )
-        entering = states[joint] == OPEN
-        if which % 2 == 0:
-            states[joint] = COMPRESSION if entering else OPEN
-        else:
-            states[joint] = TENSION if entering else OPEN
-        e = flow.restitution[joint]
-        if entering and e < 1.0:
-            n = flow.n
-            speed = float(flow.b[joint] @ y[n : 2 * n])
-            impact += 0.5 * (1.0 - e * e) * flow.m_eff[joint] * speed * speed
-            y[n : 2 * n] -= (1.0 - e) * speed * flow.m_eff[joint] * flow.impulse_dirs[joint]
-    u_end, v_end = flow.split(y)
-    u = out_y[:, : flow.n] / flow.omega_ref
-    v = out_y[:, flow.n : 2 * flow.n].copy()
+    if status != _march.DONE:
+        raise SimulationError(
+            "the pattern flow's Taylor series did not converge even on a step 1e-12 of the "
+            "base step; check the structure's stiffness and mass for extreme values"
+        )
+    u_end, v_end = flow.split(y_end)
+    u = out_y[:, :n] / flow.omega_ref
+    v = out_y[:, n : 2 * n].copy()
     ledger = EnergyLedger(
         input=float(energy[0]),
         viscous=float(energy[1]),
         sliding_friction=0.0,
-        impact=impact,
+        impact=float(impact),
         mechanical_energy_change=flow.mechanical_energy(u_end, v_end)
         - flow.mechanical_energy(u0, v0),
     )
@@ -527,14 +384,15 @@ def _run(
         v=v,
         pattern=out_p,
         energy=ledger,
-        events=len(event_times),
-        event_times=np.array(event_times),
-        event_joints=np.array(event_joints, dtype=np.int64),
-        patterns_visited=len(flow.patterns),
+        events=int(ev_t.size),
+        event_times=np.asarray(ev_t, dtype=np.float64),
+        event_joints=np.asarray(ev_j, dtype=np.int64),
+        patterns_visited=_patterns_visited(states, ev_j, ev_s),
         final_state=(u_end, v_end),
         structure=flow.structure,
         omega=flow.omega,
         initial_energy=flow.mechanical_energy(u0, v0),
+        steps=int(steps),
     )
 
 
@@ -550,7 +408,7 @@ def time_response(
     """Return the exact forced motion under F sin(omega t) from ``initial`` over ``duration`` s.
 
     MODEL.md 5.2: piecewise-linear per contact pattern, solved in closed form per
-    pattern (cached), events certified (see the module docstring).
+    pattern, events certified (see the module docstring).
 
     Parameters
     ----------
