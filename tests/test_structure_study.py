@@ -71,6 +71,16 @@ def test_cli_writes_netcdf_and_json(
     assert main(["structure", str(_write(tmp_path)), task, "--out", str(out)]) == 2  # no overwrite
 
 
+def test_cli_decay_text_says_n_a_for_the_last_cycle_without_a_damping_ratio(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "decay.nc"
+    assert main(["structure", str(_write(tmp_path)), "decay", "--out", str(out)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("damping_ratio"))
+    assert "None" not in line
+    assert line.endswith("'n/a']")
+
+
 @pytest.mark.parametrize(
     ("change", "message"),
     [

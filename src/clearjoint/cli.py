@@ -1239,6 +1239,8 @@ def _run_structure(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
     else:
         for key, value in summary.items():
+            if isinstance(value, list):  # a cycle without a damping ratio (the last) says so
+                value = ["n/a" if item is None else item for item in value]
             print(f"{key}: {value}")
         print(f"wrote {out}" + (f" and {args.plot}" if args.plot else ""))
     return 0
