@@ -103,23 +103,28 @@ def restoring_force(
 def _periodic_derivatives(
     x: FloatArray, step: float, noise: float = 0.0
 ) -> tuple[FloatArray, FloatArray]:
-    """Velocity and acceleration of one periodic cycle, spectrally, harmonics above the noise.
+    """Velocity and acceleration of periodic cycles, spectrally, harmonics above the noise.
 
-    The harmonics kept are those up to the last one whose amplitude exceeds three times
-    the noise's (``noise``: the rms noise per sample of ``x``). Used only to place the
-    stages, choose the model and take the sign of the velocity; the joint's parameters
-    never use them (the weak form needs no derivative).
+    ``x`` is one cycle (M,) or one cycle per row (R, M), each row treated on its own
+    (in one batched FFT). The harmonics kept are those up to the last one whose
+    amplitude exceeds three times the noise's (``noise``: the rms noise per sample of
+    ``x``). Used only to place the stages, choose the model and take the sign of the
+    velocity; the joint's parameters never use them (the weak form needs no derivative).
     """
-    m = x.size
-    spectrum = np.fft.rfft(x)
-    k = np.arange(spectrum.size)
+    rows = np.atleast_2d(x)
+    m = rows.shape[1]
+    spectrum = np.fft.rfft(rows, axis=1)
+    k = np.arange(spectrum.shape[1])
     floor = 3.0 * noise * math.sqrt(m / 2.0)
-    above = np.nonzero(np.abs(spectrum) > floor)[0]
-    cut = int(above[-1]) if above.size else 1
-    spectrum[cut + 1 :] = 0.0
+    above = np.abs(spectrum) > floor
+    last = spectrum.shape[1] - 1 - np.argmax(above[:, ::-1], axis=1)
+    cut = np.where(above.any(axis=1), last, 1)
+    spectrum[k[None, :] > cut[:, None]] = 0.0
     w = 2.0 * math.pi * k / (m * step)
-    v = np.fft.irfft(1j * w * spectrum, n=m)
-    a = np.fft.irfft(-(w**2) * spectrum, n=m)
+    v = np.fft.irfft(1j * w * spectrum, n=m, axis=1)
+    a = np.fft.irfft(-(w**2) * spectrum, n=m, axis=1)
+    if x.ndim == 1:
+        return v[0], a[0]
     return v, a
 
 
@@ -367,8 +372,9 @@ def _identify_stack(
     elif model == "joint":
         assert first_fit is not None
         fits = []
+        reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
         for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
-            vr, ar = _periodic_derivatives(xr_, st.step, noise_x)
+            vr, ar = reps_v[i], reps_ad[i]
             if reps_a is not None:
                 ar = reps_a[i]
             if "v" in st.channels:
@@ -378,8 +384,9 @@ def _identify_stack(
         masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     else:
         fits = []
+        reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
         for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
-            vr, ar = _periodic_derivatives(xr_, st.step, noise_x)
+            vr, ar = reps_v[i], reps_ad[i]
             if reps_a is not None:
                 ar = reps_a[i]
             if "v" in st.channels:
