@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -92,11 +93,14 @@ def friction_loop(
     cycles: int = 8,
     rate: float = 2000.0,
     frequency: float = 1.0,
+    backlash_falling: float | None = None,
 ) -> Record:
     """A rigid-plastic friction loop with backlash under imposed x = X sin(w t), exactly.
 
     The force follows, along the travel from each reversal, elastic unloading at
     ``stiffness``, the backlash at zero force, elastic loading, then the slip plateau.
+    ``backlash_falling`` (default: ``backlash``) is the free travel after the upper
+    reversal: a loop that is not one gap when the two differ.
     """
     t = np.arange(int(cycles * rate / frequency)) / rate
     envelope = np.clip(t * frequency, 0.0, 1.0)  # a one-cycle ramp in, as the BRFD has
@@ -109,12 +113,13 @@ def friction_loop(
             state, anchor, level = direction, x[n - 1], force[n - 1]
         travel = abs(x[n] - anchor)
         unload = abs(level) / stiffness
+        gap = backlash if state > 0 or backlash_falling is None else backlash_falling
         if travel <= unload:
             value = level + state * stiffness * travel
-        elif travel <= unload + backlash:
+        elif travel <= unload + gap:
             value = 0.0
         else:
-            value = state * stiffness * (travel - unload - backlash)
+            value = state * stiffness * (travel - unload - gap)
         force[n] = state * min(abs(value), friction) if np.sign(value) == state else value
     return Record(
         time=t,
@@ -124,6 +129,24 @@ def friction_loop(
         frequency_hz=frequency,
         source="friction loop",
     )
+
+
+def test_a_loop_whose_branches_show_different_backlash_is_doubtful() -> None:
+    """One gap is crossed both ways: 4 mm rising against 1.5 mm falling is not one gap."""
+    b, f_f, k, x_amp = 4e-3, 1e4, 5e6, 20e-3
+    one_gap = identify(friction_loop(b, f_f, k, x_amp))
+    assert one_gap.flags["clearance_m"] == ("ok", "")
+    two = identify(friction_loop(b, f_f, k, x_amp, backlash_falling=1.5e-3))
+    assert two.model == "damper"
+    flag, reason = two.flags["clearance_m"]
+    assert flag == "doubtful"
+    # each branch's reading is the generator's own free travel
+    rising, falling = (float(v) for v in re.findall(r"([\d.]+) mm on the", reason))
+    assert rising == pytest.approx(4.0, rel=0.02)
+    assert falling == pytest.approx(1.5, rel=0.02)
+    # the same rule on the two other branch ratios: 1.8 passes, 2.2 does not
+    assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 1.8)).flag == "ok"
+    assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 2.2)).flag != "ok"
 
 
 def test_exact_friction_loop_with_backlash() -> None:
@@ -338,6 +361,11 @@ def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
     up, down = s["friction_force_positive_n"], s["friction_force_negative_n"]
     assert up > 0 > down
     assert s["friction_force_n"] == pytest.approx(0.5 * (up - down))
+    # 2 Hz, 0 lb: a backlash of about 4.3 mm on the rising branch, 1.4 mm on the falling one
+    # (docs/identify.md): not one gap, so its backlash is doubtful; the others read alike
+    flag, reason = result.flags["clearance_m"]
+    assert flag == ("doubtful" if tension == 0 else "ok")
+    assert ("not one gap" in reason) == (tension == 0)
     assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
 
 

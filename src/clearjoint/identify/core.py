@@ -22,8 +22,9 @@ MODEL.md section 3. The steps:
    cycle's own loop area (the closed integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
-   exceeds a quarter of it, a fit residual above the noise floor, or a force-controlled
-   record without a mass (then estimated from the record, with a warning).
+   exceeds a quarter of it, a fit residual above the noise floor, a force-controlled
+   record without a mass (then estimated from the record, with a warning), or a damper
+   whose backlash reads more than twice as long on one branch as on the other.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ from clearjoint.identify.cycles import (
     steady,
     steady_rule,
 )
-from clearjoint.identify.damper import _damper_fit
+from clearjoint.identify.damper import BRANCH_RATIO, _damper_fit
 from clearjoint.identify.result import QUANTITIES, CycleResult, Identification
 from clearjoint.identify.segments import (
     STAGE_COMPRESSION,
@@ -454,6 +455,17 @@ def _identify_stack(
         mass_missing,
         summary["mass_kg"],
     )
+    if model == "damper":
+        b_rise, b_fall = fits[0].backlash_branches
+        low, high = min(b_rise, b_fall), max(b_rise, b_fall)
+        apart = high > BRANCH_RATIO * low  # False when a reading is missing (NaN)
+        if apart and flags["clearance_m"][0] == "ok":
+            flags["clearance_m"] = (
+                "doubtful",
+                f"backlash {b_rise * 1e3:.3g} mm on the rising branch and {b_fall * 1e3:.3g} mm "
+                f"on the falling one (more than {BRANCH_RATIO:g} times apart): not one gap "
+                "crossed both ways",
+            )
     if mass_missing:
         warnings.append(
             f"{where}: force-controlled record without a mass: the mass was estimated from the "

@@ -160,6 +160,8 @@ class _Fit:
     lines: tuple[tuple[float, float], ...] = ()
     level_positive: float = math.nan
     level_negative: float = math.nan
+    #: the damper's backlash read on the rising and on the falling branch
+    backlash_branches: tuple[float, float] = (math.nan, math.nan)
 
 
 def _joint_fit(
