@@ -18,7 +18,8 @@ MODEL.md section 3. The steps:
    sign and drag from its spectral derivative); the damper's and the line's by their
    per-sample fits;
 6. a jackknife over the cycles (the average without each of at most eight contiguous
-   groups of cycles in turn) for every standard error; the energy per cycle is each
+   groups of cycles in turn, all replicates fitted in one batched solve) for every
+   standard error; the energy per cycle is each
    cycle's own loop area (the closed integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
@@ -57,7 +58,9 @@ from clearjoint.identify.segments import (
     _Fit,
     _is_joint,
     _joint_fit,
+    _joint_fits,
     _line_fit,
+    _line_fits,
     _windows,
 )
 from clearjoint.identify.weak import stage_runs, weak_fit, weak_system
@@ -370,33 +373,38 @@ def _identify_stack(
             )
         masses = weak.mass
         residual = float(weak.residual[0])
-    elif model == "joint":
-        assert first_fit is not None
-        fits = []
-        reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
-        for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
-            vr, ar = reps_v[i], reps_ad[i]
-            if reps_a is not None:
-                ar = reps_a[i]
-            if "v" in st.channels:
-                vr = v
-            rr = fr_ - m_guess * ar if force_control else fr_
-            fits.append(_joint_fit(xr_, rr, vr, parts, windows, compete=False) or first_fit)
-        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     else:
-        fits = []
+        # every replicate's velocity and restoring force, (G + 1, M), then the fits of all
+        # replicates in one batched solve (row by row only if that solve is singular)
         reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
-        for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
-            vr, ar = reps_v[i], reps_ad[i]
-            if reps_a is not None:
-                ar = reps_a[i]
-            if "v" in st.channels:
-                vr = v
-            rr = fr_ - m_guess * ar if force_control else fr_
-            fit = _damper_fit(xr_, fr_, parts) if model == "damper" else None
-            if fit is None:
-                fit = _line_fit(xr_, rr, vr)
-            fits.append(fit)
+        if reps_a is not None:
+            reps_ad = reps_a
+        if "v" in st.channels:
+            reps_v = np.broadcast_to(v, reps_x.shape)
+        reps_r = reps_f - m_guess * reps_ad if force_control else reps_f
+        fits = []
+        if model == "joint":
+            assert first_fit is not None
+            batch = _joint_fits(reps_x, reps_r, reps_v, parts, windows)
+            if batch is None:
+                batch = [
+                    _joint_fit(xr_, rr_, vr_, parts, windows, compete=False)
+                    for xr_, rr_, vr_ in zip(reps_x, reps_r, reps_v, strict=True)
+                ]
+            fits = [fit or first_fit for fit in batch]
+        elif model == "damper":
+            for xr_, fr_, rr_, vr_ in zip(reps_x, reps_f, reps_r, reps_v, strict=True):
+                fits.append(_damper_fit(xr_, fr_, parts) or _line_fit(xr_, rr_, vr_))
+        else:
+            line_fits = _line_fits(reps_x, reps_r, reps_v)
+            fits = (
+                line_fits
+                if line_fits is not None
+                else [
+                    _line_fit(xr_, rr_, vr_)
+                    for xr_, rr_, vr_ in zip(reps_x, reps_r, reps_v, strict=True)
+                ]
+            )
         masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     values = [
         _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
