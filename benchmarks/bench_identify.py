@@ -10,7 +10,8 @@ and over the BRFD folder, best of ``--repeats``, in wall-clock seconds and in CP
 (user + system of the command's processes, which contention inflates less). With
 ``--old-src`` (for example the ``src`` folder of another checkout) the same command runs
 with that code too, in the same loop, and the ratio is printed: on a shared machine only
-ratios measured side by side mean anything. Target (issue 15): 1e6 samples per second.
+ratios measured side by side mean anything; the load average is printed before and after.
+Target (issue 15): 1e6 samples per second.
 """
 
 from __future__ import annotations
@@ -62,6 +63,10 @@ def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float
     return wall, cpu
 
 
+def _load() -> str:
+    return " ".join(f"{value:.2f}" for value in os.getloadavg())
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--brfd", default=str(HERE.parents[2] / "shared" / "data" / "brfd"))
@@ -81,6 +86,7 @@ def main() -> None:
         if brfd.exists():
             sets["BRFD folder"] = sorted(brfd.glob("*.json"))
         out = Path(folder) / "results.csv"
+        print("load average (1, 5, 15 min) before: " + _load())
         for name, files in sets.items():
             n = samples(files)
             best = {"new": (float("inf"), 0.0), "old": (float("inf"), 0.0)}
@@ -103,6 +109,7 @@ def main() -> None:
                     f"{old_wall / wall:.2f}x wall, {old_cpu / cpu:.2f}x CPU"
                 )
             print(line)
+        print("load average (1, 5, 15 min) after: " + _load())
 
 
 if __name__ == "__main__":
