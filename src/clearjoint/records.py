@@ -652,18 +652,20 @@ def _read_netcdf(path: Path, resample_: bool) -> Record:
         columns: dict[str, FloatArray] = {}
         units: dict[str, str] = {}
         for name in ("time", *CHANNELS):
-            if name not in handle:
+            variable = handle.get(name)  # one lookup each (h5py's are slow)
+            if variable is None:
                 continue
-            variable = handle[name]
             unit = _text(variable.attrs.get("units", ""))
             if not unit:
                 raise RecordError(f"{where}: variable {name!r} has no units attribute")
             columns[name] = np.asarray(variable[...], dtype=np.float64) * _factor(where, name, unit)
             units[name] = unit
         meta: dict[str, Any] = {}
+        attrs = handle.attrs
+        present = set(attrs.keys())
         for attr, key in _NC_META.items():
-            if attr in handle.attrs:
-                value = handle.attrs[attr]
+            if attr in present:
+                value = attrs[attr]
                 meta[key] = (
                     _text(value)
                     if key in ("joint_id", "control", "notes")
