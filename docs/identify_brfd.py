@@ -13,7 +13,7 @@ within 15 % of the elastic-plastic-with-gap estimate 2 F_f (2X - b - 2 F_f / k).
 backlash misses, the travel steps between the level crossings on each branch (what the
 damper estimator reads, :mod:`clearjoint.identify.damper`), and the backlash of every file
 under an alternative rule tried in docs/identify.md (a long step in which the force falls
-back by more than two crossing levels is ringing, not backlash).
+back by more than two crossing levels, or one, is ringing, not backlash).
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ def _steps(x: np.ndarray, f: np.ndarray, dip: float | None) -> tuple[list[np.nda
 def diagnose(results: list[tuple[object, object]]) -> None:
     loops = {Path(i.source).stem: i.loop for _, i in results}  # type: ignore[attr-defined]
     tension = {k: int(re.search(r"(\d+)lbtension", k)[1]) for k in loops}  # type: ignore[index]
-    for dip in (None, 0.1):
+    for dip in (None, 0.1, 0.05):
         b = {k: _steps(*loop, dip)[1] for k, loop in loops.items()}
         median = {t: float(np.median([b[k] for k in b if tension[k] == t])) for t in (0, 30, 36)}
         miss = {
