@@ -503,3 +503,24 @@ def test_batched_replicate_fits_equal_the_fits_one_by_one(
             assert batched[name].stderr[q] == pytest.approx(
                 one_by_one.stderr[q], rel=1e-6, abs=1e-12, nan_ok=True
             ), q
+
+
+def test_fft_length_is_the_smallest_even_five_smooth_one() -> None:
+    """numpy's FFT at the length scipy's next_fast_len would give (where that one is even)."""
+    from scipy.fft import next_fast_len
+
+    from clearjoint.identify.cycles import _smooth_length
+
+    rng = np.random.default_rng(5)
+    for n in [1, 2, 3, 7, 100, 1000, 14_400, 118_788, *rng.integers(1, 10**6, 300)]:
+        length = _smooth_length(int(n))
+        assert length >= n
+        assert length % 2 == 0
+        reduced = length
+        for p in (2, 3, 5):
+            while reduced % p == 0:
+                reduced //= p
+        assert reduced == 1
+        reference = next_fast_len(int(n), real=True)
+        if reference % 2 == 0:
+            assert length == reference

@@ -19,8 +19,8 @@ MODEL.md section 3. The steps:
    per-sample fits;
 6. a jackknife over the cycles (the average without each of at most eight contiguous
    groups of cycles in turn, all replicates fitted in one batched solve) for every
-   standard error; the energy per cycle is each
-   cycle's own loop area (the closed integral of F dx, in which the inertia term cancels);
+   standard error; the energy per cycle is each cycle's own loop area (the closed
+   integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
    exceeds a quarter of it, a fit residual above the noise floor, a force-controlled
