@@ -632,7 +632,9 @@ def identify_files(
     resample, tolerance
         As for :func:`~clearjoint.records.read_record` and :func:`identify`.
     jobs : int
-        Processes over the files; the results are those of one process, in file order.
+        Processes over the files (the first file is identified here before they start, so
+        that they inherit what it loaded); the results are those of one process, in file
+        order.
     progress : callable, optional
         ``progress(done, total)``, called after each file.
 
@@ -646,12 +648,19 @@ def identify_files(
     """
     tasks = [(str(path), resample, tolerance) for path in paths]
     outcomes: list[tuple[Record, Identification] | str] = []
-    if jobs > 1 and len(tasks) > 1:
+    if jobs > 1 and len(tasks) > 2:
         from concurrent.futures import ProcessPoolExecutor
 
+        # the first file here, before the workers fork: they inherit what it loaded (the
+        # file format's reader, e.g. h5py, imported on first use, and warm caches) instead
+        # of each loading it again
+        outcomes.append(_identify_path(tasks[0]))
+        if progress:
+            progress(1, len(tasks))
+        rest = tasks[1:]
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            chunk = max(1, len(tasks) // (4 * jobs))
-            for k, outcome in enumerate(pool.map(_identify_path, tasks, chunksize=chunk), 1):
+            chunk = max(1, len(rest) // (4 * jobs))
+            for k, outcome in enumerate(pool.map(_identify_path, rest, chunksize=chunk), 2):
                 outcomes.append(outcome)
                 if progress:
                     progress(k, len(tasks))
