@@ -3,6 +3,7 @@
 Run on demand::
 
     python benchmarks/bench_identify.py [--brfd DIR] [--records DIR] [--old-src SRC] [--jobs N]
+        [--repeats R] [--split]
 
 It times the command (process start, reading, identification, writing results.csv) over
 the default rig campaign (written to a temporary folder unless ``--records`` names one)
@@ -10,12 +11,15 @@ and over the BRFD folder, best of ``--repeats``, in wall-clock seconds and in CP
 (user + system of the command's processes, which contention inflates less). With
 ``--old-src`` (for example the ``src`` folder of another checkout) the same command runs
 with that code too, in the same loop, and the ratio is printed: on a shared machine only
-ratios measured side by side mean anything. Target (issue 15): 1e6 samples per second.
+ratios measured side by side mean anything; the load average is printed before and after.
+``--split`` also prints the CPU seconds of reading and of identifying in this process.
+Target (issue 15): 1e6 samples per second.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import resource
 import subprocess
@@ -62,6 +66,25 @@ def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float
     return wall, cpu
 
 
+def split(files: list[Path]) -> str:
+    """CPU seconds of reading and of identifying ``files`` in this process (no start-up)."""
+    from clearjoint.errors import ClearjointError
+    from clearjoint.identify import identify
+
+    start = time.process_time()
+    records = [read_record(path) for path in files]
+    read = time.process_time() - start
+    start = time.process_time()
+    for record in records:  # a record refused with its reason costs its time as well
+        with contextlib.suppress(ClearjointError):
+            identify(record)
+    return f"in-process: reading {read:.2f} CPU s, identifying {time.process_time() - start:.2f}"
+
+
+def _load() -> str:
+    return " ".join(f"{value:.2f}" for value in os.getloadavg())
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--brfd", default=str(HERE.parents[2] / "shared" / "data" / "brfd"))
@@ -69,6 +92,9 @@ def main() -> None:
     parser.add_argument("--old-src", help="src folder of the code to compare with")
     parser.add_argument("--jobs", type=int, default=1)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument(
+        "--split", action="store_true", help="also time reading and identifying in-process"
+    )
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
         if args.records:
@@ -81,6 +107,7 @@ def main() -> None:
         if brfd.exists():
             sets["BRFD folder"] = sorted(brfd.glob("*.json"))
         out = Path(folder) / "results.csv"
+        print("load average (1, 5, 15 min) before: " + _load())
         for name, files in sets.items():
             n = samples(files)
             best = {"new": (float("inf"), 0.0), "old": (float("inf"), 0.0)}
@@ -103,6 +130,9 @@ def main() -> None:
                     f"{old_wall / wall:.2f}x wall, {old_cpu / cpu:.2f}x CPU"
                 )
             print(line)
+            if args.split:
+                print(f"{name:22s} {split(files)}")
+        print("load average (1, 5, 15 min) after: " + _load())
 
 
 if __name__ == "__main__":

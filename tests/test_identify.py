@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -92,11 +93,14 @@ def friction_loop(
     cycles: int = 8,
     rate: float = 2000.0,
     frequency: float = 1.0,
+    backlash_falling: float | None = None,
 ) -> Record:
     """A rigid-plastic friction loop with backlash under imposed x = X sin(w t), exactly.
 
     The force follows, along the travel from each reversal, elastic unloading at
     ``stiffness``, the backlash at zero force, elastic loading, then the slip plateau.
+    ``backlash_falling`` (default: ``backlash``) is the free travel after the upper
+    reversal: a loop that is not one gap when the two differ.
     """
     t = np.arange(int(cycles * rate / frequency)) / rate
     envelope = np.clip(t * frequency, 0.0, 1.0)  # a one-cycle ramp in, as the BRFD has
@@ -109,12 +113,13 @@ def friction_loop(
             state, anchor, level = direction, x[n - 1], force[n - 1]
         travel = abs(x[n] - anchor)
         unload = abs(level) / stiffness
+        gap = backlash if state > 0 or backlash_falling is None else backlash_falling
         if travel <= unload:
             value = level + state * stiffness * travel
-        elif travel <= unload + backlash:
+        elif travel <= unload + gap:
             value = 0.0
         else:
-            value = state * stiffness * (travel - unload - backlash)
+            value = state * stiffness * (travel - unload - gap)
         force[n] = state * min(abs(value), friction) if np.sign(value) == state else value
     return Record(
         time=t,
@@ -124,6 +129,24 @@ def friction_loop(
         frequency_hz=frequency,
         source="friction loop",
     )
+
+
+def test_a_loop_whose_branches_show_different_backlash_is_doubtful() -> None:
+    """One gap is crossed both ways: 4 mm rising against 1.5 mm falling is not one gap."""
+    b, f_f, k, x_amp = 4e-3, 1e4, 5e6, 20e-3
+    one_gap = identify(friction_loop(b, f_f, k, x_amp))
+    assert one_gap.flags["clearance_m"] == ("ok", "")
+    two = identify(friction_loop(b, f_f, k, x_amp, backlash_falling=1.5e-3))
+    assert two.model == "damper"
+    flag, reason = two.flags["clearance_m"]
+    assert flag == "doubtful"
+    # each branch's reading is the generator's own free travel
+    rising, falling = (float(v) for v in re.findall(r"([\d.]+) mm on the", reason))
+    assert rising == pytest.approx(4.0, rel=0.02)
+    assert falling == pytest.approx(1.5, rel=0.02)
+    # the same rule on the two other branch ratios: 1.8 passes, 2.2 does not
+    assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 1.8)).flag == "ok"
+    assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 2.2)).flag != "ok"
 
 
 def test_exact_friction_loop_with_backlash() -> None:
@@ -338,6 +361,11 @@ def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
     up, down = s["friction_force_positive_n"], s["friction_force_negative_n"]
     assert up > 0 > down
     assert s["friction_force_n"] == pytest.approx(0.5 * (up - down))
+    # 2 Hz, 0 lb: a backlash of about 4.3 mm on the rising branch, 1.4 mm on the falling one
+    # (docs/identify.md): not one gap, so its backlash is doubtful; the others read alike
+    flag, reason = result.flags["clearance_m"]
+    assert flag == ("doubtful" if tension == 0 else "ok")
+    assert ("not one gap" in reason) == (tension == 0)
     assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
 
 
@@ -439,3 +467,60 @@ def test_the_steady_cycle_rule_is_stated_where_a_record_is_refused() -> None:
         identify(short, tolerance=0.05)
     assert steady_rule(0.05) in str(refused.value)
     assert "5%" in steady_rule(0.05)
+
+
+def test_batched_replicate_fits_equal_the_fits_one_by_one(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The jackknife's replicates are fitted in one batched solve; fitted one by one (the
+    row-by-row robust least squares, the fallback) they give the same values and errors."""
+    import clearjoint.identify.core as core
+
+    joint, _ = independent[40.0]
+    path = write_record(joint, tmp_path / "noisy.csv", noise=0.01, acceleration=True)
+    t = np.arange(4000) / 2000.0
+    x = 1e-4 * np.sin(2 * np.pi * 10.0 * t)
+    v = 2e-3 * np.pi * np.cos(2 * np.pi * 10.0 * t)
+    rng = np.random.default_rng(3)
+    spring = Record(
+        time=t,
+        force=3e6 * x + 500.0 * v + rng.normal(0.0, 1.0, t.size),
+        displacement=x,
+        control="displacement",
+        frequency_hz=10.0,
+    )
+    records = {"joint": read_record(path), "line": spring}
+    batched = {name: identify(record) for name, record in records.items()}
+    monkeypatch.setattr(core, "_joint_fits", lambda *args: None)
+    monkeypatch.setattr(core, "_line_fits", lambda *args: None)
+    for name, record in records.items():
+        one_by_one = identify(record)
+        assert batched[name].model == one_by_one.model == name
+        for q, value in one_by_one.summary.items():
+            assert batched[name].summary[q] == pytest.approx(value, rel=1e-9, nan_ok=True), q
+            assert batched[name].stderr[q] == pytest.approx(
+                one_by_one.stderr[q], rel=1e-6, abs=1e-12, nan_ok=True
+            ), q
+
+
+def test_fft_length_is_the_smallest_even_five_smooth_one() -> None:
+    """numpy's FFT at the length scipy's next_fast_len would give (where that one is even)."""
+    from scipy.fft import next_fast_len
+
+    from clearjoint.identify.cycles import _smooth_length
+
+    rng = np.random.default_rng(5)
+    for n in [1, 2, 3, 7, 100, 1000, 14_400, 118_788, *rng.integers(1, 10**6, 300)]:
+        length = _smooth_length(int(n))
+        assert length >= n
+        assert length % 2 == 0
+        reduced = length
+        for p in (2, 3, 5):
+            while reduced % p == 0:
+                reduced //= p
+        assert reduced == 1
+        reference = next_fast_len(int(n), real=True)
+        if reference % 2 == 0:
+            assert length == reference

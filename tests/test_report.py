@@ -198,3 +198,34 @@ def test_names_moved_out_of_report_still_import() -> None:
     assert example_cycle is verification.example_cycle
     with pytest.raises(ImportError, match="no_such_name"):
         from clearjoint.report import no_such_name  # noqa: F401
+
+
+def test_report_tables_show_the_flags(reproduction: Path, tmp_path: Path) -> None:
+    """A record set with one flagged record (force control, its mass removed): the table of
+    identified tests shows its flag and reason beside the others' ``ok``."""
+    from dataclasses import replace
+
+    from clearjoint.records import read_record, write_record
+
+    folder = tmp_path / "records"
+    folder.mkdir()
+    records = sorted((reproduction / "records").glob("joint-*.nc"))[:3]
+    for path in records[1:]:
+        shutil.copy(path, folder / path.name)
+    record = read_record(records[0])
+    assert record.control == "force"
+    assert record.mass
+    write_record(replace(record, mass=None), folder / f"{records[0].stem}-no-mass.csv")
+    out = tmp_path / "report"
+    assert main(["report", "--records", str(folder), "--out", str(out)]) == 0
+    page = (out / "report.html").read_text()
+    table = page[page.index("Identified tests") :]
+    table = table[: table.index("</table>")]
+    assert "<th>flag</th><th>flag reason</th>" in table
+    rows = table.split("<tr>")[2:]
+    assert len(rows) == 3
+    flagged = [row for row in rows if "no-mass" in row]
+    assert len(flagged) == 1
+    assert "<td>doubtful</td>" in flagged[0]
+    assert "force control without a mass" in flagged[0]
+    assert all("<td>ok</td><td></td>" in row for row in rows if row not in flagged)

@@ -137,6 +137,8 @@ TEST_COLUMNS: tuple[tuple[str, str, float], ...] = (
     ("E per cycle (mJ)", "energy_per_cycle_j", 1e3),
     ("cycles used", "cycles_used", 1.0),
     ("model", "model", 1.0),
+    ("flag", "flag", 1.0),
+    ("flag reason", "flag_reason", 1.0),
 )
 
 

@@ -18,12 +18,14 @@ MODEL.md section 3. The steps:
    sign and drag from its spectral derivative); the damper's and the line's by their
    per-sample fits;
 6. a jackknife over the cycles (the average without each of at most eight contiguous
-   groups of cycles in turn) for every standard error; the energy per cycle is each
-   cycle's own loop area (the closed integral of F dx, in which the inertia term cancels);
+   groups of cycles in turn, all replicates fitted in one batched solve) for every
+   standard error; the energy per cycle is each cycle's own loop area (the closed
+   integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
-   exceeds a quarter of it, a fit residual above the noise floor, or a force-controlled
-   record without a mass (then estimated from the record, with a warning).
+   exceeds a quarter of it, a fit residual above the noise floor, a force-controlled
+   record without a mass (then estimated from the record, with a warning), or a damper
+   whose backlash reads more than twice as long on one branch as on the other.
 """
 
 from __future__ import annotations
@@ -48,7 +50,7 @@ from clearjoint.identify.cycles import (
     steady,
     steady_rule,
 )
-from clearjoint.identify.damper import _damper_fit
+from clearjoint.identify.damper import BRANCH_RATIO, _damper_fit
 from clearjoint.identify.result import QUANTITIES, CycleResult, Identification
 from clearjoint.identify.segments import (
     STAGE_COMPRESSION,
@@ -56,7 +58,9 @@ from clearjoint.identify.segments import (
     _Fit,
     _is_joint,
     _joint_fit,
+    _joint_fits,
     _line_fit,
+    _line_fits,
     _windows,
 )
 from clearjoint.identify.weak import stage_runs, weak_fit, weak_system
@@ -103,23 +107,28 @@ def restoring_force(
 def _periodic_derivatives(
     x: FloatArray, step: float, noise: float = 0.0
 ) -> tuple[FloatArray, FloatArray]:
-    """Velocity and acceleration of one periodic cycle, spectrally, harmonics above the noise.
+    """Velocity and acceleration of periodic cycles, spectrally, harmonics above the noise.
 
-    The harmonics kept are those up to the last one whose amplitude exceeds three times
-    the noise's (``noise``: the rms noise per sample of ``x``). Used only to place the
-    stages, choose the model and take the sign of the velocity; the joint's parameters
-    never use them (the weak form needs no derivative).
+    ``x`` is one cycle (M,) or one cycle per row (R, M), each row treated on its own
+    (in one batched FFT). The harmonics kept are those up to the last one whose
+    amplitude exceeds three times the noise's (``noise``: the rms noise per sample of
+    ``x``). Used only to place the stages, choose the model and take the sign of the
+    velocity; the joint's parameters never use them (the weak form needs no derivative).
     """
-    m = x.size
-    spectrum = np.fft.rfft(x)
-    k = np.arange(spectrum.size)
+    rows = np.atleast_2d(x)
+    m = rows.shape[1]
+    spectrum = np.fft.rfft(rows, axis=1)
+    k = np.arange(spectrum.shape[1])
     floor = 3.0 * noise * math.sqrt(m / 2.0)
-    above = np.nonzero(np.abs(spectrum) > floor)[0]
-    cut = int(above[-1]) if above.size else 1
-    spectrum[cut + 1 :] = 0.0
+    above = np.abs(spectrum) > floor
+    last = spectrum.shape[1] - 1 - np.argmax(above[:, ::-1], axis=1)
+    cut = np.where(above.any(axis=1), last, 1)
+    spectrum[k[None, :] > cut[:, None]] = 0.0
     w = 2.0 * math.pi * k / (m * step)
-    v = np.fft.irfft(1j * w * spectrum, n=m)
-    a = np.fft.irfft(-(w**2) * spectrum, n=m)
+    v = np.fft.irfft(1j * w * spectrum, n=m, axis=1)
+    a = np.fft.irfft(-(w**2) * spectrum, n=m, axis=1)
+    if x.ndim == 1:
+        return v[0], a[0]
     return v, a
 
 
@@ -364,31 +373,38 @@ def _identify_stack(
             )
         masses = weak.mass
         residual = float(weak.residual[0])
-    elif model == "joint":
-        assert first_fit is not None
-        fits = []
-        for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
-            vr, ar = _periodic_derivatives(xr_, st.step, noise_x)
-            if reps_a is not None:
-                ar = reps_a[i]
-            if "v" in st.channels:
-                vr = v
-            rr = fr_ - m_guess * ar if force_control else fr_
-            fits.append(_joint_fit(xr_, rr, vr, parts, windows, compete=False) or first_fit)
-        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     else:
+        # every replicate's velocity and restoring force, (G + 1, M), then the fits of all
+        # replicates in one batched solve (row by row only if that solve is singular)
+        reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
+        if reps_a is not None:
+            reps_ad = reps_a
+        if "v" in st.channels:
+            reps_v = np.broadcast_to(v, reps_x.shape)
+        reps_r = reps_f - m_guess * reps_ad if force_control else reps_f
         fits = []
-        for i, (xr_, fr_) in enumerate(zip(reps_x, reps_f, strict=True)):
-            vr, ar = _periodic_derivatives(xr_, st.step, noise_x)
-            if reps_a is not None:
-                ar = reps_a[i]
-            if "v" in st.channels:
-                vr = v
-            rr = fr_ - m_guess * ar if force_control else fr_
-            fit = _damper_fit(xr_, fr_, parts) if model == "damper" else None
-            if fit is None:
-                fit = _line_fit(xr_, rr, vr)
-            fits.append(fit)
+        if model == "joint":
+            assert first_fit is not None
+            batch = _joint_fits(reps_x, reps_r, reps_v, parts, windows)
+            if batch is None:
+                batch = [
+                    _joint_fit(xr_, rr_, vr_, parts, windows, compete=False)
+                    for xr_, rr_, vr_ in zip(reps_x, reps_r, reps_v, strict=True)
+                ]
+            fits = [fit or first_fit for fit in batch]
+        elif model == "damper":
+            for xr_, fr_, rr_, vr_ in zip(reps_x, reps_f, reps_r, reps_v, strict=True):
+                fits.append(_damper_fit(xr_, fr_, parts) or _line_fit(xr_, rr_, vr_))
+        else:
+            line_fits = _line_fits(reps_x, reps_r, reps_v)
+            fits = (
+                line_fits
+                if line_fits is not None
+                else [
+                    _line_fit(xr_, rr_, vr_)
+                    for xr_, rr_, vr_ in zip(reps_x, reps_r, reps_v, strict=True)
+                ]
+            )
         masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     values = [
         _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
@@ -447,6 +463,17 @@ def _identify_stack(
         mass_missing,
         summary["mass_kg"],
     )
+    if model == "damper":
+        b_rise, b_fall = fits[0].backlash_branches
+        low, high = min(b_rise, b_fall), max(b_rise, b_fall)
+        apart = high > BRANCH_RATIO * low  # False when a reading is missing (NaN)
+        if apart and flags["clearance_m"][0] == "ok":
+            flags["clearance_m"] = (
+                "doubtful",
+                f"backlash {b_rise * 1e3:.3g} mm on the rising branch and {b_fall * 1e3:.3g} mm "
+                f"on the falling one (more than {BRANCH_RATIO:g} times apart): not one gap "
+                "crossed both ways",
+            )
     if mass_missing:
         warnings.append(
             f"{where}: force-controlled record without a mass: the mass was estimated from the "
@@ -605,7 +632,9 @@ def identify_files(
     resample, tolerance
         As for :func:`~clearjoint.records.read_record` and :func:`identify`.
     jobs : int
-        Processes over the files; the results are those of one process, in file order.
+        Processes over the files (the first file is identified here before they start, so
+        that they inherit what it loaded); the results are those of one process, in file
+        order.
     progress : callable, optional
         ``progress(done, total)``, called after each file.
 
@@ -619,12 +648,19 @@ def identify_files(
     """
     tasks = [(str(path), resample, tolerance) for path in paths]
     outcomes: list[tuple[Record, Identification] | str] = []
-    if jobs > 1 and len(tasks) > 1:
+    if jobs > 1 and len(tasks) > 2:
         from concurrent.futures import ProcessPoolExecutor
 
+        # the first file here, before the workers fork: they inherit what it loaded (the
+        # file format's reader, e.g. h5py, imported on first use, and warm caches) instead
+        # of each loading it again
+        outcomes.append(_identify_path(tasks[0]))
+        if progress:
+            progress(1, len(tasks))
+        rest = tasks[1:]
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            chunk = max(1, len(tasks) // (4 * jobs))
-            for k, outcome in enumerate(pool.map(_identify_path, tasks, chunksize=chunk), 1):
+            chunk = max(1, len(rest) // (4 * jobs))
+            for k, outcome in enumerate(pool.map(_identify_path, rest, chunksize=chunk), 2):
                 outcomes.append(outcome)
                 if progress:
                     progress(k, len(tasks))

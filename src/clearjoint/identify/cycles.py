@@ -50,14 +50,29 @@ class IdentificationError(ClearjointError, ValueError):
     """A record could not be identified; the message says why in one line."""
 
 
+def _smooth_length(n: int) -> int:
+    """The smallest even 2^a 3^b 5^c >= n (a length the FFT factors into small primes)."""
+    best = 2 * n
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            p = p35 * 2  # even: rfft of an even length
+            while p < n:
+                p *= 2
+            best = min(best, p)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
 def excitation_frequency(record: Record) -> float:
     """Return the excitation frequency in Hz: the displacement spectrum's peak, interpolated."""
-    from scipy.fft import next_fast_len, rfft
-
     x = record.displacement - record.displacement.mean()
     n = x.size
-    padded = next_fast_len(4 * n, real=True)  # a length the FFT factors fast
-    spectrum = np.abs(rfft(x * np.hanning(n), n=padded))
+    padded = _smooth_length(4 * n)  # a length the FFT factors fast
+    # numpy's FFT (pocketfft): importing scipy.fft cost more than all the fits of a record
+    spectrum = np.abs(np.fft.rfft(x * np.hanning(n), n=padded))
     spectrum[0] = 0.0
     k = float(np.argmax(spectrum))
     i = int(k)

@@ -13,6 +13,12 @@ where the force first reaches L_prev + alpha (L_new - L_prev). On the elastic pi
 as alpha (L_new - L_prev) / k; across the backlash it jumps by b. So k is the slope of the
 median step (the jump spans one or two of the sixteen), and b is what the steps longer than
 two elastic steps hold beyond one elastic step each.
+
+One gap is crossed both ways, so both branches must show the same backlash: the reading
+of each branch is kept (``_Fit.backlash_branches``), and a loop whose two readings differ
+by more than :data:`BRANCH_RATIO` is flagged (:mod:`clearjoint.identify.core`): its
+backlash is not one gap's (ringing read as gap, or a loop that does not come back to a
+backlash level on one branch).
 """
 
 from __future__ import annotations
@@ -32,6 +38,8 @@ PLATEAU = 0.4
 JUMP = 1.0
 #: A plateau may change by at most this fraction of the level change over its travel.
 FLATNESS = 0.35
+#: The two branches' backlash readings may differ by at most this factor (else: doubtful).
+BRANCH_RATIO = 2.0
 
 
 def _crossings(travel: FloatArray, f: FloatArray, start: float, stop: float) -> FloatArray | None:
@@ -114,4 +122,5 @@ def _damper_fit(x: FloatArray, f: FloatArray, parts: tuple[slice, slice]) -> _Fi
         0.5 * abs(delta),
         level_positive=max(rise, fall),
         level_negative=min(rise, fall),
+        backlash_branches=(b_rise, b_fall),
     )

@@ -160,6 +160,8 @@ class _Fit:
     lines: tuple[tuple[float, float], ...] = ()
     level_positive: float = math.nan
     level_negative: float = math.nan
+    #: the damper's backlash read on the rising and on the falling branch
+    backlash_branches: tuple[float, float] = (math.nan, math.nan)
 
 
 def _joint_fit(
@@ -213,6 +215,104 @@ def _joint_fit(
     lower = (a_f - a_t) / (k_t - k_f)
     lines = ((a_t, k_t), (a_f, k_f), (a_c, k_c))
     return _Fit(upper, lower, k_c, k_t, max(k_f, 0.0), abs(friction), lines)
+
+
+def _solve_batch(
+    design: FloatArray, y: FloatArray, mask: FloatArray, iterations: int = 2
+) -> FloatArray | None:
+    """:func:`_solve` for R problems at once: design (R, N, P), y (R, N), mask (R, N) of 0/1
+    (the rows each problem has); the coefficients (R, P), or None when a system is singular.
+
+    The same robust least squares (Tukey's biweight, the same scale and iterations) as
+    :func:`_solve` on each problem's own rows; rows outside a problem's mask weigh nothing.
+    """
+    count = mask.sum(axis=1)
+
+    def weighted(weight: FloatArray) -> FloatArray:
+        wd = design * weight[:, :, None]
+        gram = wd.transpose(0, 2, 1) @ design
+        rhs = (wd.transpose(0, 2, 1) @ y[:, :, None])[:, :, 0]
+        solved = np.linalg.solve(gram, rhs[:, :, None])[:, :, 0]
+        return np.asarray(solved, dtype=np.float64)
+
+    try:
+        coef = weighted(mask)
+        for _ in range(iterations):
+            residual = y - (design @ coef[:, :, None])[:, :, 0]
+            centre = (residual * mask).sum(axis=1) / count
+            spread = (np.abs(residual - centre[:, None]) * mask).sum(axis=1) / count
+            scale = 1.2533 * spread + 1e-300
+            u = residual / (4.685 * scale[:, None])
+            weight: FloatArray = np.where(np.abs(u) < 1.0, (1.0 - u * u) ** 2, 0.0) * mask
+            coef = weighted(weight)
+    except np.linalg.LinAlgError:
+        return None
+    return coef
+
+
+def _joint_fits(
+    x: FloatArray,
+    f: FloatArray,
+    v: FloatArray,
+    parts: tuple[slice, slice],
+    windows: tuple[list[Window], list[Window]],
+) -> list[_Fit | None] | None:
+    """:func:`_joint_fit` (``compete=False``) on every row of x, f, v (R, M) in one batched
+    solve: each row's own samples in each stage window, as there. None when the batch
+    cannot be solved at once (a singular system: then fit the rows one by one)."""
+    if not (_is_joint(windows[0]) and _is_joint(windows[1])):
+        return [None] * x.shape[0]
+    if any(w[0][2] >= w[1][1] or w[1][2] >= w[2][1] for w in windows):
+        return None  # overlapping windows: a sample in two stages, as the row-by-row fit has
+    blocks_x, blocks_v, blocks_f, labels = [], [], [], []
+    for part, branch in zip(parts, windows, strict=True):
+        xb = x[:, part]
+        label = np.zeros(xb.shape, dtype=np.int64)  # 0: in no stage's window
+        for code, (_, low, high) in enumerate(branch, start=1):  # tension, free, compression
+            label[(xb >= low) & (xb <= high)] = code
+        blocks_x.append(xb)
+        blocks_f.append(f[:, part])
+        blocks_v.append(v[:, part])
+        labels.append(label)
+    xs, fs, vs = np.hstack(blocks_x), np.hstack(blocks_f), np.hstack(blocks_v)
+    stage = np.hstack(labels)
+    mask = (stage > 0).astype(float)
+    columns = []
+    for code in (1, 2, 3):
+        in_stage = (stage == code).astype(float)
+        columns += [in_stage, in_stage * xs]
+    design = np.stack((*columns, vs * mask, np.sign(vs) * mask), axis=2)
+    coef = _solve_batch(design, fs * mask, mask)
+    if coef is None:
+        return None
+    out: list[_Fit | None] = []
+    for row, n_rows in zip(coef, mask.sum(axis=1), strict=True):
+        a_t, k_t, a_f, k_f, a_c, k_c, _, friction = (float(c) for c in row)
+        if n_rows <= design.shape[2] + 2 or not (k_c > k_f and k_t > k_f):
+            out.append(None)
+            continue
+        lines = ((a_t, k_t), (a_f, k_f), (a_c, k_c))
+        out.append(
+            _Fit(
+                (a_f - a_c) / (k_c - k_f),
+                (a_f - a_t) / (k_t - k_f),
+                k_c,
+                k_t,
+                max(k_f, 0.0),
+                abs(friction),
+                lines,
+            )
+        )
+    return out
+
+
+def _line_fits(x: FloatArray, f: FloatArray, v: FloatArray) -> list[_Fit] | None:
+    """:func:`_line_fit` on every row of x, f, v (R, M) in one batched solve (None: singular)."""
+    design = np.stack((np.ones_like(x), x * (x > 0), x * (x <= 0), v, np.sign(v)), axis=2)
+    coef = _solve_batch(design, f, np.ones_like(x))
+    if coef is None:
+        return None
+    return [_Fit(0.0, 0.0, float(c[1]), float(c[2]), 0.0, abs(float(c[4]))) for c in coef]
 
 
 def _line_fit(x: FloatArray, f: FloatArray, v: FloatArray) -> _Fit:
