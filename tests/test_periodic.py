@@ -322,6 +322,43 @@ def test_study_curve_crosses_the_grazing_with_impacts_near_69_hz() -> None:
         assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
 
 
+def test_study_curve_turns_back_where_sticking_begins_near_74_hz() -> None:
+    # examples/study.toml: the unstable branch coming down from the fold near 76.9 Hz meets,
+    # at 74.2232 Hz, an orbit whose velocity zero in the free play becomes tangent: past it
+    # the mass sticks for a moment. The map stays continuous but its Jacobian jumps (a
+    # corner), the no-stick branch ends there, and a stable sticking branch leaves it back
+    # up in frequency (a nonsmooth fold). The curve used to stop at this point.
+    joint, kw = _study_losses()
+    force = float(kw.pop("force"))  # type: ignore[arg-type]
+    hz = 2.0 * math.pi
+    curve = frequency_response(joint, force, 72.0 * hz, 78.0 * hz, **kw)  # type: ignore[arg-type]
+    assert curve.stop_reason == "reached"
+    corner = [e for e in curve.events if "sticking begins" in e.note and "turns back" in e.note]
+    assert len(corner) == 1
+    assert corner[0].omega / hz == pytest.approx(74.2232, abs=2e-3)
+    assert any(e.kind == "fold" and abs(e.omega - corner[0].omega) < 1e-3 for e in curve.events)
+    # two orbits just above the corner, one on each piece: unstable without sticking, stable
+    # with it, each the orbit of the exact map there (the fold has two sides)
+    near = np.nonzero(np.abs(curve.omega / hz - 74.5) < 0.2)[0]
+    pieces = {bool(curve.stable[i]): int(i) for i in near}
+    assert set(pieces) == {True, False}
+    unstable, stable = curve.cycle(pieces[False]), curve.cycle(pieces[True])
+    assert unstable.stick_time == 0.0
+    assert stable.stick_time > 0.0
+    # the stable sticking orbits past the corner, by time marching from off the orbit
+    past = np.nonzero(curve.stable & (curve.omega > 74.3 * hz))[0]
+    past = past[np.argsort(curve.omega[past])]
+    assert past.size > 5
+    for i in past[:: max(1, past.size // 3)]:
+        start = curve.initial_state[i] * (1.0 + 1e-6)
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        assert ss.period_multiple == 1
+        assert ss.stick_time > 0.0
+        scale = curve.amplitude[i]
+        assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
+        assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
+
+
 def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
     # e = 0.8: the impacts make the map square-root singular where the orbit first touches
     # the edges (omega ~ 0.913) and where the unstable branch meets the lower one (~1.0785)

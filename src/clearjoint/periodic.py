@@ -612,8 +612,27 @@ def frequency_response(
     mu = np.take_along_axis(mu, np.argsort(-np.abs(mu), axis=1), axis=1)
     stable = np.max(np.abs(mu), axis=1) < 1.0
     amplitude = 0.5 * (x_max - x_min)
+    sticking = []
+    for k in branch.kinks:
+        stuck = []
+        for i in (int(k) - 1, int(k)):
+            q = p.copy()
+            _set_parameter(q, code, float(branch.lam[i]))
+            state = np.zeros(4)
+            start_state(q, float(branch.u[i, 0]), float(branch.u[i, 1]), state)
+            stuck.append(_orbit_from(q, joint, state, 1, 0, None, 0.0, 8).stick_time > 0.0)
+        sticking.append(stuck[0] != stuck[1])
     events = _events(
-        joint, branch.tangent[:, -1], mono, x_max, x_min, omega, force, amplitude, branch.kinks
+        joint,
+        branch.tangent[:, -1],
+        mono,
+        x_max,
+        x_min,
+        omega,
+        force,
+        amplitude,
+        branch.kinks,
+        np.array(sticking, dtype=bool),
     )
     return FrequencyResponse(
         omega=omega,
@@ -646,6 +665,7 @@ def _events(
     force: FloatArray,
     amplitude: FloatArray,
     kinks: NDArray[np.int64] | None = None,
+    sticking: NDArray[np.bool_] | None = None,
 ) -> list[ResponseEvent]:
     """Folds, period doublings and grazings between successive points, located linearly.
 
@@ -653,6 +673,8 @@ def _events(
     the point after it) is a grazing too: where no edge crossing of x_max or x_min
     explains it, the orbit grazed an edge from inside contact (a short stage
     appears or vanishes) or began to stick; it is placed at the last point before.
+    ``sticking`` (one per kink) says where the orbits on the two sides differ in
+    whether they stick: a corner at a sticking onset, named so in the note.
     """
     trace = mono[:, 0, 0] + mono[:, 1, 1]
     det = mono[:, 0, 0] * mono[:, 1, 1] - mono[:, 0, 1] * mono[:, 1, 0]
@@ -681,13 +703,22 @@ def _events(
                 return float(a[i] + frac * (a[i + 1] - a[i]))
 
             events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), note)))
-    for k in kinks if kinks is not None else []:
+    for n, k in enumerate(kinks if kinks is not None else []):
         before = int(k) - 1
         if not any(index == before and e.kind == "grazing" for index, e in events):
-            note = (
-                "a kink crossed by a parameter step: a stage appears or vanishes (the orbit "
-                "grazes a gap edge from inside contact) or sticking begins"
-            )
+            if sticking is not None and sticking[n]:
+                note = (
+                    "a corner of the branch where sticking begins or ends (a velocity zero "
+                    "of the orbit becomes tangent): the map is continuous, its Jacobian jumps"
+                )
+            else:
+                note = (
+                    "a kink crossed by a parameter step: a stage appears or vanishes (the orbit "
+                    "grazes a gap edge from inside contact) or sticking begins"
+                )
+            lam = omega if np.ptp(omega) > 0.0 else force
+            if before >= 1 and (lam[before] - lam[before - 1]) * (lam[k] - lam[before]) < 0.0:
+                note += "; the branch turns back here (a nonsmooth fold)"
             where = (float(omega[before]), float(force[before]), float(amplitude[before]))
             events.append((before, ResponseEvent("grazing", *where, note)))
     events.sort(key=lambda item: item[0])
