@@ -438,7 +438,7 @@ def _behind(
 ) -> bool:
     """``y_new`` lies on the branch's earlier path, travelled the other way.
 
-    On a chord between two earlier points (not among the last ten) to 1e-3 of
+    On a chord between two earlier points (not among the last ten) to 1e-2 of
     its length, on the same smooth piece, with a tangent turned by more than 155
     degrees from theirs: the branch runs back along itself (a kink crossing went
     back onto a piece it had followed). Near a fold the two halves of a branch
@@ -452,7 +452,7 @@ def _behind(
     offsets = y_new - path[:-1]
     where = np.clip(np.einsum("ij,ij->i", offsets, chords) / np.maximum(lengths, 1e-300), 0, 1)
     miss = np.linalg.norm(offsets - where[:, None] * chords, axis=1)
-    near = np.nonzero(miss <= 1e-3 * np.sqrt(lengths) + 1e-12)[0]
+    near = np.nonzero(miss <= 1e-2 * np.sqrt(lengths) + 1e-12)[0]
     return any(
         float(t_new @ ts[int(j)]) < -0.9 and not differs(datas[int(j)], data_new) for j in near
     )
