@@ -385,3 +385,33 @@ def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
         scale = curve.amplitude[i]
         assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
         assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
+
+
+def test_compiled_corrector_matches_the_generic_one() -> None:
+    # the continuation hands its Newton loop to periodic's compiled corrector: on the same
+    # prediction it must land where continuation's own Python loop lands
+    from clearjoint.continuation import ContinuationSettings, _correct
+    from clearjoint.periodic import _map_residual
+    from clearjoint.simulate.core import _parameters
+
+    orbit = periodic_orbit(PYHARM, F0, 1.3, damping_ratio=ZETA)
+    p = _parameters(PYHARM, F0, 1.3, ZETA, None, 1.0)
+    residual = _map_residual(p, "omega")
+    scale = np.array([0.2, 0.26, 1.75])
+    y0 = np.array([*orbit.initial_state, 1.3]) / scale + np.array([1e-3, -2e-3, 4e-3])
+    tangent = np.array([0.3, -0.2, 0.9])
+    tangent /= np.linalg.norm(tangent)
+    settings = ContinuationSettings(chord_parameter=True)
+
+    def generic(u: np.ndarray, lam: float, derivative: bool = True) -> object:
+        return residual(u, lam, derivative)
+
+    for fixed in (False, True):
+        fast = residual.corrector(y0, tangent, scale, settings, fixed)
+        slow = _correct(generic, y0, tangent, scale, settings, fixed)  # type: ignore[arg-type]
+        assert fast is not None
+        assert slow is not None
+        assert fast[3] == slow[3]
+        assert np.allclose(fast[0], slow[0], rtol=0.0, atol=1e-12)
+        assert np.allclose(fast[1], slow[1], rtol=1e-9, atol=1e-12)
+        assert np.allclose(fast[2][:2], 0.0, atol=1e-11 * 0.2)

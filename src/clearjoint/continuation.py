@@ -168,17 +168,64 @@ def _solve(a: FloatArray, b: FloatArray) -> FloatArray:
     return x
 
 
+@njit(cache=True)
+def _gauss(m: FloatArray) -> bool:
+    """Solve the square system held in ``m`` = [A | b] in place (partial pivoting).
+
+    On success the last column holds x; False when a pivot is zero or not finite.
+    """
+    n = m.shape[0]
+    for col in range(n):
+        pivot = col
+        for row in range(col + 1, n):
+            if abs(m[row, col]) > abs(m[pivot, col]):
+                pivot = row
+        if m[pivot, col] == 0.0 or not np.isfinite(m[pivot, col]):
+            return False
+        if pivot != col:
+            for j in range(n + 1):
+                m[col, j], m[pivot, j] = m[pivot, j], m[col, j]
+        for row in range(col + 1, n):
+            f = m[row, col] / m[col, col]
+            for j in range(col, n + 1):
+                m[row, j] -= f * m[col, j]
+    for i in range(n - 1, -1, -1):
+        s = m[i, n]
+        for j in range(i + 1, n):
+            s -= m[i, j] * m[j, n]
+        m[i, n] = s / m[i, i]
+    return True
+
+
+@njit(cache=True)
+def _tangent_solve(a: FloatArray, previous: FloatArray, t: FloatArray) -> bool:
+    """t <- the solution of [a; previous] t = e_last, normalised; False if singular."""
+    d = a.shape[0]
+    m = np.zeros((d + 1, d + 2))
+    m[:d, : d + 1] = a
+    m[d, : d + 1] = previous
+    m[d, d + 1] = 1.0
+    if not _gauss(m):
+        return False
+    norm = 0.0
+    for i in range(d + 1):
+        t[i] = m[i, d + 1]
+        norm += t[i] * t[i]
+    norm = math.sqrt(norm)
+    if not (norm > 0.0 and math.isfinite(norm)):
+        return False
+    for i in range(d + 1):
+        t[i] /= norm
+    return True
+
+
 def _tangent(a: FloatArray, previous: FloatArray) -> FloatArray:
     """Unit null vector of the (d, d+1) matrix ``a``, oriented along ``previous``."""
-    system = np.vstack((a, previous))
-    rhs = np.zeros(a.shape[1])
-    rhs[-1] = 1.0
-    try:
-        t = np.linalg.solve(system, rhs)
-    except np.linalg.LinAlgError:
+    t = np.empty(a.shape[1])
+    if not _tangent_solve(np.ascontiguousarray(a, dtype=np.float64), previous, t):
         _, _, vt = np.linalg.svd(a)
-        t = vt[-1]
-    unit: FloatArray = np.asarray(t / np.linalg.norm(t), dtype=np.float64)
+        t = vt[-1] / np.linalg.norm(vt[-1])
+    unit: FloatArray = np.asarray(t, dtype=np.float64)
     return unit if float(unit @ previous) >= 0.0 else np.asarray(-unit, dtype=np.float64)
 
 
@@ -190,7 +237,18 @@ def _correct(
     settings: ContinuationSettings,
     fixed_lambda: bool,
 ) -> tuple[FloatArray, FloatArray, Any, int] | None:
-    """Newton on [R(y); t . (y - y0)] = 0 (or on R at fixed lambda); None if it fails."""
+    """Newton on [R(y); t . (y - y0)] = 0 (or on R at fixed lambda); None if it fails.
+
+    A residual that carries a ``corrector(y0, tangent, scale, settings, fixed_lambda)``
+    method doing this same correction (compiled, say) is handed the work when
+    ``settings.chord_parameter`` is set.
+    """
+    fast = getattr(residual, "corrector", None)
+    if fast is not None and settings.chord_parameter:
+        result: tuple[FloatArray, FloatArray, Any, int] | None = fast(
+            y0, tangent, scale, settings, fixed_lambda
+        )
+        return result
     y = y0.copy()
     d = y.size - 1
     u_scale = scale[:d]

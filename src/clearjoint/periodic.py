@@ -45,6 +45,7 @@ from clearjoint.simulate._shooting import (
     R_XMIN,
     Shot,
     _set_parameter,
+    correct_orbit,
     map_residual,
     newton_orbit,
     start_state,
@@ -432,22 +433,63 @@ class FrequencyResponse:
         return ds
 
 
-def _map_residual(p: FloatArray, parameter: str) -> Any:
-    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
-    code = 0 if parameter == "omega" else 1
+class _MapResidual:
+    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``.
 
-    def residual(
-        u: FloatArray, lam: float, derivative: bool = True
+    Called as ``residual(u, lam, derivative=True)`` it returns what
+    ``continuation.Residual`` asks for; its ``corrector`` runs the whole
+    arclength Newton correction compiled (``_shooting.correct_orbit``), which
+    ``continuation`` uses in place of its own loop when it finds one.
+    """
+
+    def __init__(self, p: FloatArray, parameter: str) -> None:
+        self.p = p
+        self.code = 0 if parameter == "omega" else 1
+
+    def __call__(
+        self, u: FloatArray, lam: float, derivative: bool = True
     ) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
         if not lam > 0.0:
             raise SimulationError(f"the parameter left the positive range ({lam!r})")
         out = np.zeros(N_RES)
-        status = map_residual(p, code, float(u[0]), float(u[1]), lam, out, derivative)
+        status = map_residual(self.p, self.code, float(u[0]), float(u[1]), lam, out, derivative)
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
         return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
 
-    return residual
+    def corrector(
+        self,
+        y0: FloatArray,
+        tangent: FloatArray,
+        scale: FloatArray,
+        settings: ContinuationSettings,
+        fixed_lambda: bool,
+    ) -> tuple[FloatArray, FloatArray, Any, int] | None:
+        """``continuation._correct`` for this residual, compiled: (y, [R_u, R_lam], data, its)."""
+        y = np.empty(3)
+        system = np.empty((3, 3))
+        out = np.zeros(N_RES)
+        its = correct_orbit(
+            self.p,
+            self.code,
+            y0,
+            tangent,
+            scale,
+            fixed_lambda,
+            settings.tolerance,
+            settings.max_iterations,
+            y,
+            system,
+            out,
+        )
+        if its < 0:
+            return None
+        return y, system[:2].copy(), out, int(its)
+
+
+def _map_residual(p: FloatArray, parameter: str) -> _MapResidual:
+    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
+    return _MapResidual(p, parameter)
 
 
 def _parameter_range(

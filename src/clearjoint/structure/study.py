@@ -282,7 +282,7 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
         if not (math.isfinite(ex["frequency"]) and ex["frequency"] > 0.0):
             raise StructureStudyError(
                 f"{where}: [excitation] frequency must be finite and > 0, got "
-                f"{ex['frequency']:g} Hz; e.g. frequency = \"15Hz\""
+                f'{ex["frequency"]:g} Hz; e.g. frequency = "15Hz"'
             )
         if ex.get("periods", 20) < 1:
             raise StructureStudyError(
