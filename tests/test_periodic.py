@@ -415,3 +415,30 @@ def test_compiled_corrector_matches_the_generic_one() -> None:
         assert np.allclose(fast[0], slow[0], rtol=0.0, atol=1e-12)
         assert np.allclose(fast[1], slow[1], rtol=1e-9, atol=1e-12)
         assert np.allclose(fast[2][:2], 0.0, atol=1e-11 * 0.2)
+
+
+def test_branch_switching_at_each_period_doubling_finds_the_period_2_orbit() -> None:
+    fr = frequency_response(ONE_SIDED, 1.0, 1.8, 3.8, damping_ratio=0.05)
+    doublings = [e for e in fr.events if e.kind == "period_doubling"]
+    assert len(doublings) == 2
+    for event in doublings:
+        orbit = fr.period_2_orbit(event)
+        assert orbit.period_multiple == 2
+        omega = orbit.omega
+        assert abs(omega - event.omega) < 0.1
+        period = 2 * math.pi / omega
+        z = np.array(orbit.initial_state)
+        scale = np.array([orbit.amplitude, orbit.amplitude * omega])
+        # by time marching (no Newton): back after two forcing periods, not after one
+        one = time_response(ONE_SIDED, 1.0, omega, period, initial=z, damping_ratio=0.05)
+        two = time_response(ONE_SIDED, 1.0, omega, 2 * period, initial=z, damping_ratio=0.05)
+        assert np.max(np.abs(np.array(two.final_state) - z) / scale) < 1e-9
+        assert np.max(np.abs(np.array(one.final_state) - z) / scale) > 1e-3
+        if orbit.stable:  # and steady_state from off the orbit settles on it
+            ss = steady_state(ONE_SIDED, 1.0, omega, damping_ratio=0.05, initial=z * (1.0 + 1e-6))
+            assert ss.period_multiple == 2
+            assert abs(ss.x_max - orbit.x_max) / orbit.amplitude < 1e-9
+            assert abs(ss.x_min - orbit.x_min) / orbit.amplitude < 1e-9
+    assert any(fr.period_2_orbit(e).stable for e in doublings)
+    with pytest.raises(ParameterError, match="period_doubling"):
+        fr.period_2_orbit(next(e for e in fr.events if e.kind != "period_doubling"))

@@ -48,6 +48,7 @@ from clearjoint.simulate._shooting import (
     correct_orbit,
     map_residual,
     newton_orbit,
+    shoot,
     start_state,
 )
 from clearjoint.simulate.core import (
@@ -327,6 +328,92 @@ class FrequencyResponse:
             p, float(self.initial_state[index, 0]), float(self.initial_state[index, 1]), state
         )
         return _orbit_from(p, s["joint"], state, 1, 0, None, 0.0, 64)
+
+    def period_2_orbit(self, event: ResponseEvent) -> PeriodicOrbit:
+        """Switch branches at a period doubling: the period-2 orbit born there (MODEL.md sec. 5.1).
+
+        At a period doubling a Floquet multiplier of the period-1 orbit passes -1 and a
+        period-2 orbit branches off along its eigenvector w. From the curve's points
+        around the event (a multiplier below -0.5), nearest first, on either side, Newton
+        on the two-period map P_2 starts at z* +- eps w (eps from 1e-3 to 0.3 of the
+        orbit's size); the first fixed point of P_2 that is not the period-1 orbit z*
+        (further than 1e-6 of its size) is returned.
+
+        Parameters
+        ----------
+        event : ResponseEvent
+            One of ``events`` with ``kind == "period_doubling"``.
+
+        Returns
+        -------
+        PeriodicOrbit
+            ``period_multiple == 2``, at the frequency (or force) of the curve point it
+            branched from.
+
+        Raises
+        ------
+        ParameterError
+            The event is not a period doubling, or the curve is not from shooting.
+        SimulationError
+            No period-2 orbit was found near the event.
+        """
+        if self.method != "shooting" or event.kind != "period_doubling":
+            raise ParameterError(
+                "period_2_orbit takes a 'period_doubling' event of a shooting curve, got "
+                f"{event.kind!r} of a {self.method!r} curve"
+            )
+        s = self.settings
+        lam = self.omega if self.parameter == "omega" else self.force_amplitude
+        at = event.omega if self.parameter == "omega" else event.force_amplitude
+        # both sides: past a supercritical doubling the period-2 orbit lies where the
+        # period-1 orbit is unstable, past a subcritical one where it is stable
+        beyond = np.nonzero(self.multipliers.real.min(axis=1) < -0.5)[0]
+        beyond = beyond[np.argsort(np.abs(lam[beyond] - at))][:16]
+        for i in beyond:
+            kw = {
+                "damping_ratio": s["damping_ratio"],
+                "friction": s["friction"],
+                "restitution": s["restitution"],
+            }
+            w, f = float(self.omega[i]), float(self.force_amplitude[i])
+            z = self.initial_state[i]
+            mono = self._monodromy(int(i))
+            mu, vectors = np.linalg.eig(mono)
+            direction = np.real(vectors[:, int(np.argmin(mu.real))])
+            size = np.array([max(self.amplitude[i], 1e-300), max(self.amplitude[i], 1e-300) * w])
+            direction = direction / np.max(np.abs(direction) / size)
+            for eps in (1e-3, 1e-2, 3e-2, 1e-1, 3e-1):
+                for sign in (1.0, -1.0):
+                    try:
+                        orbit = periodic_orbit(
+                            s["joint"],
+                            f,
+                            w,
+                            period_multiple=2,
+                            initial=z + sign * eps * direction,
+                            **kw,
+                        )
+                    except SimulationError:
+                        continue
+                    if np.max(np.abs(np.array(orbit.initial_state) - z) / size) > 1e-6:
+                        return orbit
+        raise SimulationError(
+            f"no period-2 orbit found near the period doubling at {event!r}; try "
+            "periodic_orbit(..., period_multiple=2, initial=...) from a steady_state"
+        )
+
+    def _monodromy(self, index: int) -> FloatArray:
+        """The monodromy matrix of the period-1 orbit at point ``index`` (re-run exactly)."""
+        s = self.settings
+        p = _parameters(
+            s["joint"],
+            float(self.force_amplitude[index]),
+            float(self.omega[index]),
+            s["damping_ratio"],
+            s["friction"],
+            s["restitution"],
+        )
+        return shoot(p, self.initial_state[index], 1).monodromy
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.
