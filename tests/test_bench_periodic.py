@@ -52,3 +52,32 @@ def test_stiff_impacting_case_agrees_with_time_response(bench: ModuleType) -> No
     assert motion.impact_times.size > 3  # it does hit the edges, with the restitution jump
     assert abs(motion.final_state[0] - x) / 0.1 < 1e-9
     assert abs(motion.final_state[1] - v) / abs(v) < 1e-7
+
+
+def test_longdouble_reference_is_the_closed_form_in_the_gap_resonant_or_not(
+    bench: ModuleType,
+) -> None:
+    # x'' + x = f0 sin(w t) from rest: f0 / (1 - w^2) (sin w t - w sin t); at w = 1 the
+    # resonant f0 / 2 (sin t - t cos t)
+    f0, t = 0.002, 20.0
+    x, v, impacts = bench.closed_form_reference(STIFF, f0, 0.5, t, 0.8)
+    amp = f0 / (1.0 - 0.25)
+    assert impacts == 0
+    assert x == pytest.approx(amp * (math.sin(0.5 * t) - 0.5 * math.sin(t)), abs=1e-16)
+    assert v == pytest.approx(amp * 0.5 * (math.cos(0.5 * t) - math.cos(t)), abs=1e-16)
+    x, v, impacts = bench.closed_form_reference(STIFF, f0, 1.0, t, 0.8)
+    assert impacts == 0
+    assert x == pytest.approx(0.5 * f0 * (math.sin(t) - t * math.cos(t)), abs=1e-16)
+    assert v == pytest.approx(0.5 * f0 * t * math.sin(t), abs=1e-16)
+
+
+def test_longdouble_reference_with_impacts_agrees_with_both_solvers(bench: ModuleType) -> None:
+    duration = 2.0 * math.pi
+    x, v, impacts = bench.closed_form_reference(STIFF, 1.0, 1.0, duration, 0.8)
+    assert impacts == 7
+    ivp = bench.per_state_reference(STIFF, 1.0, 1.0, duration, 0.8, rtol=1e-12)
+    exact = time_response(STIFF, 1.0, 1.0, duration, restitution=0.8)
+    assert abs(ivp[0] - x) < 1e-9
+    assert abs(ivp[1] - v) < 1e-9
+    assert abs(exact.final_state[0] - x) < 1e-12
+    assert abs(exact.final_state[1] - v) < 1e-12

@@ -61,3 +61,55 @@ def test_no_solution_at_the_start_is_an_error() -> None:
 def test_settings_are_validated() -> None:
     with pytest.raises(ParameterError, match="min_step <= step <= max_step"):
         ContinuationSettings(step=1.0, max_step=0.1)
+
+
+def _corner(u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """|u| - lambda = 0: two pieces u = -lambda and u = +lambda meet in a corner at 0."""
+    return (
+        np.array([abs(u[0]) - lam]),
+        np.array([[math.copysign(1.0, u[0])]]),
+        np.array([-1.0]),
+        u[0],
+    )
+
+
+def _sides(a: float, b: float) -> bool:
+    return (a > 0.0) != (b > 0.0)
+
+
+def test_turns_back_at_a_corner_onto_the_other_piece() -> None:
+    # a nonsmooth fold: the residual is continuous, its Jacobian jumps at u = 0; the branch
+    # coming down u = -lambda must go on up u = +lambda (no solution exists for lambda < 0)
+    settings = ContinuationSettings(step=0.01, max_step=0.05, max_points=80)
+    branch = continue_branch(
+        _corner,
+        np.array([-0.5]),
+        0.5,
+        -0.5,
+        u_scale=np.ones(1),
+        lam_scale=1.0,
+        settings=settings,
+        differs=_sides,
+    )
+    u, lam = branch.u[:, 0], branch.lam
+    assert np.max(np.abs(np.abs(u) - lam)) < 1e-10
+    assert branch.kinks.size == 1
+    k = int(branch.kinks[0])
+    assert np.all(u[:k] < 0.0)
+    assert np.all(u[k:] > 0.0)
+    assert lam[k - 1] < 1e-5  # it came down to the corner before turning
+    assert np.all(np.diff(lam[:k]) < 0.0)
+    assert np.all(np.diff(lam[k:]) > 0.0)
+    assert lam[-1] > 0.4
+    # the parameter-jump crossing alone cannot find the piece that turns back
+    stuck = continue_branch(
+        _corner,
+        np.array([-0.5]),
+        0.5,
+        -0.5,
+        u_scale=np.ones(1),
+        lam_scale=1.0,
+        settings=settings,
+    )
+    assert stuck.reason.startswith("step too small")
+    assert np.all(stuck.u < 0.0)

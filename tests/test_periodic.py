@@ -322,6 +322,43 @@ def test_study_curve_crosses_the_grazing_with_impacts_near_69_hz() -> None:
         assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
 
 
+def test_study_curve_turns_back_where_sticking_begins_near_74_hz() -> None:
+    # examples/study.toml: the unstable branch coming down from the fold near 76.9 Hz meets,
+    # at 74.2232 Hz, an orbit whose velocity zero in the free play becomes tangent: past it
+    # the mass sticks for a moment. The map stays continuous but its Jacobian jumps (a
+    # corner), the no-stick branch ends there, and a stable sticking branch leaves it back
+    # up in frequency (a nonsmooth fold). The curve used to stop at this point.
+    joint, kw = _study_losses()
+    force = float(kw.pop("force"))  # type: ignore[arg-type]
+    hz = 2.0 * math.pi
+    curve = frequency_response(joint, force, 72.0 * hz, 78.0 * hz, **kw)  # type: ignore[arg-type]
+    assert curve.stop_reason == "reached"
+    corner = [e for e in curve.events if "sticking begins" in e.note and "turns back" in e.note]
+    assert len(corner) == 1
+    assert corner[0].omega / hz == pytest.approx(74.2232, abs=2e-3)
+    assert any(e.kind == "fold" and abs(e.omega - corner[0].omega) < 1e-3 for e in curve.events)
+    # two orbits just above the corner, one on each piece: unstable without sticking, stable
+    # with it, each the orbit of the exact map there (the fold has two sides)
+    near = np.nonzero(np.abs(curve.omega / hz - 74.5) < 0.2)[0]
+    pieces = {bool(curve.stable[i]): int(i) for i in near}
+    assert set(pieces) == {True, False}
+    unstable, stable = curve.cycle(pieces[False]), curve.cycle(pieces[True])
+    assert unstable.stick_time == 0.0
+    assert stable.stick_time > 0.0
+    # the stable sticking orbits past the corner, by time marching from off the orbit
+    past = np.nonzero(curve.stable & (curve.omega > 74.3 * hz))[0]
+    past = past[np.argsort(curve.omega[past])]
+    assert past.size > 5
+    for i in past[:: max(1, past.size // 3)]:
+        start = curve.initial_state[i] * (1.0 + 1e-6)
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        assert ss.period_multiple == 1
+        assert ss.stick_time > 0.0
+        scale = curve.amplitude[i]
+        assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
+        assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
+
+
 def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
     # e = 0.8: the impacts make the map square-root singular where the orbit first touches
     # the edges (omega ~ 0.913) and where the unstable branch meets the lower one (~1.0785)
@@ -348,3 +385,60 @@ def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
         scale = curve.amplitude[i]
         assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
         assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
+
+
+def test_compiled_corrector_matches_the_generic_one() -> None:
+    # the continuation hands its Newton loop to periodic's compiled corrector: on the same
+    # prediction it must land where continuation's own Python loop lands
+    from clearjoint.continuation import ContinuationSettings, _correct
+    from clearjoint.periodic import _map_residual
+    from clearjoint.simulate.core import _parameters
+
+    orbit = periodic_orbit(PYHARM, F0, 1.3, damping_ratio=ZETA)
+    p = _parameters(PYHARM, F0, 1.3, ZETA, None, 1.0)
+    residual = _map_residual(p, "omega")
+    scale = np.array([0.2, 0.26, 1.75])
+    y0 = np.array([*orbit.initial_state, 1.3]) / scale + np.array([1e-3, -2e-3, 4e-3])
+    tangent = np.array([0.3, -0.2, 0.9])
+    tangent /= np.linalg.norm(tangent)
+    settings = ContinuationSettings(chord_parameter=True)
+
+    def generic(u: np.ndarray, lam: float, derivative: bool = True) -> object:
+        return residual(u, lam, derivative)
+
+    for fixed in (False, True):
+        fast = residual.corrector(y0, tangent, scale, settings, fixed)
+        slow = _correct(generic, y0, tangent, scale, settings, fixed)  # type: ignore[arg-type]
+        assert fast is not None
+        assert slow is not None
+        assert fast[3] == slow[3]
+        assert np.allclose(fast[0], slow[0], rtol=0.0, atol=1e-12)
+        assert np.allclose(fast[1], slow[1], rtol=1e-9, atol=1e-12)
+        assert np.allclose(fast[2][:2], 0.0, atol=1e-11 * 0.2)
+
+
+def test_branch_switching_at_each_period_doubling_finds_the_period_2_orbit() -> None:
+    fr = frequency_response(ONE_SIDED, 1.0, 1.8, 3.8, damping_ratio=0.05)
+    doublings = [e for e in fr.events if e.kind == "period_doubling"]
+    assert len(doublings) == 2
+    for event in doublings:
+        orbit = fr.period_2_orbit(event)
+        assert orbit.period_multiple == 2
+        omega = orbit.omega
+        assert abs(omega - event.omega) < 0.1
+        period = 2 * math.pi / omega
+        z = np.array(orbit.initial_state)
+        scale = np.array([orbit.amplitude, orbit.amplitude * omega])
+        # by time marching (no Newton): back after two forcing periods, not after one
+        one = time_response(ONE_SIDED, 1.0, omega, period, initial=z, damping_ratio=0.05)
+        two = time_response(ONE_SIDED, 1.0, omega, 2 * period, initial=z, damping_ratio=0.05)
+        assert np.max(np.abs(np.array(two.final_state) - z) / scale) < 1e-9
+        assert np.max(np.abs(np.array(one.final_state) - z) / scale) > 1e-3
+        if orbit.stable:  # and steady_state from off the orbit settles on it
+            ss = steady_state(ONE_SIDED, 1.0, omega, damping_ratio=0.05, initial=z * (1.0 + 1e-6))
+            assert ss.period_multiple == 2
+            assert abs(ss.x_max - orbit.x_max) / orbit.amplitude < 1e-9
+            assert abs(ss.x_min - orbit.x_min) / orbit.amplitude < 1e-9
+    assert any(fr.period_2_orbit(e).stable for e in doublings)
+    with pytest.raises(ParameterError, match="period_doubling"):
+        fr.period_2_orbit(next(e for e in fr.events if e.kind != "period_doubling"))

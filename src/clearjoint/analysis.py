@@ -322,5 +322,3 @@ def analyse(
             what="eq 22 (A = X)",
         )
     return analysis
-
-

@@ -21,8 +21,15 @@ y = (u / u_scale, lambda / lambda_scale):
   unknowns moved less than the largest arclength step (else it is another branch); the
   point reached is recorded in ``Branch.kinks`` and the pseudo-arclength continuation
   resumes from it. A jump backwards in lambda (a fold at the kink) is taken only when
-  ``differs`` says the point is on another piece of the branch than the last one. If
-  nothing converges the branch stops with the reason saying where.
+  ``differs`` says the point is on another piece of the branch than the last one, and
+  not on a piece the branch left at an earlier kink.
+- crossing a corner (the residual continuous, its Jacobian not: a sticking onset),
+  where the other piece may turn back in lambda (a nonsmooth fold) and no parameter
+  jump from the last point finds it: the residual is probed around the last point
+  until a probe lands on another piece; that piece's own tangent predicts, the
+  arclength corrector solves. If nothing converges the branch stops with the
+  reason saying where; if a crossing sends it back along its own path, it stops
+  too (``_BACK_POINTS`` points in a row), saying so.
 """
 
 from __future__ import annotations
@@ -56,6 +63,10 @@ Restart = Callable[[FloatArray, float], FloatArray | None]
 Differs = Callable[[Any, Any], bool]
 #: equivalents(u) -> other coordinates of the same solution (e.g. across a jump at the section)
 Equivalents = Callable[[FloatArray], list[FloatArray]]
+
+
+#: Points in a row running back along the branch's own path after which it stops.
+_BACK_POINTS = 5
 
 
 class ContinuationError(ClearjointError, RuntimeError):
@@ -132,8 +143,10 @@ class Branch:
     data : list
         What the residual returned as data at each converged point.
     reason : str
-        Why it stopped: "reached", "max_points", "left the range", or "step too
-        small at lambda = ...: ..." (no step converged, the kink jump included).
+        Why it stopped: "reached", "max_points", "left the range", "step too
+        small at lambda = ...: ..." (no step converged, the kink jump included),
+        or "ran back along its own path from lambda = ...: ..." (a kink crossing
+        led back onto the branch already followed; those points are dropped).
     kinks : (k,) ndarray of int
         Indices of the points reached by a natural-parameter jump across a kink
         (the kink lies between point i - 1 and point i).
@@ -155,17 +168,64 @@ def _solve(a: FloatArray, b: FloatArray) -> FloatArray:
     return x
 
 
+@njit(cache=True)
+def _gauss(m: FloatArray) -> bool:
+    """Solve the square system held in ``m`` = [A | b] in place (partial pivoting).
+
+    On success the last column holds x; False when a pivot is zero or not finite.
+    """
+    n = m.shape[0]
+    for col in range(n):
+        pivot = col
+        for row in range(col + 1, n):
+            if abs(m[row, col]) > abs(m[pivot, col]):
+                pivot = row
+        if m[pivot, col] == 0.0 or not np.isfinite(m[pivot, col]):
+            return False
+        if pivot != col:
+            for j in range(n + 1):
+                m[col, j], m[pivot, j] = m[pivot, j], m[col, j]
+        for row in range(col + 1, n):
+            f = m[row, col] / m[col, col]
+            for j in range(col, n + 1):
+                m[row, j] -= f * m[col, j]
+    for i in range(n - 1, -1, -1):
+        s = m[i, n]
+        for j in range(i + 1, n):
+            s -= m[i, j] * m[j, n]
+        m[i, n] = s / m[i, i]
+    return True
+
+
+@njit(cache=True)
+def _tangent_solve(a: FloatArray, previous: FloatArray, t: FloatArray) -> bool:
+    """t <- the solution of [a; previous] t = e_last, normalised; False if singular."""
+    d = a.shape[0]
+    m = np.zeros((d + 1, d + 2))
+    m[:d, : d + 1] = a
+    m[d, : d + 1] = previous
+    m[d, d + 1] = 1.0
+    if not _gauss(m):
+        return False
+    norm = 0.0
+    for i in range(d + 1):
+        t[i] = m[i, d + 1]
+        norm += t[i] * t[i]
+    norm = math.sqrt(norm)
+    if not (norm > 0.0 and math.isfinite(norm)):
+        return False
+    for i in range(d + 1):
+        t[i] /= norm
+    return True
+
+
 def _tangent(a: FloatArray, previous: FloatArray) -> FloatArray:
     """Unit null vector of the (d, d+1) matrix ``a``, oriented along ``previous``."""
-    system = np.vstack((a, previous))
-    rhs = np.zeros(a.shape[1])
-    rhs[-1] = 1.0
-    try:
-        t = np.linalg.solve(system, rhs)
-    except np.linalg.LinAlgError:
+    t = np.empty(a.shape[1])
+    if not _tangent_solve(np.ascontiguousarray(a, dtype=np.float64), previous, t):
         _, _, vt = np.linalg.svd(a)
-        t = vt[-1]
-    unit: FloatArray = np.asarray(t / np.linalg.norm(t), dtype=np.float64)
+        t = vt[-1] / np.linalg.norm(vt[-1])
+    unit: FloatArray = np.asarray(t, dtype=np.float64)
     return unit if float(unit @ previous) >= 0.0 else np.asarray(-unit, dtype=np.float64)
 
 
@@ -177,7 +237,18 @@ def _correct(
     settings: ContinuationSettings,
     fixed_lambda: bool,
 ) -> tuple[FloatArray, FloatArray, Any, int] | None:
-    """Newton on [R(y); t . (y - y0)] = 0 (or on R at fixed lambda); None if it fails."""
+    """Newton on [R(y); t . (y - y0)] = 0 (or on R at fixed lambda); None if it fails.
+
+    A residual that carries a ``corrector(y0, tangent, scale, settings, fixed_lambda)``
+    method doing this same correction (compiled, say) is handed the work when
+    ``settings.chord_parameter`` is set.
+    """
+    fast = getattr(residual, "corrector", None)
+    if fast is not None and settings.chord_parameter:
+        result: tuple[FloatArray, FloatArray, Any, int] | None = fast(
+            y0, tangent, scale, settings, fixed_lambda
+        )
+        return result
     y = y0.copy()
     d = y.size - 1
     u_scale = scale[:d]
@@ -290,6 +361,7 @@ def continue_branch(
     reason = "max_points"
     kinks: list[int] = []
     curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
+    back_steps = 0  # points in a row that run back along the branch's own path
     while len(ys) < settings.max_points:
         predicted = y + h * t + 0.5 * h * h * curvature
         attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
@@ -299,52 +371,64 @@ def continue_branch(
             turn = math.acos(min(1.0, max(-1.0, float(t_new @ t))))
             if turn > settings.max_turn and h > settings.min_step:
                 attempt = None
-        if attempt is None:
-            if h <= settings.min_step:
-                # the way the branch was travelling (the tangent at a kink can point anywhere)
-                travel = float(np.sign(y[-1] - ys[-2][-1])) if len(ys) > 1 else 0.0
-                jump = _cross_kink(
-                    residual,
-                    y,
-                    travel or direction,
-                    datas[-1],
-                    scale,
-                    settings,
-                    stop,
-                    direction,
-                    restart,
-                    differs,
-                    equivalents,
+        stuck = attempt is None and h <= settings.min_step
+        if stuck:
+            # the way the branch was travelling (the tangent at a kink can point anywhere)
+            travel = float(np.sign(y[-1] - ys[-2][-1])) if len(ys) > 1 else 0.0
+
+            def back(found: FloatArray, found_data: Any) -> bool:
+                return _retraces(found, found_data, ys, datas, kinks, differs)
+
+            jump = _cross_kink(
+                residual,
+                y,
+                travel or direction,
+                datas[-1],
+                scale,
+                settings,
+                stop,
+                direction,
+                restart,
+                differs,
+                equivalents,
+                back,
+            )
+
+            if jump is None:
+                jump = _other_piece(residual, y, t, datas[-1], scale, settings, differs, back)
+            if jump is None:
+                reason = (
+                    f"step too small at lambda = {y[-1] * scale[-1]:.10g}: no arclength step "
+                    "converged, nor a parameter jump of up to "
+                    f"{settings.max_kink_jump * scale[-1]:.3g}"
                 )
-                if jump is None:
-                    reason = (
-                        f"step too small at lambda = {y[-1] * scale[-1]:.10g}: no arclength step "
-                        "converged, nor a parameter jump of up to "
-                        f"{settings.max_kink_jump * scale[-1]:.3g}"
-                    )
-                    break
-                (y_new, a_new, data_new, its), relabelled = jump
-                t_new = _tangent(a_new, t)
-                if float(t_new @ (y_new - y)) < 0.0:
-                    t_new = -t_new  # go on away from the kink (at a grazing fold: back in lambda)
-                if direction * (y_new[-1] - stop) >= 0.0:
-                    reason = "reached"
-                    if direction * (y_new[-1] - stop) == 0.0:
-                        ys.append(y_new)
-                        ts.append(t_new)
-                        datas.append(data_new)
-                        iters.append(its)
-                    break
-                if not relabelled:
-                    kinks.append(len(ys))
-                curvature = np.zeros_like(t)
-                y, t = y_new, t_new
-                ys.append(y)
-                ts.append(t)
-                datas.append(data_new)
-                iters.append(its)
-                h = settings.step
-                continue
+                break
+            (y_new, a_new, data_new, its), relabelled = jump
+            t_new = _tangent(a_new, t)
+            if differs is not None and (y_new[-1] - y[-1]) * (travel or direction) < 0.0:
+                # a fold at the kink: both pieces may end there, so try which way leads away
+                t_new = _away(residual, y, y_new, t_new, data_new, scale, settings, differs)
+            elif float(t_new @ (y_new - y)) < 0.0:
+                t_new = -t_new  # go on away from the kink (at a grazing fold: back in lambda)
+            if direction * (y_new[-1] - stop) >= 0.0:
+                reason = "reached"
+                if direction * (y_new[-1] - stop) == 0.0:
+                    ys.append(y_new)
+                    ts.append(t_new)
+                    datas.append(data_new)
+                    iters.append(its)
+                break
+            if not relabelled:
+                kinks.append(len(ys))
+            curvature = np.zeros_like(t)
+            y, t = y_new, t_new
+            ys.append(y)
+            ts.append(t)
+            datas.append(data_new)
+            iters.append(its)
+            h = settings.step
+            continue
+        if attempt is None:
             h = max(0.5 * h, settings.min_step)
             continue
         if direction * (y_new[-1] - stop) >= 0.0:
@@ -361,6 +445,20 @@ def continue_branch(
                 iters.append(its_end)
             reason = "reached"
             break
+        if kinks and differs is not None:
+            back_steps = (
+                back_steps + 1 if _behind(y_new, t_new, data_new, ys, ts, datas, differs) else 0
+            )
+            if back_steps >= _BACK_POINTS:
+                first_back = ys[-_BACK_POINTS + 1] if _BACK_POINTS > 1 else y_new
+                reason = (
+                    f"ran back along its own path from lambda = {first_back[-1] * scale[-1]:.10g}"
+                    f" (after the kink at lambda = {ys[kinks[-1]][-1] * scale[-1]:.10g}): no "
+                    "way on past the kinks was found"
+                )
+                del ys[len(ys) - _BACK_POINTS + 1 :], ts[len(ts) - _BACK_POINTS + 1 :]
+                del datas[len(datas) - _BACK_POINTS + 1 :], iters[len(iters) - _BACK_POINTS + 1 :]
+                break
         step_length = float(np.linalg.norm(y_new - y))
         curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         y, t = y_new, t_new
@@ -387,6 +485,172 @@ def continue_branch(
     )
 
 
+def _behind(
+    y_new: FloatArray,
+    t_new: FloatArray,
+    data_new: Any,
+    ys: list[FloatArray],
+    ts: list[FloatArray],
+    datas: list[Any],
+    differs: Differs,
+) -> bool:
+    """``y_new`` lies on the branch's earlier path, travelled the other way.
+
+    On a chord between two earlier points (not among the last ten) to 1e-2 of
+    its length, on the same smooth piece, with a tangent turned by more than 155
+    degrees from theirs: the branch runs back along itself (a kink crossing went
+    back onto a piece it had followed). Near a fold the two halves of a branch
+    part quadratically, so a few points in a row tell the two apart.
+    """
+    if len(ys) < 12:
+        return False
+    path = np.array(ys[:-9])
+    chords = np.diff(path, axis=0)  # chords[j] = y_j+1 - y_j, j < len(ys) - 10
+    lengths = np.einsum("ij,ij->i", chords, chords)
+    offsets = y_new - path[:-1]
+    where = np.clip(np.einsum("ij,ij->i", offsets, chords) / np.maximum(lengths, 1e-300), 0, 1)
+    miss = np.linalg.norm(offsets - where[:, None] * chords, axis=1)
+    near = np.nonzero(miss <= 1e-2 * np.sqrt(lengths) + 1e-12)[0]
+    return any(
+        float(t_new @ ts[int(j)]) < -0.9 and not differs(datas[int(j)], data_new) for j in near
+    )
+
+
+def _away(
+    residual: Residual,
+    y: FloatArray,
+    y_new: FloatArray,
+    t_new: FloatArray,
+    data_new: Any,
+    scale: FloatArray,
+    settings: ContinuationSettings,
+    differs: Differs,
+) -> FloatArray:
+    """Orient the tangent at a point reached back in lambda across a kink: away from ``y``.
+
+    A short trial step (100 smallest steps) each way along the new piece; of the
+    ways that stay on that piece, the one whose point ends further from ``y`` wins
+    (at a grazing fold both pieces end at the grazing, so the way towards ``y`` runs
+    back into it). Without such a trial, the tangent points along ``y_new - y``.
+    """
+    best, far = None, -1.0
+    for way in (1.0, -1.0):
+        tangent = way * t_new
+        trial = y_new + 100.0 * settings.min_step * tangent
+        found = _correct(residual, trial, tangent, scale, settings, fixed_lambda=False)
+        if found is None or differs(data_new, found[2]):
+            continue
+        distance = float(np.linalg.norm(found[0] - y))
+        if distance > far:
+            best, far = tangent, distance
+    if best is None:
+        best = t_new if float(t_new @ (y_new - y)) >= 0.0 else -t_new
+    return np.asarray(best, dtype=np.float64)
+
+
+def _retraces(
+    y_new: FloatArray,
+    data_new: Any,
+    ys: list[FloatArray],
+    datas: list[Any],
+    kinks: list[int],
+    differs: Differs | None,
+) -> bool:
+    """A kink crossing that lands back on a piece the branch left at an earlier kink.
+
+    True when ``y_new`` lies on the same smooth piece (``differs`` False) as a
+    point before the last kink, and nearer to it than that point's larger spacing
+    to its neighbours: the branch would run back along itself. (Points since the
+    last kink are the current piece, which may fold back close to itself.)
+    """
+    if differs is None or not kinks or kinks[-1] < 2:
+        return False
+    before = np.array(ys[: kinks[-1]])
+    gaps = np.linalg.norm(before - y_new, axis=1)
+    spacing = np.linalg.norm(np.diff(before, axis=0), axis=1)
+    reach = np.maximum(np.append(spacing, 0.0), np.insert(spacing, 0, 0.0))
+    return any(not differs(datas[int(j)], data_new) for j in np.nonzero(gaps <= reach)[0])
+
+
+def _scaled_jacobian(jac_u: FloatArray, r_lam: FloatArray, scale: FloatArray) -> FloatArray:
+    """[dR/du, dR/dlam] (d, d + 1) in the scaled coordinates of ``_correct``."""
+    d = scale.size - 1
+    u_scale = scale[:d]
+    a = np.empty((d, d + 1))
+    a[:, :d] = jac_u * (u_scale / u_scale[:, None])
+    a[:, d] = r_lam * (scale[d] / u_scale)
+    return a
+
+
+def _other_piece(
+    residual: Residual,
+    y: FloatArray,
+    t: FloatArray,
+    data: Any,
+    scale: FloatArray,
+    settings: ContinuationSettings,
+    differs: Differs | None,
+    back: Callable[[FloatArray, Any], bool],
+) -> tuple[tuple[FloatArray, FloatArray, Any, int], bool] | None:
+    """Step onto the other smooth piece at a kink where the residual is continuous (C0).
+
+    At a sticking onset (a velocity zero that becomes tangent) the map stays
+    continuous but its Jacobian jumps, so the branch has a corner: it goes on
+    (persistence) or turns back in lambda (a nonsmooth fold), and neither the
+    arclength step nor a natural-parameter jump from the last point finds the
+    piece that turns back. Here the residual is probed around the last point
+    ``y`` (scaled offsets 1e-6 to 1e-4 along each coordinate) until a probe lands
+    on another piece (``differs``); that piece's own tangent, taken both ways,
+    predicts the next point, which the arclength corrector then solves for. A
+    point is accepted only when it lies on another piece than the last one and
+    near its prediction, and not on the way back (``back``). Returns it (with
+    False: it is a kink) or None.
+    """
+    if differs is None:
+        return None
+    d = y.size - 1
+    tried: list[FloatArray] = []
+    for size in (1e-6, 1e-5, 1e-4):
+        for axis in range(d + 1):
+            for sign in (1.0, -1.0):
+                probe = y.copy()
+                probe[axis] += sign * size
+                try:
+                    _, jac_u, r_lam, data_probe = residual(
+                        probe[:d] * scale[:d], float(probe[d] * scale[d])
+                    )
+                except ClearjointError:
+                    continue
+                if not differs(data, data_probe):
+                    continue
+                a = _scaled_jacobian(jac_u, r_lam, scale)
+                if not np.all(np.isfinite(a)):
+                    continue
+                other = np.linalg.svd(a)[2][-1]
+                if any(abs(float(other @ seen)) > 1.0 - 1e-6 for seen in tried):
+                    continue  # this piece's tangent was tried already
+                tried.append(other)
+                # away from the old piece first: the way the last tangent did not come from
+                ways = sorted((1.0, -1.0), key=lambda w: float(w * other @ t))
+                for way in ways:
+                    tangent = way * other
+                    h = 10.0 * settings.min_step
+                    while h <= settings.max_step * (1.0 + 1e-12):
+                        predicted = y + h * tangent
+                        found = _correct(
+                            residual, predicted, tangent, scale, settings, fixed_lambda=False
+                        )
+                        if (
+                            found is not None
+                            and differs(data, found[2])
+                            and float(np.linalg.norm(found[0] - predicted)) <= h
+                            and not back(found[0], found[2])
+                        ):
+                            return found, False
+                        h *= 10.0
+    return None
+
+
 def _cross_kink(
     residual: Residual,
     y: FloatArray,
@@ -399,14 +663,15 @@ def _cross_kink(
     restart: Restart | None,
     differs: Differs | None,
     equivalents: Equivalents | None,
+    back: Callable[[FloatArray, Any], bool] | None = None,
 ) -> tuple[tuple[FloatArray, FloatArray, Any, int], bool] | None:
     """A natural-parameter step across a kink: Newton at fixed lambda, smallest jump first.
 
     Forward (``forward``: +1 or -1, the way lambda was moving) from ten times
     ``min_step`` up to ``max_kink_jump``, tenfold each time, not past ``stop``; then
     backward when ``differs`` is given, accepting only a point on another smooth piece
-    than the last one. Returns the point and whether it was reached through an
-    equivalent of the last one (no kink).
+    than the last one and not on the way back (``back``). Returns the point and
+    whether it was reached through an equivalent of the last one (no kink).
     """
     if settings.max_kink_jump <= 0.0:
         return None
@@ -437,7 +702,10 @@ def _cross_kink(
                 gaps = [float(np.linalg.norm(found[0][:d] - a / scale[:d])) for a in anchors]
                 if min(gaps) > settings.max_step:
                     continue  # further than any arclength step: another branch, not this one
-                if side != forward and not differs(data, found[2]):  # type: ignore[misc]
+                if side != forward and (
+                    not differs(data, found[2])  # type: ignore[misc]
+                    or (back is not None and back(found[0], found[2]))
+                ):
                     continue
                 # near an equivalent of the last point, not the point itself: the same orbit
                 # written across a jump of the section, no kink of the branch

@@ -45,8 +45,10 @@ from clearjoint.simulate._shooting import (
     R_XMIN,
     Shot,
     _set_parameter,
+    correct_orbit,
     map_residual,
     newton_orbit,
+    shoot,
     start_state,
 )
 from clearjoint.simulate.core import (
@@ -327,6 +329,92 @@ class FrequencyResponse:
         )
         return _orbit_from(p, s["joint"], state, 1, 0, None, 0.0, 64)
 
+    def period_2_orbit(self, event: ResponseEvent) -> PeriodicOrbit:
+        """Switch branches at a period doubling: the period-2 orbit born there (MODEL.md sec. 5.1).
+
+        At a period doubling a Floquet multiplier of the period-1 orbit passes -1 and a
+        period-2 orbit branches off along its eigenvector w. From the curve's points
+        around the event (a multiplier below -0.5), nearest first, on either side, Newton
+        on the two-period map P_2 starts at z* +- eps w (eps from 1e-3 to 0.3 of the
+        orbit's size); the first fixed point of P_2 that is not the period-1 orbit z*
+        (further than 1e-6 of its size) is returned.
+
+        Parameters
+        ----------
+        event : ResponseEvent
+            One of ``events`` with ``kind == "period_doubling"``.
+
+        Returns
+        -------
+        PeriodicOrbit
+            ``period_multiple == 2``, at the frequency (or force) of the curve point it
+            branched from.
+
+        Raises
+        ------
+        ParameterError
+            The event is not a period doubling, or the curve is not from shooting.
+        SimulationError
+            No period-2 orbit was found near the event.
+        """
+        if self.method != "shooting" or event.kind != "period_doubling":
+            raise ParameterError(
+                "period_2_orbit takes a 'period_doubling' event of a shooting curve, got "
+                f"{event.kind!r} of a {self.method!r} curve"
+            )
+        s = self.settings
+        lam = self.omega if self.parameter == "omega" else self.force_amplitude
+        at = event.omega if self.parameter == "omega" else event.force_amplitude
+        # both sides: past a supercritical doubling the period-2 orbit lies where the
+        # period-1 orbit is unstable, past a subcritical one where it is stable
+        beyond = np.nonzero(self.multipliers.real.min(axis=1) < -0.5)[0]
+        beyond = beyond[np.argsort(np.abs(lam[beyond] - at))][:16]
+        for i in beyond:
+            kw = {
+                "damping_ratio": s["damping_ratio"],
+                "friction": s["friction"],
+                "restitution": s["restitution"],
+            }
+            w, f = float(self.omega[i]), float(self.force_amplitude[i])
+            z = self.initial_state[i]
+            mono = self._monodromy(int(i))
+            mu, vectors = np.linalg.eig(mono)
+            direction = np.real(vectors[:, int(np.argmin(mu.real))])
+            size = np.array([max(self.amplitude[i], 1e-300), max(self.amplitude[i], 1e-300) * w])
+            direction = direction / np.max(np.abs(direction) / size)
+            for eps in (1e-3, 1e-2, 3e-2, 1e-1, 3e-1):
+                for sign in (1.0, -1.0):
+                    try:
+                        orbit = periodic_orbit(
+                            s["joint"],
+                            f,
+                            w,
+                            period_multiple=2,
+                            initial=z + sign * eps * direction,
+                            **kw,
+                        )
+                    except SimulationError:
+                        continue
+                    if np.max(np.abs(np.array(orbit.initial_state) - z) / size) > 1e-6:
+                        return orbit
+        raise SimulationError(
+            f"no period-2 orbit found near the period doubling at {event!r}; try "
+            "periodic_orbit(..., period_multiple=2, initial=...) from a steady_state"
+        )
+
+    def _monodromy(self, index: int) -> FloatArray:
+        """The monodromy matrix of the period-1 orbit at point ``index`` (re-run exactly)."""
+        s = self.settings
+        p = _parameters(
+            s["joint"],
+            float(self.force_amplitude[index]),
+            float(self.omega[index]),
+            s["damping_ratio"],
+            s["friction"],
+            s["restitution"],
+        )
+        return shoot(p, self.initial_state[index], 1).monodromy
+
     def plot(self, ax: Axes | None = None) -> Axes:
         """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.
 
@@ -432,22 +520,63 @@ class FrequencyResponse:
         return ds
 
 
-def _map_residual(p: FloatArray, parameter: str) -> Any:
-    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
-    code = 0 if parameter == "omega" else 1
+class _MapResidual:
+    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``.
 
-    def residual(
-        u: FloatArray, lam: float, derivative: bool = True
+    Called as ``residual(u, lam, derivative=True)`` it returns what
+    ``continuation.Residual`` asks for; its ``corrector`` runs the whole
+    arclength Newton correction compiled (``_shooting.correct_orbit``), which
+    ``continuation`` uses in place of its own loop when it finds one.
+    """
+
+    def __init__(self, p: FloatArray, parameter: str) -> None:
+        self.p = p
+        self.code = 0 if parameter == "omega" else 1
+
+    def __call__(
+        self, u: FloatArray, lam: float, derivative: bool = True
     ) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
         if not lam > 0.0:
             raise SimulationError(f"the parameter left the positive range ({lam!r})")
         out = np.zeros(N_RES)
-        status = map_residual(p, code, float(u[0]), float(u[1]), lam, out, derivative)
+        status = map_residual(self.p, self.code, float(u[0]), float(u[1]), lam, out, derivative)
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
         return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
 
-    return residual
+    def corrector(
+        self,
+        y0: FloatArray,
+        tangent: FloatArray,
+        scale: FloatArray,
+        settings: ContinuationSettings,
+        fixed_lambda: bool,
+    ) -> tuple[FloatArray, FloatArray, Any, int] | None:
+        """``continuation._correct`` for this residual, compiled: (y, [R_u, R_lam], data, its)."""
+        y = np.empty(3)
+        system = np.empty((3, 3))
+        out = np.zeros(N_RES)
+        its = correct_orbit(
+            self.p,
+            self.code,
+            y0,
+            tangent,
+            scale,
+            fixed_lambda,
+            settings.tolerance,
+            settings.max_iterations,
+            y,
+            system,
+            out,
+        )
+        if its < 0:
+            return None
+        return y, system[:2].copy(), out, int(its)
+
+
+def _map_residual(p: FloatArray, parameter: str) -> _MapResidual:
+    """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
+    return _MapResidual(p, parameter)
 
 
 def _parameter_range(
@@ -612,8 +741,27 @@ def frequency_response(
     mu = np.take_along_axis(mu, np.argsort(-np.abs(mu), axis=1), axis=1)
     stable = np.max(np.abs(mu), axis=1) < 1.0
     amplitude = 0.5 * (x_max - x_min)
+    sticking = []
+    for k in branch.kinks:
+        stuck = []
+        for i in (int(k) - 1, int(k)):
+            q = p.copy()
+            _set_parameter(q, code, float(branch.lam[i]))
+            state = np.zeros(4)
+            start_state(q, float(branch.u[i, 0]), float(branch.u[i, 1]), state)
+            stuck.append(_orbit_from(q, joint, state, 1, 0, None, 0.0, 8).stick_time > 0.0)
+        sticking.append(stuck[0] != stuck[1])
     events = _events(
-        joint, branch.tangent[:, -1], mono, x_max, x_min, omega, force, amplitude, branch.kinks
+        joint,
+        branch.tangent[:, -1],
+        mono,
+        x_max,
+        x_min,
+        omega,
+        force,
+        amplitude,
+        branch.kinks,
+        np.array(sticking, dtype=bool),
     )
     return FrequencyResponse(
         omega=omega,
@@ -646,6 +794,7 @@ def _events(
     force: FloatArray,
     amplitude: FloatArray,
     kinks: NDArray[np.int64] | None = None,
+    sticking: NDArray[np.bool_] | None = None,
 ) -> list[ResponseEvent]:
     """Folds, period doublings and grazings between successive points, located linearly.
 
@@ -653,6 +802,8 @@ def _events(
     the point after it) is a grazing too: where no edge crossing of x_max or x_min
     explains it, the orbit grazed an edge from inside contact (a short stage
     appears or vanishes) or began to stick; it is placed at the last point before.
+    ``sticking`` (one per kink) says where the orbits on the two sides differ in
+    whether they stick: a corner at a sticking onset, named so in the note.
     """
     trace = mono[:, 0, 0] + mono[:, 1, 1]
     det = mono[:, 0, 0] * mono[:, 1, 1] - mono[:, 0, 1] * mono[:, 1, 0]
@@ -681,13 +832,22 @@ def _events(
                 return float(a[i] + frac * (a[i + 1] - a[i]))
 
             events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), note)))
-    for k in kinks if kinks is not None else []:
+    for n, k in enumerate(kinks if kinks is not None else []):
         before = int(k) - 1
         if not any(index == before and e.kind == "grazing" for index, e in events):
-            note = (
-                "a kink crossed by a parameter step: a stage appears or vanishes (the orbit "
-                "grazes a gap edge from inside contact) or sticking begins"
-            )
+            if sticking is not None and sticking[n]:
+                note = (
+                    "a corner of the branch where sticking begins or ends (a velocity zero "
+                    "of the orbit becomes tangent): the map is continuous, its Jacobian jumps"
+                )
+            else:
+                note = (
+                    "a kink crossed by a parameter step: a stage appears or vanishes (the orbit "
+                    "grazes a gap edge from inside contact) or sticking begins"
+                )
+            lam = omega if np.ptp(omega) > 0.0 else force
+            if before >= 1 and (lam[before] - lam[before - 1]) * (lam[k] - lam[before]) < 0.0:
+                note += "; the branch turns back here (a nonsmooth fold)"
             where = (float(omega[before]), float(force[before]), float(amplitude[before]))
             events.append((before, ResponseEvent("grazing", *where, note)))
     events.sort(key=lambda item: item[0])

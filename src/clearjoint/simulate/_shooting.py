@@ -371,3 +371,116 @@ def map_residual(
     out[R_EDGE] = o1[O_EDGE_SPEED]
     out[R_EVENTS] = o1[O_EVENTS]
     return kn.STATUS_OK
+
+
+@njit(cache=True)
+def _solve3(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> bool:
+    """x <- a^-1 b for a 3x3 system by Gaussian elimination with partial pivoting.
+
+    Returns False when a pivot vanishes (singular) or a value is not finite.
+    """
+    m = np.empty((3, 4))
+    for i in range(3):
+        for j in range(3):
+            m[i, j] = a[i, j]
+        m[i, 3] = b[i]
+    for col in range(3):
+        pivot = col
+        for row in range(col + 1, 3):
+            if abs(m[row, col]) > abs(m[pivot, col]):
+                pivot = row
+        if m[pivot, col] == 0.0 or not np.isfinite(m[pivot, col]):
+            return False
+        if pivot != col:
+            for j in range(4):
+                m[col, j], m[pivot, j] = m[pivot, j], m[col, j]
+        for row in range(col + 1, 3):
+            f = m[row, col] / m[col, col]
+            for j in range(col, 4):
+                m[row, j] -= f * m[col, j]
+    for i in range(2, -1, -1):
+        s = m[i, 3]
+        for j in range(i + 1, 3):
+            s -= m[i, j] * x[j]
+        x[i] = s / m[i, i]
+    return bool(np.isfinite(x[0]) and np.isfinite(x[1]) and np.isfinite(x[2]))
+
+
+@njit(cache=True)
+def correct_orbit(
+    p: np.ndarray,
+    parameter: int,
+    y0: np.ndarray,
+    tangent: np.ndarray,
+    scale: np.ndarray,
+    fixed_lambda: bool,
+    tolerance: float,
+    max_iterations: int,
+    y: np.ndarray,
+    system: np.ndarray,
+    out: np.ndarray,
+) -> int:
+    """The continuation's corrector for R(z, lam) = P_1(z; lam) - z, compiled (MODEL.md sec. 5.1).
+
+    Newton in scaled coordinates y = (x, x', lam) / ``scale`` on R(y) = 0 together
+    with ``tangent . (y - y0) = 0`` (or lam fixed), exactly as
+    ``continuation._correct`` with a chord in the parameter column (dR/dlam taken
+    at the first iteration only). On success ``y`` holds the solution, ``system``
+    (3, 3) the scaled [dR/du, dR/dlam] in its first two rows, ``out`` the
+    ``map_residual`` data there, and the iterations are returned; -1 on failure
+    (a kernel failure, a parameter <= 0, a value not finite, no convergence).
+    """
+    for i in range(3):
+        y[i] = y0[i]
+    if fixed_lambda:
+        system[2, 0] = 0.0
+        system[2, 1] = 0.0
+        system[2, 2] = 1.0
+    else:
+        for i in range(3):
+            system[2, i] = tangent[i]
+    rhs = np.empty(3)
+    dy = np.empty(3)
+    for iteration in range(max_iterations + 1):
+        lam = y[2] * scale[2]
+        if not lam > 0.0:
+            return -1
+        derivative = iteration == 0
+        status = map_residual(p, parameter, y[0] * scale[0], y[1] * scale[1], lam, out, derivative)
+        if status != kn.STATUS_OK:
+            return -1
+        if derivative:
+            system[0, 2] = out[R_DLAM] * (scale[2] / scale[0])
+            system[1, 2] = out[R_DLAM + 1] * (scale[2] / scale[1])
+        system[0, 0] = out[R_JAC]
+        system[0, 1] = out[R_JAC + 1] * (scale[1] / scale[0])
+        system[1, 0] = out[R_JAC + 2] * (scale[0] / scale[1])
+        system[1, 1] = out[R_JAC + 3]
+        r0 = out[R_RES] / scale[0]
+        r1 = out[R_RES + 1] / scale[1]
+        size = max(abs(r0), abs(r1))
+        if not np.isfinite(size):
+            return -1
+        for i in range(2):
+            for j in range(3):
+                if not np.isfinite(system[i, j]):
+                    return -1
+        if size <= tolerance:
+            return iteration
+        if iteration == max_iterations:
+            return -1
+        rhs[0] = -r0
+        rhs[1] = -r1
+        if fixed_lambda:
+            rhs[2] = 0.0
+        else:
+            rhs[2] = -(
+                tangent[0] * (y[0] - y0[0])
+                + tangent[1] * (y[1] - y0[1])
+                + tangent[2] * (y[2] - y0[2])
+            )
+        if not _solve3(system, rhs, dy):
+            return -1
+        for i in range(3):
+            y[i] += dy[i]
+    return -1

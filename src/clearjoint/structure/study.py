@@ -382,7 +382,7 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
         if not (math.isfinite(ex["frequency"]) and ex["frequency"] > 0.0):
             raise StructureStudyError(
                 f"{where}: [excitation] frequency must be finite and > 0, got "
-                f"{ex['frequency']:g} Hz; e.g. frequency = \"15Hz\""
+                f'{ex["frequency"]:g} Hz; e.g. frequency = "15Hz"'
             )
         if ex.get("periods", 20) < 1:
             raise StructureStudyError(
