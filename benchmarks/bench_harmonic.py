@@ -7,7 +7,8 @@ Run on demand:
 The case (issue 10): m = 1, c_v = 0.05, k0 = 1, gap edges at +-0.1745, contact adds
 3, F0 = 0.03, omega from 0.05 to 1.8, H = 12 harmonics. Both codes follow the whole
 curve (both stable branches and the unstable one) by arclength continuation; each is
-timed twice in its own interpreter and the second (warm) call is compared. pyHarm is
+timed four times in its own interpreter, and the best of the last three (warm) calls
+is compared. pyHarm is
 not installed in the project's environment: give its interpreter with --pyharm.
 BLAS runs on one thread in both (OPENBLAS_NUM_THREADS=1), since the machine's cores
 are shared and threaded BLAS on 25 x 25 matrices only adds waiting.
@@ -71,7 +72,7 @@ def problem():
     }
 
 times = []
-for _ in range(2):
+for _ in range(%(repeats)d):
     t = time.perf_counter(); m = pyHarm.Maestro(problem()); m.operate()
     times.append(time.perf_counter() - t)
 sols = [s for s in m.nls["frf"].SolList if s.flag_accepted]
@@ -79,15 +80,20 @@ idx = m.getIndex("sdof", 0, 0)
 dft = compute_DFT(m.system.nti, m.system.nh)
 om = np.array([s.x[-1] for s in sols])
 xt = np.array([s.x[idx] @ dft["ft"] for s in sols])
-print(json.dumps({"first_s": times[0], "second_s": times[1], "points": len(sols),
+print(json.dumps({"first_s": times[0], "best_s": min(times[1:]), "points": len(sols),
                   "omega": om.tolist(), "amplitude": ((xt.max(1) - xt.min(1)) / 2).tolist()}))
 """
+
+
+#: Each code runs this many times in its interpreter: the first call (imports, compiled-code
+#: cache) is reported apart, the best of the others is compared (the machine is shared).
+REPEATS = 4
 
 
 def ours(harmonics: int, samples: int | None, max_step: float) -> tuple[float, float, object]:
     times = []
     curve = None
-    for _ in range(2):
+    for _ in range(REPEATS):
         start = time.perf_counter()
         curve = frequency_response(
             JOINT,
@@ -100,13 +106,13 @@ def ours(harmonics: int, samples: int | None, max_step: float) -> tuple[float, f
             max_step=max_step,
         )
         times.append(time.perf_counter() - start)
-    return times[0], times[1], curve
+    return times[0], min(times[1:]), curve
 
 
 def pyharm(python: str, harmonics: int) -> dict[str, object]:
     with tempfile.TemporaryDirectory() as folder:
         script = Path(folder) / "pyharm_case.py"
-        script.write_text(PYHARM_SCRIPT % {"h": harmonics})
+        script.write_text(PYHARM_SCRIPT % {"h": harmonics, "repeats": REPEATS})
         try:
             done = subprocess.run(
                 [python, str(script)],
@@ -135,7 +141,7 @@ def main() -> None:
     first, second, curve = ours(H, 512, 0.025)
     print(
         f"clearjoint.harmonic (N_t = 512, as pyHarm): {curve.omega.size} points, "  # type: ignore[attr-defined]
-        f"first call {first:.3f} s, second {second:.3f} s"
+        f"first call {first:.3f} s, best of {REPEATS - 1} more {second:.3f} s"
     )
     print(describe("  clearjoint", curve.omega, curve.amplitude))  # type: ignore[attr-defined]
     for e in curve.events:  # type: ignore[attr-defined]
@@ -151,14 +157,14 @@ def main() -> None:
         om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])
         print(
             f"pyHarm (nti = 512): {ph['points']} points, first call {ph['first_s']:.3f} s, "
-            f"second {ph['second_s']:.3f} s"
+            f"best of {REPEATS - 1} more {ph['best_s']:.3f} s"
         )
         print(describe("  pyHarm", om, amp))
-        ratio = float(ph["second_s"]) / second  # type: ignore[arg-type]
-        per_point = (float(ph["second_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
+        ratio = float(ph["best_s"]) / second  # type: ignore[arg-type]
+        per_point = (float(ph["best_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
             second / curve.omega.size  # type: ignore[attr-defined]
         )
-        print(f"ratio pyHarm / clearjoint (whole curve, warm): {ratio:.2f}x")
+        print(f"ratio pyHarm / clearjoint (whole curve, best warm call): {ratio:.2f}x")
         print(f"ratio per point: {per_point:.2f}x")
     else:
         print("pyHarm not run (give --pyharm PYTHON to compare)")

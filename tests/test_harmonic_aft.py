@@ -122,9 +122,9 @@ def test_harmonic_balance_converges_to_the_exact_orbit() -> None:
     assert errors[3] < errors[1] / 10.0
 
 
-@pytest.mark.parametrize(("harmonics", "samples"), [(1, 6), (4, 18), (12, 512)])
+@pytest.mark.parametrize(("harmonics", "samples"), [(1, 6), (4, 18), (12, 512), (32, 130)])
 def test_fft_products_equal_the_dense_dft_product(harmonics: int, samples: int) -> None:
-    """P diag(v) E by one FFT and the product identities equals the dense triple product."""
+    """P diag(v) E from 2 (2H + 1) moments equals the dense triple product (H = 32 gathers)."""
     basis = aft.Basis.make(harmonics, samples)
     values = np.random.default_rng(harmonics).normal(size=(samples, 3))
     blocks = basis.products(values)

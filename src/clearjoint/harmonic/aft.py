@@ -79,6 +79,11 @@ class Basis:
     gather : (4, 2H + 1, 2H + 1) ndarray of int
         Where :meth:`products` reads the two cosine/sine moments of each entry
         (rows 0-1: indices, rows 2-3: their weights).
+    moments : (2 (2H + 1), N_t) ndarray
+        Rows cos(m tau_n) / N_t, then sin(m tau_n) / N_t, m = 0..2H.
+    assemble : (2 (2H + 1), (2H + 1)^2) ndarray or None
+        ``gather`` as a matrix (moments to entries), kept for H <= 31 (larger ones
+        would take tens of MB; :meth:`products` then gathers).
     """
 
     harmonics: int
@@ -88,6 +93,8 @@ class Basis:
     derivative: FloatArray
     order: FloatArray
     gather: NDArray[np.int64] = field(repr=False)
+    moments: FloatArray = field(repr=False)
+    assemble: FloatArray | None = field(repr=False)
 
     @classmethod
     def make(cls, harmonics: int, samples: int) -> Basis:
@@ -105,20 +112,32 @@ class Basis:
         d[2 * h - 1, 2 * h] = h  # (a cos + b sin)' = h b cos - h a sin
         d[2 * h, 2 * h - 1] = -h
         order = np.concatenate(([0.0], np.repeat(h.astype(np.float64), 2)))
-        return cls(harmonics, samples, e, p, d, order, _gather(harmonics))
+        gather = _gather(harmonics)
+        m = np.arange(n_c)
+        moments = np.concatenate((np.cos(np.outer(m, tau)), np.sin(np.outer(m, tau)))) / samples
+        assemble = None
+        if harmonics <= 31:
+            assemble = np.zeros((2 * n_c, n_c * n_c))
+            cells = np.arange(n_c * n_c)
+            for k in (0, 1):
+                np.add.at(assemble, (gather[k].ravel(), cells), gather[2 + k].ravel())
+            assemble[:, :n_c] *= 0.5  # the mean's row of P carries 1 / N_t, the others 2 / N_t
+        return cls(harmonics, samples, e, p, d, order, gather, moments, assemble)
 
     def products(self, values: FloatArray) -> FloatArray:
         """Return P diag(v) E for each column v of ``values`` (N_t, n): shape (n, 2H + 1, 2H + 1).
 
         The matrix that maps the coefficients of u to those of v(t) u(t) (the
         Jacobian block of a sampled tangent v). Its entries are sums of two moments
-        C_m = mean(v cos m tau), S_m = mean(v sin m tau), m = 0..2H, taken by one
-        real FFT, so the cost is O(N_t log N_t + H^2) per column instead of the
-        O(N_t H^2) of the dense product (equal to round-off, tests/test_harmonic_aft.py).
+        C_m = mean(v cos m tau), S_m = mean(v sin m tau), m = 0..2H (the product
+        identities of cos and sin), so the cost is O(N_t H + H^3) per column instead
+        of the O(N_t H^2) of the dense product P diag(v) E (equal to round-off,
+        tests/test_harmonic_aft.py).
         """
         n_c = 2 * self.harmonics + 1
-        spectrum = np.fft.rfft(values, axis=0)[:n_c] / self.samples  # (2H + 1, n)
-        moments = np.concatenate((spectrum.real, -spectrum.imag), axis=0).T  # (n, 2 (2H + 1))
+        moments = values.T @ self.moments.T  # (n, 2 (2H + 1)): C_0..C_2H, S_0..S_2H
+        if self.assemble is not None:
+            return np.asarray((moments @ self.assemble).reshape(-1, n_c, n_c), dtype=np.float64)
         g = self.gather
         out = moments[:, g[0]] * g[2] + moments[:, g[1]] * g[3]
         out[:, 0, :] *= 0.5  # the mean's row of P carries 1 / N_t, the others 2 / N_t
@@ -302,8 +321,9 @@ def linear_jacobian(
     w2h2 = (omega * basis.order) ** 2
     if n == 1:
         jac = omega * float(damping[0, 0]) * basis.derivative
-        jac[np.diag_indices(n_c)] += float(system.stiffness[0, 0]) - w2h2 * float(system.mass[0, 0])
-        return np.asarray(jac, dtype=np.float64)
+        diagonal = jac.reshape(-1)[:: n_c + 1]  # a view of the diagonal
+        diagonal += float(system.stiffness[0, 0]) - w2h2 * float(system.mass[0, 0])
+        return jac
     jac4 = np.zeros((n_c, n, n_c, n))
     for r in range(n_c):
         jac4[r, :, r, :] = system.stiffness - w2h2[r] * system.mass
