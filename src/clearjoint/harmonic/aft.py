@@ -24,6 +24,7 @@ exp(lambda T), T = 2 pi / w.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -99,7 +100,11 @@ class Basis:
 
     @classmethod
     def make(cls, harmonics: int, samples: int) -> Basis:
-        """Build the basis for H harmonics and N_t samples."""
+        """Build the basis for H harmonics and N_t samples (built once per pair, then shared)."""
+        return _basis(int(harmonics), int(samples))
+
+    @classmethod
+    def _build(cls, harmonics: int, samples: int) -> Basis:
         tau = 2.0 * math.pi * np.arange(samples) / samples
         h = np.arange(1, harmonics + 1)
         n_c = 2 * harmonics + 1
@@ -174,6 +179,12 @@ class Basis:
                 t = t - np.clip(step, -math.pi / fine, math.pi / fine)
             out.append(_diag_eval(self, coefficients, t))
         return out[0], out[1]
+
+
+@functools.lru_cache(maxsize=32)
+def _basis(harmonics: int, samples: int) -> Basis:
+    """The shared :class:`Basis` of (H, N_t): its arrays are read, never written."""
+    return Basis._build(harmonics, samples)
 
 
 def _gather(harmonics: int) -> NDArray[np.int64]:
