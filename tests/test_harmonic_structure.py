@@ -132,3 +132,20 @@ def test_first_nonlinear_mode_is_the_free_decay_backbone() -> None:
     np.testing.assert_allclose(zeta[ok], z_epmc[ok], rtol=0.2)
     # the backbone is nonlinear here: 1 % of frequency over the stretch compared
     assert w[0] / w[-1] > 1.01
+
+
+def test_sparse_and_dense_newton_give_the_same_mode(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Newton's sparse LU (used above solve.SPARSE_ABOVE unknowns) and the dense one agree."""
+    from clearjoint.harmonic import solve
+
+    amplitudes = np.geomspace(2e-4, 2e-2, 5)
+    dense = nonlinear_modes(three_links, 1, amplitudes, harmonics=7)
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    sparse = nonlinear_modes(three_links, 1, amplitudes, harmonics=7)
+    assert dense.converged.all()
+    assert sparse.converged.all()
+    np.testing.assert_allclose(sparse.frequency, dense.frequency, rtol=1e-9)
+    np.testing.assert_allclose(sparse.damping_ratio, dense.damping_ratio, rtol=1e-7)
+    np.testing.assert_allclose(sparse.x_max, dense.x_max, rtol=1e-8, atol=1e-14)

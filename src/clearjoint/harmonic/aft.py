@@ -265,6 +265,7 @@ def evaluate(
     force: FloatArray,
     *,
     negative_damping: float = 0.0,
+    jacobian: bool = True,
 ) -> Evaluation:
     """Return R(q, w) of MODEL.md 5.3 with its exact Jacobian (AFT, dense).
 
@@ -280,6 +281,9 @@ def evaluate(
         Amplitude per DOF of F sin(w t), N (zeros for free motion).
     negative_damping : float
         xi of EPMC (MODEL.md 5.4): adds -xi M u', 1/s.
+    jacobian : bool
+        False: skip the Jacobian (a line search needs only R); ``jacobian`` is then
+        an empty (0, 0) array.
     """
     n = system.n_dof
     if n == 1 and system.friction_force is None and basis.assemble is not None:
@@ -327,6 +331,8 @@ def evaluate(
         residual += (p @ f_fr) @ b
         d_omega += (p @ (kv * (e @ rel_rate))) @ b
         blocks = blocks + omega * (basis.products(kv) @ d)
+    if not jacobian:
+        return Evaluation(residual.ravel(), np.empty((0, 0)), d_omega.ravel(), kt, kv)
     jac = linear_jacobian(system, basis, omega, c_eff)
     add_joint_blocks(jac, blocks, b)
     return Evaluation(residual.ravel(), jac, d_omega.ravel(), kt, kv)
@@ -443,13 +449,35 @@ def add_joint_blocks(jac: FloatArray, blocks: FloatArray, directions: FloatArray
         else:
             jac += np.tensordot(directions[:, 0] ** 2, blocks, axes=1)
         return
-    jac4 = jac.reshape(n_c, n, n_c, n)
-    every = np.arange(n_c)
+    index, weights = _scatter(n_c, directions.shape, directions.tobytes())
+    values = blocks[:, :, None, :, None] * weights  # (n_j, 2H + 1, k, 2H + 1, k)
+    np.add.at(jac.reshape(-1), index, values.reshape(-1))
+
+
+@functools.lru_cache(maxsize=8)
+def _scatter(n_c: int, shape: tuple[int, ...], data: bytes) -> tuple[NDArray[np.int64], FloatArray]:
+    """Where each joint's block lands in the flat Jacobian, and the b_j b_j^T weights.
+
+    Each joint touches only the k DOFs where b_j is not zero (k the most any joint has;
+    fewer are padded with weight 0). Returns the flat indices (n_j (2H + 1)^2 k^2,) and
+    weights (n_j, 1, k, 1, k).
+    """
+    directions = np.frombuffer(data, dtype=np.float64).reshape(shape)
+    n_j, n = shape
+    k = max(int(np.max(np.count_nonzero(directions, axis=1))), 1)
+    dofs = np.zeros((n_j, k), dtype=np.int64)
+    b = np.zeros((n_j, k))
     for j in range(n_j):
-        dofs = np.flatnonzero(directions[j])
-        bj = directions[j, dofs]
-        where = np.ix_(every, dofs, every, dofs)
-        jac4[where] += blocks[j][:, None, :, None] * np.outer(bj, bj)[None, :, None, :]
+        nz = np.flatnonzero(directions[j])
+        dofs[j, : nz.size] = nz
+        b[j, : nz.size] = directions[j, nz]
+    r = np.arange(n_c)
+    index = (
+        (r[None, :, None, None, None] * n + dofs[:, None, :, None, None]) * n_c
+        + r[None, None, None, :, None]
+    ) * n + dofs[:, None, None, None, :]
+    weights = (b[:, :, None] * b[:, None, :])[:, None, :, None, :]
+    return index.reshape(-1), weights
 
 
 def hill_exponents(
