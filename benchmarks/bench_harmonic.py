@@ -14,6 +14,16 @@ BLAS runs on one thread in both (OPENBLAS_NUM_THREADS=1), since the machine's co
 are shared and threaded BLAS on 25 x 25 matrices only adds waiting.
 
 It also prints the peak, both folds, and how the time grows with H.
+
+    python benchmarks/bench_harmonic.py --mast [--mast-points 300]
+
+times the planar mast (clearjoint.structure.mast, hinge joints ClearanceJoint(1e-4, 1e8,
+gap_stiffness=1e6) in every longeron, Rayleigh beta 2e-6 s): the first nonlinear mode
+at 50 amplitudes (0.1 to 20 mm on the tip) for 5, 10, 20 and 40 bays at H = 7 and for
+H = 3, 7, 15 at 10 bays; the frequency response of the 10-bay mast (tip force 2 N,
+from the open to past the closed first mode) for --mast-points points, and the cost
+per point of the frequency response (continuation and Hill's eigenproblem timed apart,
+on a 10-point stretch) against the bays and H.
 """
 
 from __future__ import annotations
@@ -133,10 +143,113 @@ def describe(name: str, omega: np.ndarray, amplitude: np.ndarray) -> str:
     return f"{name}: peak X = {amplitude[i]:.4f} at omega = {omega[i]:.4f} rad/s"
 
 
+def mast_model(bays: int) -> object:
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast
+
+    return mast(bays, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0, 2e-6))
+
+
+def mast_benchmarks(points: int) -> None:
+    """The mast timings (see the module docstring)."""
+    from clearjoint.harmonic import aft, nonlinear_modes
+    from clearjoint.harmonic.system import from_structure
+
+    amplitudes = np.geomspace(1e-4, 2e-2, 50)
+    print("mast, first nonlinear mode (EPMC), 50 amplitudes 0.1 to 20 mm:")
+    for bays, h in ((5, 7), (10, 7), (20, 7), (40, 7), (10, 3), (10, 15)):
+        s = mast_model(bays)
+        start = time.perf_counter()
+        nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
+        took = time.perf_counter() - start
+        f = nm.frequency[nm.converged] / (2 * math.pi)
+        print(
+            f"  {bays:2d} bays ({s.n_dof} DOF, {(2 * h + 1) * s.n_dof} unknowns), H = {h:2d}: "  # type: ignore[attr-defined]
+            f"{took:7.2f} s, {int(nm.converged.sum())}/50 converged, {f.min():.3f} to "
+            f"{f.max():.3f} Hz"
+        )
+    print("mast frequency response, cost per point (10-point stretch near the open mode):")
+    for bays, h in ((5, 7), (10, 7), (20, 7), (10, 3), (10, 15)):
+        s = mast_model(bays)
+        force = np.zeros(s.n_dof)  # type: ignore[attr-defined]
+        force[-2] = 2.0  # the tip node, along x
+        f_open = float(s.modes("open").omega[0])  # type: ignore[attr-defined]
+        start = time.perf_counter()
+        fr = frequency_response(s, force, 0.8 * f_open, 2.0 * f_open, harmonics=h, max_points=10)
+        took = time.perf_counter() - start
+        model = from_structure(s)
+        basis = aft.Basis.make(h, 1 << math.ceil(math.log2(32 * (2 * h + 1))))
+        q = fr.coefficients[-1].ravel()  # type: ignore[union-attr]
+        w = float(fr.omega[-1])
+        ev = aft.evaluate(model, basis, q, w, force)
+        start = time.perf_counter()
+        aft.hill_exponents(model, basis, ev.jacobian, w)
+        hill = time.perf_counter() - start
+        print(
+            f"  {bays:2d} bays, H = {h:2d}: {took / fr.omega.size:.3f} s per point "
+            f"({fr.omega.size} points), of which Hill's eigenproblem {hill:.3f} s"
+        )
+    s = mast_model(10)
+    force = np.zeros(s.n_dof)  # type: ignore[attr-defined]
+    force[-2] = 2.0
+    f_open = float(s.modes("open").omega[0])  # type: ignore[attr-defined]
+    f_closed = float(s.modes("closed").omega[0])  # type: ignore[attr-defined]
+    start = time.perf_counter()
+    fr = frequency_response(s, force, 0.8 * f_open, 1.2 * f_closed, harmonics=7, max_points=points)
+    took = time.perf_counter() - start
+    print(
+        f"mast, 10 bays, H = 7, tip force 2 N, {0.8 * f_open / (2 * math.pi):.2f} to "
+        f"{1.2 * f_closed / (2 * math.pi):.2f} Hz: {fr.omega.size} points in {took:.1f} s "
+        f"({fr.stop_reason}; reached {fr.omega[-1] / (2 * math.pi):.3f} Hz, "
+        f"{int(np.sum(~fr.stable))} unstable points)"
+    )
+
+
+def samples_error() -> None:
+    """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
+    from clearjoint.harmonic import aft, solve, system
+    from clearjoint.periodic import periodic_orbit
+
+    model = system.from_joint(JOINT, ZETA, None, 1.0)
+    omega, force = 1.3, np.array([0.03])
+    print(f"x_max error / X against the exact orbit, omega = {omega} rad/s (upper branch):")
+    for h in (7, 12):
+        exact = None
+        row = []
+        for n_t in (2 * (2 * h + 1), 64, 128, 256, 512, 1024, 4096):
+            basis = aft.Basis.make(h, n_t)
+            q0 = np.zeros(2 * h + 1)
+            q0[1], q0[2] = -0.3, 0.1
+
+            def function(q: np.ndarray, basis: aft.Basis = basis) -> tuple[np.ndarray, np.ndarray]:
+                ev = aft.evaluate(model, basis, q, omega, force)
+                return ev.residual, ev.jacobian
+
+            found = solve.newton(function, q0, 0.1)
+            assert found is not None
+            q = found[0]
+            if exact is None:
+                x0 = q[0] + q[1::2].sum()
+                v0 = omega * float(np.arange(1, h + 1) @ q[2::2])
+                exact = periodic_orbit(JOINT, 0.03, omega, damping_ratio=ZETA, initial=(x0, v0))
+            top, _ = basis.extremes(q[:, None])
+            row.append(f"N_t = {n_t}: {abs(top[0] - exact.x_max) / exact.amplitude:.1e}")
+        print(f"  H = {h}: " + ", ".join(row))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
+    parser.add_argument("--mast", action="store_true", help="the mast timings instead")
+    parser.add_argument("--mast-points", type=int, default=300, help="mast curve points")
+    parser.add_argument("--samples", action="store_true", help="the error against N_t instead")
     args = parser.parse_args()
+    if args.samples:
+        samples_error()
+        return
+    if args.mast:
+        mast_benchmarks(args.mast_points)
+        return
     print(f"pyHarm SDOF clearance case, H = {H}, omega 0.05 to 1.8 rad/s")
     first, second, curve = ours(H, 512, 0.025)
     print(
