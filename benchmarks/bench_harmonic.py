@@ -273,6 +273,11 @@ def main() -> None:
             f"best of {REPEATS - 1} more {ph['best_s']:.3f} s"
         )
         print(describe("  pyHarm", om, amp))
+        # the load of the shared machine drifts: time ours again after pyHarm and compare
+        # with the slower of our two best times (the ratio that favours pyHarm)
+        _, again, _ = ours(H, 512, 0.025)
+        print(f"clearjoint.harmonic again after pyHarm: best of {REPEATS - 1} {again:.3f} s")
+        second = max(second, again)
         ratio = float(ph["best_s"]) / second  # type: ignore[arg-type]
         per_point = (float(ph["best_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
             second / curve.omega.size  # type: ignore[attr-defined]
