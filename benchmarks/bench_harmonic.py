@@ -52,9 +52,9 @@ ZETA = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 2 zeta sqrt(m k_c) = 0.05
 H = 12
 #: pyHarm's continuation settings, as in benchmarks/bench_periodic.py: its documented tangent
 #: predictor, arc-length corrector and "acceptance" step sizer with ds_max = 0.01. With ds_max
-#: 0.05 (and 0.04) its predictor turns back and forth between 1.09 and 1.14 rad/s after the
-#: upper fold without end (the sign of det J flips on the sampled law's kinks); with 0.01 it
-#: follows the whole curve, 326 points. Give up after this many s all the same.
+#: 0.05 its predictor turns back and forth between 1.09 and 1.14 rad/s after the upper fold
+#: without end (the sign of det J flips on the sampled law's kinks); with 0.01 it follows
+#: the whole curve, 326 points (docs/harmonic.md, "Speed"). Give up after this many s.
 PYHARM_TIMEOUT = 240
 
 PYHARM_SCRIPT = """
