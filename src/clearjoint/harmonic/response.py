@@ -269,7 +269,10 @@ def _response(
     determinant = n == 1 and model.friction_force is None
     jacobians = np.empty((n_pts, n_c, n_c)) if determinant else None
     for i in range(n_pts):
-        ev = evaluations[i]  # the residual's evaluation at the converged point
+        ev = evaluations[i] if i < len(evaluations) else None
+        if not isinstance(ev, aft.Evaluation):  # a point the continuation did not evaluate
+            f = pattern if parameter == "omega" else force[i] * unit_force
+            ev = aft.evaluate(model, basis, u[i], float(omega[i]), f)
         if jacobians is not None:  # one DOF, constant damping: Hill's determinant
             jacobians[i] = ev.jacobian
             continue
