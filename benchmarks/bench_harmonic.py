@@ -7,12 +7,23 @@ Run on demand:
 The case (issue 10): m = 1, c_v = 0.05, k0 = 1, gap edges at +-0.1745, contact adds
 3, F0 = 0.03, omega from 0.05 to 1.8, H = 12 harmonics. Both codes follow the whole
 curve (both stable branches and the unstable one) by arclength continuation; each is
-timed twice in its own interpreter and the second (warm) call is compared. pyHarm is
+timed four times in its own interpreter, and the best of the last three (warm) calls
+is compared. pyHarm is
 not installed in the project's environment: give its interpreter with --pyharm.
 BLAS runs on one thread in both (OPENBLAS_NUM_THREADS=1), since the machine's cores
 are shared and threaded BLAS on 25 x 25 matrices only adds waiting.
 
 It also prints the peak, both folds, and how the time grows with H.
+
+    python benchmarks/bench_harmonic.py --mast [--mast-points 300]
+
+times the planar mast (clearjoint.structure.mast, hinge joints ClearanceJoint(1e-4, 1e8,
+gap_stiffness=1e6) in every longeron, Rayleigh beta 2e-6 s): the first nonlinear mode
+at 50 amplitudes (0.1 to 20 mm on the tip) for 5, 10, 20 and 40 bays at H = 7 and for
+H = 3, 7, 15 at 10 bays; the frequency response of the 10-bay mast (tip force 2 N,
+from the open to past the closed first mode) for --mast-points points, and the cost
+per point of the frequency response (continuation and Hill's eigenproblem timed apart,
+on a 10-point stretch) against the bays and H.
 """
 
 from __future__ import annotations
@@ -39,7 +50,11 @@ from clearjoint.harmonic import frequency_response
 JOINT = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_stiffness=1.0)
 ZETA = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 2 zeta sqrt(m k_c) = 0.05
 H = 12
-#: pyHarm sometimes stalls after the upper fold on this case; give up after this many s.
+#: pyHarm's continuation settings, as in benchmarks/bench_periodic.py: its documented tangent
+#: predictor, arc-length corrector and "acceptance" step sizer with ds_max = 0.01. With ds_max
+#: 0.05 its predictor turns back and forth between 1.09 and 1.14 rad/s after the upper fold
+#: without end (the sign of det J flips on the sampled law's kinks); with 0.01 it follows
+#: the whole curve, 326 points (docs/harmonic.md, "Speed"). Give up after this many s.
 PYHARM_TIMEOUT = 240
 
 PYHARM_SCRIPT = """
@@ -51,7 +66,7 @@ from pyHarm.DynamicOperator import compute_DFT
 def problem():
     return {
         "analysis": {"frf": {"study": "frf", "puls_inf": 0.05, "puls_start": 0.05,
-                             "puls_sup": 1.8, "ds0": 1e-2, "ds_min": 1e-8, "ds_max": 0.05,
+                             "puls_sup": 1.8, "ds0": 1e-2, "ds_min": 1e-4, "ds_max": 0.01,
                              "sign_ds": 1, "verbose": False, "stepsizer": "acceptance",
                              "predictor": "tangent", "corrector": "arc_length",
                              "stopper": "bounds", "solver": "NewtonRaphson"}},
@@ -67,7 +82,7 @@ def problem():
     }
 
 times = []
-for _ in range(2):
+for _ in range(%(repeats)d):
     t = time.perf_counter(); m = pyHarm.Maestro(problem()); m.operate()
     times.append(time.perf_counter() - t)
 sols = [s for s in m.nls["frf"].SolList if s.flag_accepted]
@@ -75,15 +90,20 @@ idx = m.getIndex("sdof", 0, 0)
 dft = compute_DFT(m.system.nti, m.system.nh)
 om = np.array([s.x[-1] for s in sols])
 xt = np.array([s.x[idx] @ dft["ft"] for s in sols])
-print(json.dumps({"first_s": times[0], "second_s": times[1], "points": len(sols),
+print(json.dumps({"first_s": times[0], "best_s": min(times[1:]), "points": len(sols),
                   "omega": om.tolist(), "amplitude": ((xt.max(1) - xt.min(1)) / 2).tolist()}))
 """
+
+
+#: Each code runs this many times in its interpreter: the first call (imports, compiled-code
+#: cache) is reported apart, the best of the others is compared (the machine is shared).
+REPEATS = 4
 
 
 def ours(harmonics: int, samples: int | None, max_step: float) -> tuple[float, float, object]:
     times = []
     curve = None
-    for _ in range(2):
+    for _ in range(REPEATS):
         start = time.perf_counter()
         curve = frequency_response(
             JOINT,
@@ -96,13 +116,13 @@ def ours(harmonics: int, samples: int | None, max_step: float) -> tuple[float, f
             max_step=max_step,
         )
         times.append(time.perf_counter() - start)
-    return times[0], times[1], curve
+    return times[0], min(times[1:]), curve
 
 
 def pyharm(python: str, harmonics: int) -> dict[str, object]:
     with tempfile.TemporaryDirectory() as folder:
         script = Path(folder) / "pyharm_case.py"
-        script.write_text(PYHARM_SCRIPT % {"h": harmonics})
+        script.write_text(PYHARM_SCRIPT % {"h": harmonics, "repeats": REPEATS})
         try:
             done = subprocess.run(
                 [python, str(script)],
@@ -123,15 +143,118 @@ def describe(name: str, omega: np.ndarray, amplitude: np.ndarray) -> str:
     return f"{name}: peak X = {amplitude[i]:.4f} at omega = {omega[i]:.4f} rad/s"
 
 
+def mast_model(bays: int) -> object:
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast
+
+    return mast(bays, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0, 2e-6))
+
+
+def mast_benchmarks(points: int) -> None:
+    """The mast timings (see the module docstring)."""
+    from clearjoint.harmonic import aft, nonlinear_modes
+    from clearjoint.harmonic.system import from_structure
+
+    amplitudes = np.geomspace(1e-4, 2e-2, 50)
+    print("mast, first nonlinear mode (EPMC), 50 amplitudes 0.1 to 20 mm:")
+    for bays, h in ((5, 7), (10, 7), (20, 7), (40, 7), (10, 3), (10, 15)):
+        s = mast_model(bays)
+        start = time.perf_counter()
+        nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
+        took = time.perf_counter() - start
+        f = nm.frequency[nm.converged] / (2 * math.pi)
+        print(
+            f"  {bays:2d} bays ({s.n_dof} DOF, {(2 * h + 1) * s.n_dof} unknowns), H = {h:2d}: "  # type: ignore[attr-defined]
+            f"{took:7.2f} s, {int(nm.converged.sum())}/50 converged, {f.min():.3f} to "
+            f"{f.max():.3f} Hz"
+        )
+    print("mast frequency response, cost per point (10-point stretch near the open mode):")
+    for bays, h in ((5, 7), (10, 7), (20, 7), (10, 3), (10, 15)):
+        s = mast_model(bays)
+        force = np.zeros(s.n_dof)  # type: ignore[attr-defined]
+        force[-2] = 2.0  # the tip node, along x
+        f_open = float(s.modes("open").omega[0])  # type: ignore[attr-defined]
+        start = time.perf_counter()
+        fr = frequency_response(s, force, 0.8 * f_open, 2.0 * f_open, harmonics=h, max_points=10)
+        took = time.perf_counter() - start
+        model = from_structure(s)
+        basis = aft.Basis.make(h, 1 << math.ceil(math.log2(32 * (2 * h + 1))))
+        q = fr.coefficients[-1].ravel()  # type: ignore[union-attr]
+        w = float(fr.omega[-1])
+        ev = aft.evaluate(model, basis, q, w, force)
+        start = time.perf_counter()
+        aft.hill_exponents(model, basis, ev.jacobian, w)
+        hill = time.perf_counter() - start
+        print(
+            f"  {bays:2d} bays, H = {h:2d}: {took / fr.omega.size:.3f} s per point "
+            f"({fr.omega.size} points), of which Hill's eigenproblem {hill:.3f} s"
+        )
+    s = mast_model(10)
+    force = np.zeros(s.n_dof)  # type: ignore[attr-defined]
+    force[-2] = 2.0
+    f_open = float(s.modes("open").omega[0])  # type: ignore[attr-defined]
+    f_closed = float(s.modes("closed").omega[0])  # type: ignore[attr-defined]
+    start = time.perf_counter()
+    fr = frequency_response(s, force, 0.8 * f_open, 1.2 * f_closed, harmonics=7, max_points=points)
+    took = time.perf_counter() - start
+    print(
+        f"mast, 10 bays, H = 7, tip force 2 N, {0.8 * f_open / (2 * math.pi):.2f} to "
+        f"{1.2 * f_closed / (2 * math.pi):.2f} Hz: {fr.omega.size} points in {took:.1f} s "
+        f"({fr.stop_reason}; reached {fr.omega[-1] / (2 * math.pi):.3f} Hz, "
+        f"{int(np.sum(~fr.stable))} unstable points)"
+    )
+
+
+def samples_error() -> None:
+    """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
+    from clearjoint.harmonic import aft, solve, system
+    from clearjoint.periodic import periodic_orbit
+
+    model = system.from_joint(JOINT, ZETA, None, 1.0)
+    omega, force = 1.3, np.array([0.03])
+    print(f"x_max error / X against the exact orbit, omega = {omega} rad/s (upper branch):")
+    for h in (7, 12):
+        exact = None
+        row = []
+        for n_t in (2 * (2 * h + 1), 64, 128, 256, 512, 1024, 4096):
+            basis = aft.Basis.make(h, n_t)
+            q0 = np.zeros(2 * h + 1)
+            q0[1], q0[2] = -0.3, 0.1
+
+            def function(q: np.ndarray, basis: aft.Basis = basis) -> tuple[np.ndarray, np.ndarray]:
+                ev = aft.evaluate(model, basis, q, omega, force)
+                return ev.residual, ev.jacobian
+
+            found = solve.newton(function, q0, 0.1)
+            assert found is not None
+            q = found[0]
+            if exact is None:
+                x0 = q[0] + q[1::2].sum()
+                v0 = omega * float(np.arange(1, h + 1) @ q[2::2])
+                exact = periodic_orbit(JOINT, 0.03, omega, damping_ratio=ZETA, initial=(x0, v0))
+            top, _ = basis.extremes(q[:, None])
+            row.append(f"N_t = {n_t}: {abs(top[0] - exact.x_max) / exact.amplitude:.1e}")
+        print(f"  H = {h}: " + ", ".join(row))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
+    parser.add_argument("--mast", action="store_true", help="the mast timings instead")
+    parser.add_argument("--mast-points", type=int, default=300, help="mast curve points")
+    parser.add_argument("--samples", action="store_true", help="the error against N_t instead")
     args = parser.parse_args()
+    if args.samples:
+        samples_error()
+        return
+    if args.mast:
+        mast_benchmarks(args.mast_points)
+        return
     print(f"pyHarm SDOF clearance case, H = {H}, omega 0.05 to 1.8 rad/s")
     first, second, curve = ours(H, 512, 0.025)
     print(
         f"clearjoint.harmonic (N_t = 512, as pyHarm): {curve.omega.size} points, "  # type: ignore[attr-defined]
-        f"first call {first:.3f} s, second {second:.3f} s"
+        f"first call {first:.3f} s, best of {REPEATS - 1} more {second:.3f} s"
     )
     print(describe("  clearjoint", curve.omega, curve.amplitude))  # type: ignore[attr-defined]
     for e in curve.events:  # type: ignore[attr-defined]
@@ -147,14 +270,19 @@ def main() -> None:
         om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])
         print(
             f"pyHarm (nti = 512): {ph['points']} points, first call {ph['first_s']:.3f} s, "
-            f"second {ph['second_s']:.3f} s"
+            f"best of {REPEATS - 1} more {ph['best_s']:.3f} s"
         )
         print(describe("  pyHarm", om, amp))
-        ratio = float(ph["second_s"]) / second  # type: ignore[arg-type]
-        per_point = (float(ph["second_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
+        # the load of the shared machine drifts: time ours again after pyHarm and compare
+        # with the slower of our two best times (the ratio that favours pyHarm)
+        _, again, _ = ours(H, 512, 0.025)
+        print(f"clearjoint.harmonic again after pyHarm: best of {REPEATS - 1} {again:.3f} s")
+        second = max(second, again)
+        ratio = float(ph["best_s"]) / second  # type: ignore[arg-type]
+        per_point = (float(ph["best_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
             second / curve.omega.size  # type: ignore[attr-defined]
         )
-        print(f"ratio pyHarm / clearjoint (whole curve, warm): {ratio:.2f}x")
+        print(f"ratio pyHarm / clearjoint (whole curve, best warm call): {ratio:.2f}x")
         print(f"ratio per point: {per_point:.2f}x")
     else:
         print("pyHarm not run (give --pyharm PYTHON to compare)")

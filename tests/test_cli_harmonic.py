@@ -91,3 +91,131 @@ def test_bad_input_is_one_line_exit_2(
     assert message in err
     assert len(err.strip().splitlines()) == 1
     assert "Traceback" not in err
+
+
+CHAIN_STUDY = """
+[structure]
+kind = "chain"
+masses = ["1kg", "1kg", "1kg"]
+stiffnesses = [{stiffness}, {stiffness}, {stiffness}]
+dampers = ["150N*s/m", "150N*s/m", "150N*s/m"]
+joints = [true, true, true]
+
+[joint]
+clearance = "0.1mm"
+compression_stiffness = "1e7N/m"
+gap_stiffness = "1e5N/m"
+{restitution}
+[excitation]
+frequency = "60Hz"
+force_dof = "n3x"
+force_amplitude = "40N"
+"""
+
+
+def _chain_study(tmp_path: Path, restitution: str = "", stiffness: str = '"1e6N/m"') -> Path:
+    path = tmp_path / "chain.toml"
+    path.write_text(CHAIN_STUDY.format(restitution=restitution, stiffness=stiffness))
+    return path
+
+
+def test_frf_of_a_structure_study(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The CLI reads the chain study (units: mm, N*s/m) into the same structure and force as
+    the Python API, and writes per-DOF extremes."""
+    import numpy as np
+    import xarray as xr
+
+    from clearjoint import ClearanceJoint
+    from clearjoint.harmonic import frequency_response
+    from clearjoint.structure import chain
+
+    study, out = _chain_study(tmp_path), tmp_path / "frf.nc"
+    args = ["frf", str(study), "--from", "50Hz", "--to", "52Hz", "--out", str(out)]
+    code, text, err = run([*args, "--method", "harmonic", "--harmonics", "5", "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["dofs"] == ["n1x", "n2x", "n3x"]
+    assert np.shape(data["x_max_m"])[1] == 3
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    s = chain([1.0] * 3, [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+    force = [0.0, 0.0, 40.0]
+    direct = frequency_response(s, force, 2 * math.pi * 50, 2 * math.pi * 52, harmonics=5)
+    np.testing.assert_allclose(data["x_max_m"], direct.x_max, rtol=1e-9, atol=1e-15)
+    assert max(data["x_max_m"][0]) > 1e-4  # the joints open and close: nonlinear here
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds["x_max"].dims == ("point", "dof")
+        assert ds.attrs["method"] == "harmonic"
+    # the default method (exact shooting of one joint) cannot do a structure: one line
+    code, _, err = run([*args[:-2], "--out", str(tmp_path / "y.nc")], capsys)
+    assert code == 2
+    assert "is a structure study" in err
+    assert "add --method harmonic" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_modes_of_a_structure_study(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Mode 1 of the chain lies between its all-open (21.36 Hz) and all-closed (67.56 Hz)
+    linear modes (MODEL.md 5.2) and stiffens with amplitude."""
+    study, out, png = _chain_study(tmp_path), tmp_path / "m.nc", tmp_path / "m.png"
+    args = ["modes", str(study), "--amplitude", "0.2mm..20mm", "--points", "4", "--harmonics", "5"]
+    code, text, err = run([*args, "--out", str(out), "--plot", str(png), "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    assert set(data) == {"amplitude_m", "frequency_hz", "damping_ratio", "energy_per_cycle_j"}
+    assert all(21.36 < f < 67.57 for f in data["frequency_hz"])
+    assert data["frequency_hz"] == sorted(data["frequency_hz"])
+    assert png.stat().st_size > 0
+    code, _, err = run([*args, "--mode", "4", "--out", str(tmp_path / "n.nc")], capsys)
+    assert code == 2
+    assert "modes 1 to 3" in err
+
+
+FRICTION = '\n[losses]\ndamping_ratio = 0.01\nfriction_coefficient = 0.1\nlateral_load = "100N"\n'
+
+
+@pytest.mark.parametrize(
+    ("command", "losses", "message"),
+    [
+        ("modes", FRICTION, "set friction_coefficient = 0"),
+        ("modes", "\n[losses]\nrestitution = 0.8\n", "set restitution = 1"),
+        ("frf", "\n[losses]\nrestitution = 0.8\n", "drop --method harmonic"),
+        (
+            "frf",
+            FRICTION + 'friction_region = "free-play"\n',
+            'set friction_region = "everywhere"',
+        ),
+    ],
+)
+def test_losses_harmonic_balance_cannot_carry_get_a_cli_answer(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str, losses: str, message: str
+) -> None:
+    text = EXAMPLE.read_text()
+    study = tmp_path / "lossy.toml"
+    study.write_text(text[: text.index("[losses]")] + losses)
+    rest = (
+        ["--amplitude", "0.3mm..3mm"]
+        if command == "modes"
+        else ["--from", "200Hz", "--to", "300Hz", "--method", "harmonic"]
+    )
+    code, _, err = run([command, str(study), *rest, "--out", str(tmp_path / "x.nc")], capsys)
+    assert code == 2
+    assert message in err
+    assert len(err.strip().splitlines()) == 1
+    for python_advice in ("friction=None", "restitution=1", "clearjoint.periodic", "region="):
+        assert python_advice not in err
+
+
+def test_structure_study_with_impacts_is_refused_in_cli_terms(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # impacts need rigid links (a member in series has no mass to stop)
+    study = _chain_study(tmp_path, restitution="restitution = 0.7\n", stiffness='"inf"')
+    for command, rest in (
+        ("modes", ["--amplitude", "1mm"]),
+        ("frf", ["--from", "50Hz", "--to", "52Hz", "--method", "harmonic"]),
+    ):
+        code, _, err = run([command, str(study), *rest, "--out", str(tmp_path / "x.nc")], capsys)
+        assert code == 2
+        assert "set restitution = 1" in err
+        assert "respond" in err
+        assert len(err.strip().splitlines()) == 1

@@ -153,3 +153,27 @@ def test_regularised_friction_against_exact_stick_slip_orbits(omega: float) -> N
     assert bool(fr.stable[0]) == exact.stable
     mu = float(np.max(np.abs(fr.multipliers[0])))
     assert mu == pytest.approx(float(np.max(np.abs(exact.multipliers))), rel=0.01)
+
+
+def test_stability_is_recomputed_where_the_continuation_kept_no_evaluation(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Stability reuses the continuation's evaluation at each point, or evaluates anew."""
+    import dataclasses
+
+    import clearjoint.harmonic.response as response
+
+    def run() -> FrequencyResponse:
+        return frequency_response(PYHARM, 0.03, 1.0, 1.2, harmonics=7, damping_ratio=PYHARM_ZETA)
+
+    kept = run()
+    real = response.continue_branch
+
+    def without_data(*args: object, **kwargs: object):  # type: ignore[no-untyped-def]
+        branch = real(*args, **kwargs)  # type: ignore[arg-type]
+        return dataclasses.replace(branch, data=[None] * len(branch.data))
+
+    monkeypatch.setattr(response, "continue_branch", without_data)
+    anew = run()
+    assert anew.omega.size == kept.omega.size
+    np.testing.assert_allclose(anew.multipliers, kept.multipliers, rtol=1e-12, atol=1e-15)

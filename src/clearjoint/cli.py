@@ -209,7 +209,9 @@ def _frf_parser(sub: Any) -> None:
             "Follow the exact period-1 orbit of the joint in STUDY.toml (joint, force, losses; "
             "its frequency is not used) by continuation from --from to --to, through folds; "
             "report folds, period doublings and grazings. With --parameter force, --from and "
-            "--to are forces and --frequency (default: the study's) is held fixed."
+            "--to are forces and --frequency (default: the study's) is held fixed. A structure "
+            "study (clearjoint structure's file: [structure], [joint], [excitation]) is followed "
+            "by harmonic balance (--method harmonic), with per-DOF extremes."
         ),
     )
     p.add_argument("study", help="study file (TOML), as for clearjoint simulate")
@@ -334,8 +336,10 @@ def _modes_parser(sub: Any) -> None:
         help="nonlinear mode: frequency and damping ratio against amplitude (EPMC)",
         description=(
             "Nonlinear mode of the joint in STUDY.toml (joint and losses; its excitation is "
-            "not used) by harmonic balance and the extended periodic motion concept, at "
-            "--points amplitudes spaced logarithmically over --amplitude."
+            "not used), or of the structure in a structure study, by harmonic balance and the "
+            "extended periodic motion concept, at --points amplitudes spaced logarithmically "
+            "over --amplitude (for a structure: on the DOF where the closed linear mode moves "
+            "most)."
         ),
     )
     p.add_argument("study", help="study file (TOML), as for clearjoint simulate")
@@ -877,7 +881,9 @@ def _run_frf(args: argparse.Namespace) -> int:
     from clearjoint.simulate.study import load_study
     from clearjoint.units import parse_quantity
 
-    study = load_study(args.study)
+    structure_study = _structure_study(args.study)
+    if structure_study is None:
+        study = load_study(args.study)
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     kind = "force" if args.parameter == "force" else "frequency"
@@ -891,6 +897,11 @@ def _run_frf(args: argparse.Namespace) -> int:
             f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
             "give two different values"
         )
+    if structure_study is not None:
+        curve = _frf_of_structure(args, structure_study, start, stop)
+        return _finish_frf(args, curve, structure_study.source, plot_path)
+    if args.method == "harmonic":
+        _harmonic_losses(study, args.study, "frf")
     losses: dict[str, Any] = {
         "damping_ratio": study.damping_ratio,
         "friction": study.friction,
@@ -932,8 +943,13 @@ def _run_frf(args: argparse.Namespace) -> int:
             max_points=args.max_points,
             **losses,
         )
+    return _finish_frf(args, curve, study.source, plot_path)
+
+
+def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Path | None) -> int:
+    """Write the curve (--out, --plot) and print it (--json or a summary)."""
     data = curve.to_xarray()
-    data.attrs["study"] = study.source
+    data.attrs["study"] = source
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     data.to_netcdf(args.out, engine="h5netcdf")
     _save_plot(curve, plot_path, quiet=True)
@@ -944,6 +960,8 @@ def _run_frf(args: argparse.Namespace) -> int:
             "the curve covers only part of the range",
             file=sys.stderr,
         )
+    source_system = curve.settings.get("system")
+    per_dof = curve.x_max.ndim == 2 and hasattr(source_system, "dof_names")
     if args.json:
         print(
             json.dumps(
@@ -954,6 +972,7 @@ def _run_frf(args: argparse.Namespace) -> int:
                     "x_max_m": curve.x_max.tolist(),
                     "x_min_m": curve.x_min.tolist(),
                     "stable": curve.stable.tolist(),
+                    **({"dofs": list(source_system.dof_names)} if per_dof else {}),
                     "events": [
                         {
                             "kind": e.kind,
@@ -967,7 +986,7 @@ def _run_frf(args: argparse.Namespace) -> int:
             )
         )
         return 0
-    lines = [f"study: {study.source}", repr(curve)]
+    lines = [f"study: {source}", repr(curve)]
     for e in curve.events:
         lines.append(
             f"{e.kind}: {e.omega / (2 * math.pi):.6g} Hz, {e.force_amplitude:.6g} N, "
@@ -976,6 +995,106 @@ def _run_frf(args: argparse.Namespace) -> int:
     lines.append(f"wrote {args.out}" + (f" and {args.plot}" if args.plot else ""))
     print("\n".join(lines))
     return 0
+
+
+def _structure_study(path: str) -> Any:
+    """The structure study in ``path`` (a file with a [structure] section), else None."""
+    from clearjoint.io_toml import read_toml
+    from clearjoint.simulate.study import StudyError
+
+    if "structure" not in read_toml(path, what="study", error=StudyError):
+        return None
+    from clearjoint.structure.study import load_structure_study
+
+    return load_structure_study(path)
+
+
+def _harmonic_losses(study: Any, path: str, command: str) -> None:
+    """Refuse, in CLI terms, the joint losses harmonic balance does not carry (``command``)."""
+    exact = {
+        "frf": "drop --method harmonic (exact shooting carries it)",
+        "modes": "follow the forced response instead with clearjoint frf STUDY (exact shooting)",
+    }[command]
+    if study.restitution != 1.0:
+        raise ParameterError(
+            f"{path}: [losses] restitution = {study.restitution:g} is an impact, which harmonic "
+            f"balance cannot carry; {exact}, or set restitution = 1"
+        )
+    friction = study.friction
+    if friction is None or friction.force <= 0.0:
+        return
+    if command == "modes":
+        raise ParameterError(
+            f"{path}: [losses] friction_coefficient = {friction.coefficient:g} with a lateral "
+            "load: nonlinear modes do not carry Coulomb friction yet; set friction_coefficient "
+            "= 0, or follow the forced response with clearjoint frf STUDY (exact stick-slip) or "
+            "clearjoint frf STUDY --method harmonic (regularised friction)"
+        )
+    if friction.region != "everywhere":
+        raise ParameterError(
+            f"{path}: [losses] friction_region = {friction.region!r} is not carried by harmonic "
+            f'balance; {exact}, or set friction_region = "everywhere"'
+        )
+
+
+def _structure_harmonic_check(study: Any, command: str) -> None:
+    """Refuse, in CLI terms, joints of a structure study that harmonic balance cannot carry."""
+    laws = study.structure.joint_laws
+    if any(law.restitution != 1.0 for law in laws):
+        value = next(law.restitution for law in laws if law.restitution != 1.0)
+        raise ParameterError(
+            f"{study.source}: [joint] restitution = {value:g} is an impact, which harmonic "
+            f"balance ({command}) cannot carry; set restitution = 1, or use clearjoint "
+            f"structure {study.source} respond for the exact motion with impacts"
+        )
+
+
+def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: float) -> Any:
+    """The frequency response of a structure study by harmonic balance (frf's work)."""
+    import math
+
+    from clearjoint import harmonic
+    from clearjoint.units import parse_quantity
+
+    if args.method != "harmonic":
+        raise ParameterError(
+            f"{study.source} is a structure study: its frequency response is computed by "
+            "harmonic balance; add --method harmonic"
+        )
+    if study.force is None:
+        raise ParameterError(
+            f"{study.source}: frf needs the [excitation] section (force_dof, force_amplitude; "
+            "frequency for --parameter force); put it in the study file"
+        )
+    _structure_harmonic_check(study, "frf")
+    h = 7 if args.harmonics is None else args.harmonics
+    if args.parameter == "force":
+        frequency = (
+            parse_quantity(args.frequency, "frequency", name="--frequency")
+            if args.frequency
+            else study.omega / (2.0 * math.pi)
+        )
+        pattern = study.force * (start / float(np.max(np.abs(study.force))))
+        return harmonic.frequency_response(
+            study.structure,
+            pattern,
+            2.0 * math.pi * frequency,
+            None,
+            harmonics=h,
+            parameter="force",
+            force_stop=stop,
+            max_points=args.max_points,
+        )
+    if args.frequency:
+        raise ParameterError("--frequency goes with --parameter force; drop it or add that")
+    return harmonic.frequency_response(
+        study.structure,
+        study.force,
+        2.0 * math.pi * start,
+        2.0 * math.pi * stop,
+        harmonics=h,
+        max_points=args.max_points,
+    )
 
 
 def _progress_bar(*columns: Any) -> Any:
@@ -1114,19 +1233,25 @@ def _run_modes(args: argparse.Namespace) -> int:
     from clearjoint.harmonic import nonlinear_modes
     from clearjoint.simulate.study import load_study
 
-    study = load_study(args.study)
+    structure_study = _structure_study(args.study)
+    study: Any = structure_study if structure_study is not None else load_study(args.study)
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     amplitudes = _amplitude_range(args.amplitude, args.points)
-    mode = nonlinear_modes(
-        study.joint,
-        args.mode,
-        amplitudes,
-        harmonics=args.harmonics,
-        damping_ratio=study.damping_ratio,
-        friction=study.friction,
-        restitution=study.restitution,
-    )
+    if structure_study is not None:
+        _structure_harmonic_check(study, "modes")
+        mode = nonlinear_modes(study.structure, args.mode, amplitudes, harmonics=args.harmonics)
+    else:
+        _harmonic_losses(study, args.study, "modes")
+        mode = nonlinear_modes(
+            study.joint,
+            args.mode,
+            amplitudes,
+            harmonics=args.harmonics,
+            damping_ratio=study.damping_ratio,
+            friction=study.friction,
+            restitution=study.restitution,
+        )
     data = mode.to_xarray()
     data.attrs["study"] = study.source
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)

@@ -265,7 +265,16 @@ def nonlinear_modes(
             jac[n_u + 1, 2 * n + ref] = 1.0
             return r, jac
 
-        found = newton(function, guess, 1.0)
+        def residual(z: FloatArray) -> FloatArray:
+            q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
+            ev = aft.evaluate(model, basis, q, w, zero_force, negative_damping=xi, jacobian=False)
+            r = np.empty(n_u + 2)
+            r[:n_u] = ev.residual / (k_ref * a)
+            r[n_u] = z[n + ref] - 1.0
+            r[n_u + 1] = z[2 * n + ref]
+            return r
+
+        found = newton(function, guess, 1.0, residual=residual)
         if found is None:
             return None
         z = found[0]

@@ -4,7 +4,9 @@ The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the for
 amplitude) by the same continuation as the exact shooting of
 :mod:`clearjoint.periodic`, and returned as the same
 :class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
-kept. Stability comes from Hill's method; events are located as in
+kept. Stability comes from Hill's method: for one DOF with constant damping from
+Hill's infinite determinant (one determinant per point), otherwise from the
+eigenvalues of Hill's quadratic eigenproblem; events are located as in
 :mod:`clearjoint.periodic`: folds where the parameter component of the tangent
 changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
 through -1), grazings where a joint's extreme relative displacement crosses a gap
@@ -141,7 +143,9 @@ def frequency_response(
     q0 = _start(model, basis, w0, pattern, k_ref)
     x_scale = max(0.5 * scale_length(model), float(np.max(np.abs(q0))))
 
-    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
+    def residual(
+        u: FloatArray, lam: float
+    ) -> tuple[FloatArray, FloatArray, FloatArray, aft.Evaluation]:
         if not lam > 0.0:
             raise HarmonicError(f"the parameter left the positive range ({lam!r})")
         w, f = at(lam)
@@ -151,7 +155,7 @@ def frequency_response(
         else:
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
-        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, None
+        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev
 
     branch = continue_branch(
         residual,
@@ -173,6 +177,7 @@ def frequency_response(
         basis,
         branch.u,
         branch.lam,
+        branch.data,
         parameter,
         w0,
         pattern,
@@ -240,6 +245,7 @@ def _response(
     basis: aft.Basis,
     u: FloatArray,
     lam: FloatArray,
+    evaluations: list[aft.Evaluation],
     parameter: str,
     w0: float,
     pattern: FloatArray,
@@ -260,11 +266,20 @@ def _response(
     rel = np.einsum("pcn,jn->cpj", coef, b).reshape(n_c, -1)
     d_max, d_min = (v.reshape(n_pts, b.shape[0]) for v in basis.extremes(rel))
     multipliers = np.empty((n_pts, 2 * n), dtype=np.complex128)
+    determinant = n == 1 and model.friction_force is None
+    jacobians = np.empty((n_pts, n_c, n_c)) if determinant else None
     for i in range(n_pts):
-        f = pattern if parameter == "omega" else force[i] * unit_force
-        ev = aft.evaluate(model, basis, u[i], float(omega[i]), f)
+        ev = evaluations[i] if i < len(evaluations) else None
+        if not isinstance(ev, aft.Evaluation):  # a point the continuation did not evaluate
+            f = pattern if parameter == "omega" else force[i] * unit_force
+            ev = aft.evaluate(model, basis, u[i], float(omega[i]), f)
+        if jacobians is not None:  # one DOF, constant damping: Hill's determinant
+            jacobians[i] = ev.jacobian
+            continue
         lam_i = aft.hill_exponents(model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent)
         multipliers[i] = aft.hill_multipliers(lam_i, float(omega[i]))
+    if jacobians is not None:
+        multipliers[:] = aft.hill_determinant_multipliers(model, basis, jacobians, omega)
     stable = np.max(np.abs(multipliers), axis=1) < 1.0
     amplitude = 0.5 * (x_max - x_min)
     x0 = coef[:, 0, :] + coef[:, 1::2, :].sum(axis=1)

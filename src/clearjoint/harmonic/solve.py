@@ -20,6 +20,36 @@ FloatArray = NDArray[np.float64]
 #: Converged when max abs(R) / (k_ref x_scale) is below this.
 TOLERANCE = 1e-11
 
+#: Newton's linear solves use a sparse LU (scipy's splu) above this many unknowns. A
+#: structure's HB Jacobian holds N x N blocks only where D or a joint couples two
+#: harmonics, a few % of its entries for the mast; below this size the dense LU is faster
+#: (``python benchmarks/bench_harmonic.py --mast`` times both).
+SPARSE_ABOVE = 400
+
+
+def linear_solve(jacobian: FloatArray, rhs: FloatArray) -> FloatArray:
+    """Solve jacobian x = rhs: dense LU, or sparse LU above :data:`SPARSE_ABOVE` unknowns.
+
+    A singular matrix falls back to least squares (dense) in both cases.
+    """
+    if jacobian.shape[0] > SPARSE_ABOVE:
+        import scipy.sparse
+        import scipy.sparse.linalg
+
+        try:
+            lu = scipy.sparse.linalg.splu(scipy.sparse.csc_matrix(jacobian))
+            x = lu.solve(rhs)
+            if np.all(np.isfinite(x)):
+                return np.asarray(x, dtype=np.float64)
+        except RuntimeError:  # "Factor is exactly singular"
+            pass
+    else:
+        try:
+            return np.asarray(np.linalg.solve(jacobian, rhs), dtype=np.float64)
+        except np.linalg.LinAlgError:
+            pass
+    return np.asarray(np.linalg.lstsq(jacobian, rhs, rcond=None)[0], dtype=np.float64)
+
 
 def linear_guess(
     system: LinearSystem, basis: Basis, omega: float, force: FloatArray, stiffness: FloatArray
@@ -44,11 +74,14 @@ def newton(
     scale: float,
     *,
     max_iterations: int = 80,
+    residual: Callable[[FloatArray], FloatArray] | None = None,
 ) -> tuple[FloatArray, int] | None:
     """Damped Newton on a dimensionless residual: ``function(q) -> (R, dR/dq)``.
 
     Steps are halved (up to 12 times) until max abs(R) falls; ``scale`` (m) makes q
-    dimensionless in the convergence test. Returns (q, iterations) or None.
+    dimensionless in the convergence test. ``residual(q) -> R``, if given, is used
+    for the halved trial steps (no Jacobian needed there). Returns (q, iterations)
+    or None.
     """
     q = q0.copy()
     r, jac = function(q)
@@ -58,17 +91,20 @@ def newton(
             return None
         if size <= TOLERANCE * scale:
             return q, iteration
-        try:
-            dq = np.linalg.solve(jac, -r)
-        except np.linalg.LinAlgError:
-            dq = np.linalg.lstsq(jac, -r, rcond=None)[0]
+        dq = linear_solve(jac, -r)
         step = 1.0
+        jac_t: FloatArray | None = None
         for _ in range(13):
             trial = q + step * dq
-            r_t, jac_t = function(trial)
+            if step == 1.0 or residual is None:
+                r_t, jac_t = function(trial)
+            else:
+                r_t, jac_t = residual(trial), None
             size_t = float(np.max(np.abs(r_t)))
             if size_t < size or size_t <= TOLERANCE * scale:
                 break
             step *= 0.5
+        if jac_t is None:
+            r_t, jac_t = function(trial)
         q, r, jac, size = trial, r_t, jac_t, size_t
     return (q, max_iterations) if size <= TOLERANCE * scale else None

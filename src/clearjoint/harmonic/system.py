@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import _checks
+from clearjoint._jit import njit  # numba.njit that survives a read-only install
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
 from clearjoint.joint import ClearanceJoint, Friction, Joint
 from clearjoint.stiffness import viscous_coefficient
@@ -93,13 +94,7 @@ class LinearSystem:
 
     def joint_forces(self, delta: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Return f_j(delta) (N) and df_j/d delta (N/m) for samples ``delta`` (N_t, n_j)."""
-        over = delta - self.g_c
-        under = delta + self.g_t
-        force = (
-            self.k0 * delta + self.k_c * np.maximum(over, 0.0) + self.k_t * np.minimum(under, 0.0)
-        )
-        tangent = self.k0 + self.k_c * (over > 0.0) + self.k_t * (under < 0.0)
-        return force, tangent
+        return _law(np.ascontiguousarray(delta), self.k0, self.k_c, self.k_t, self.g_c, self.g_t)
 
     def friction_forces(self, speed: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Return mu_s P tanh(v / v_eps) (N) and its derivative in v (N s/m), samples (N_t, n_j)."""
@@ -109,6 +104,34 @@ class LinearSystem:
             self.friction_force * ratio,
             (self.friction_force / self.friction_speed) * (1.0 - ratio * ratio),
         )
+
+
+@njit(cache=True)
+def _law(
+    delta: FloatArray,
+    k0: FloatArray,
+    k_c: FloatArray,
+    k_t: FloatArray,
+    g_c: FloatArray,
+    g_t: FloatArray,
+) -> tuple[FloatArray, FloatArray]:
+    """The piecewise-linear law of section 0 and its tangent, sample by sample (compiled)."""
+    force = np.empty_like(delta)
+    tangent = np.empty_like(delta)
+    for n in range(delta.shape[0]):
+        for j in range(delta.shape[1]):
+            d = delta[n, j]
+            f = k0[j] * d
+            k = k0[j]
+            if d > g_c[j]:
+                f += k_c[j] * (d - g_c[j])
+                k += k_c[j]
+            if d < -g_t[j]:
+                f += k_t[j] * (d + g_t[j])
+                k += k_t[j]
+            force[n, j] = f
+            tangent[n, j] = k
+    return force, tangent
 
 
 def _refuse_losses(
