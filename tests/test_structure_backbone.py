@@ -9,7 +9,7 @@ import pytest
 
 from clearjoint import ClearanceJoint, Joint
 from clearjoint.stiffness import natural_frequency
-from clearjoint.structure import StructureError, chain, decay_backbone, free_decay
+from clearjoint.structure import StructureError, chain, decay_backbone, free_decay, time_response
 
 
 def test_linear_decay_gives_its_damped_frequency_and_damping_ratio() -> None:
@@ -57,3 +57,16 @@ def test_backbone_result_has_short_repr_and_xarray() -> None:
     backbone = decay_backbone(decay, 0)
     assert "cycles" in repr(backbone)
     assert backbone.to_xarray()["omega"].attrs["units"] == "rad/s"
+
+
+def test_a_forced_motion_is_refused_not_read_as_a_decay() -> None:
+    """The decrement of a forced response is no damping ratio: refused with the fix."""
+    one = chain([2.0], [1e6], dampers=[10.0])
+    forced = time_response(one, [1.0], 700.0, 0.1)
+    assert forced.energy.input != 0.0
+    with pytest.raises(StructureError, match=r"was forced .* use structure.free_decay") as info:
+        decay_backbone(forced, 0)
+    assert "\n" not in str(info.value)
+    # the same call on the free decay of the same structure is read
+    free = free_decay(one, ([1e-3], [0.0]), 0.1)
+    assert decay_backbone(free, 0).amplitude.size > 5

@@ -111,6 +111,15 @@ def test_bad_motion_input_is_refused_with_one_line() -> None:
         time_response(s, [1.0, 2.0], 100.0, 0.01)
     with pytest.raises(StructureError, match="initial must be"):
         free_decay(s, np.zeros(5), 0.01)
+    one = chain([1.0], [1e6])
+    # a scalar is not "1 entry" of a 1-DOF structure: the message names the shape it got
+    with pytest.raises(
+        StructureError,
+        match=r"force must be a 1-D array of 1 value per DOF \(n1x\), got shape \(\)",
+    ):
+        time_response(one, 1.0, 100.0, 0.01)
+    with pytest.raises(StructureError, match=r"initial u0 must be a 1-D array .* got shape \(\)"):
+        free_decay(one, [1e-3, 0.0], 0.01)
     rub = ClearanceJoint(1e-4, 8e7, friction=Friction(0.1, 100.0))
     with pytest.raises(StructureError, match="Coulomb friction in a joint of a structure"):
         free_decay(chain([1.0], [math.inf], [rub]), ([1e-4], [0.0]), 0.01)

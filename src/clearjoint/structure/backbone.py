@@ -132,7 +132,8 @@ def decay_backbone(motion: StructureMotion, dof: int, mode: int | None = None) -
     Parameters
     ----------
     motion : StructureMotion
-        A free decay (``free_decay``), sampled finely enough to resolve each cycle.
+        A free decay (``free_decay``), sampled finely enough to resolve each cycle; a
+        forced motion (input work not 0) is refused.
     dof : int
         The DOF whose displacement is measured (index into ``structure.dof_names``).
     mode : int, optional
@@ -144,6 +145,11 @@ def decay_backbone(motion: StructureMotion, dof: int, mode: int | None = None) -
     Backbone
     """
     s = motion.structure
+    if motion.energy.input != 0.0:  # a forced response's decrement is no damping ratio
+        raise StructureError(
+            f"decay_backbone reads a free decay, but this motion was forced (input work "
+            f"{motion.energy.input:.3g} J); use structure.free_decay for the ring-down"
+        )
     if isinstance(dof, bool) or not isinstance(dof, int | np.integer) or not 0 <= dof < s.n_dof:
         raise StructureError(f"dof must be an index from 0 to {s.n_dof - 1}, got {dof!r}")
     u = motion.u[:, dof]

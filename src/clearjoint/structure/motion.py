@@ -241,8 +241,13 @@ class StructureMotion:
 def _vector(name: str, value: ArrayLike, structure: Structure) -> FloatArray:
     array = np.asarray(value, dtype=np.float64)
     n = structure.n_dof
-    if array.ndim != 1 or array.size != n:
-        names = ", ".join(structure.dof_names[:4]) + (", ..." if n > 4 else "")
+    names = ", ".join(structure.dof_names[:4]) + (", ..." if n > 4 else "")
+    if array.ndim != 1:  # a scalar or a table is not "n entries": name its shape
+        raise StructureError(
+            f"{name} must be a 1-D array of {n} value{'s' if n > 1 else ''} per DOF ({names}), "
+            f"got shape {array.shape}"
+        )
+    if array.size != n:
         raise StructureError(
             f"{name} has {array.size} entries but the structure has {n} DOF ({names}); "
             f"give one value per DOF"
