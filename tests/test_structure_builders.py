@@ -76,3 +76,21 @@ def test_mast_has_two_hinged_longerons_per_bay_and_bends_first() -> None:
     assert abs(tip[0]) > 5.0 * abs(tip[1])  # the first mode sways sideways
     with pytest.raises(StructureError, match="one per longeron"):
         mast(2, joints=[hinge] * 3)
+
+
+def test_mast_takes_its_own_joint_per_longeron_in_order() -> None:
+    from clearjoint.structure import mast
+
+    own = [ClearanceJoint(c, 5e7, gap_stiffness=1e5) for c in (10e-6, 20e-6, 30e-6, 40e-6)]
+    tower = mast(2, joints=own)
+    # bay 1 left, bay 1 right, bay 2 left, bay 2 right: members 0, 1, 4, 5
+    assert tower.joint_members == (0, 1, 4, 5)
+    given = [tower.members[i].joint for i in tower.joint_members]
+    assert given == own
+    # in series with the longeron (k_m = EA / h = 4e7 N/m), the gap grows by 1 + k0 / k_m
+    clearances = [law.clearance for law in tower.joint_laws]
+    np.testing.assert_allclose(clearances, np.array([1, 2, 3, 4]) * 1e-5 * (1 + 1e5 / 4e7))
+    same = mast(2, joints=[own[0]] * 4)
+    np.testing.assert_array_equal(
+        same.modes("closed").omega, mast(2, joints=own[0]).modes("closed").omega
+    )

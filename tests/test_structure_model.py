@@ -126,3 +126,28 @@ def test_rayleigh_takes_alpha_as_a_rate_and_beta_as_a_time_with_units() -> None:
         Structure(nodes, [0.0, 2.0], member, supports=(0,), rayleigh=("20Hz", 0.0))
     with pytest.raises(StructureError, match=r"rayleigh must be \(alpha, beta\)"):
         Structure(nodes, [0.0, 2.0], member, supports=(0,), rayleigh=0.5)  # type: ignore[arg-type]
+
+
+def test_a_3d_node_on_three_skew_orthogonal_members_has_their_three_frequencies() -> None:
+    """3-D: K = sum k_i e_i e_i^T for orthonormal e_i, so omega_i = sqrt(k_i / m) exactly."""
+    q, _ = np.linalg.qr(np.array([[1.0, 2.0, 0.5], [-0.3, 1.0, 2.0], [0.7, -1.0, 1.5]]))
+    k, m = np.array([1e6, 4e6, 9e6]), 2.5
+    nodes = np.vstack(([0.0, 0.0, 0.0], -q.T))  # node 0 free, supports at -e_i
+    members = tuple(Member(i + 1, 0, stiffness=float(k[i])) for i in range(3))
+    node = Structure(nodes, [m, 0.0, 0.0, 0.0], members, supports=(1, 2, 3))
+    assert node.dim == 3
+    assert node.dof_names == ["n0x", "n0y", "n0z"]
+    np.testing.assert_allclose(node.modes().omega, np.sqrt(k / m), rtol=1e-12)
+    # each shape lies along its member (up to sign), normalised to phi^T M phi = 1
+    shapes = node.modes().shapes * math.sqrt(m)
+    np.testing.assert_allclose(np.abs(np.sum(shapes * q, axis=0)), 1.0, rtol=1e-12)
+    # open, a joint (k0 = 0) in series with member 3 takes that member out: omega_3 = 0
+    joint = ClearanceJoint(1e-4, 1e12)
+    jointed = Structure(
+        nodes,
+        [m, 0.0, 0.0, 0.0],
+        (*members[:2], Member(3, 0, stiffness=float(k[2]), joint=joint)),
+        supports=(1, 2, 3),
+    )
+    open_omega = jointed.modes("open").omega
+    np.testing.assert_allclose(open_omega, [0.0, *np.sqrt(k[:2] / m)], atol=1e-6)

@@ -187,3 +187,25 @@ def test_a_small_mast_with_rayleigh_damping_matches_solve_ivp_event_for_event() 
     assert np.max(np.abs(mine.u - u)) <= 1e-9 * np.max(np.abs(u))
     assert np.max(np.abs(mine.v - v)) <= 1e-9 * np.max(np.abs(v))
     assert mine.balance_error < 1e-9
+
+
+def test_a_3d_node_with_a_joint_matches_solve_ivp_event_for_event() -> None:
+    """3-D: a mass on three skew members, a joint (k0 = 0, off-centre) in one, forced off-axis."""
+    from clearjoint.structure import Member, Structure
+
+    q, _ = np.linalg.qr(np.array([[1.0, 2.0, 0.5], [-0.3, 1.0, 2.0], [0.7, -1.0, 1.5]]))
+    hinge = ClearanceJoint(1e-4, 5e7, gap_offset=3e-5)
+    members = (
+        Member(1, 0, stiffness=1e6, damping=5.0),
+        Member(2, 0, stiffness=4e6),
+        Member(3, 0, stiffness=9e6, joint=hinge),
+    )
+    s = Structure(np.vstack(([0.0, 0.0, 0.0], -q.T)), [2.5, 0, 0, 0], members, supports=(1, 2, 3))
+    force = 300.0 * np.array([0.2, -0.5, 1.0])
+    omega = 0.8 * float(s.modes("closed").omega[2])
+    mine = time_response(s, force, omega, 4 * 2.0 * math.pi / omega, samples_per_period=32)
+    u, v, events = reference_response(s, force, omega, mine.t)
+    assert mine.events == events > 4
+    assert np.max(np.abs(mine.u - u)) <= 1e-9 * np.max(np.abs(u))
+    assert np.max(np.abs(mine.v - v)) <= 1e-9 * np.max(np.abs(v))
+    assert mine.balance_error < 1e-9
