@@ -104,6 +104,10 @@ def test_member_directions_in_2d_give_the_textbook_stiffness() -> None:
             "restitution 0.5 on a joint in series with a member",
         ),
         (lambda: chain([1.0], [math.inf]), "member 0 (nodes 0-1) is rigid and has no joint"),
+        (
+            lambda: Structure([0.0, 1.0], [0, 1], (Member(0, 1, stiffness=1e6),), (0, 0)),
+            "support 0 is listed twice; list each support once",
+        ),
     ],
 )
 def test_bad_structures_are_refused_with_one_line_naming_the_item(build, message) -> None:  # type: ignore[no-untyped-def]

@@ -106,6 +106,10 @@ def test_cli_decay_text_says_n_a_for_the_last_cycle_without_a_damping_ratio(
         (('initial_amplitude = "0.5mm"', 'initial_amplitude = "0mm"'), "must be finite and not 0"),
         (('duration = "20ms"', 'duration = "0ms"'), "duration must be finite and > 0"),
         (("[decay]", "[decays]"), "unknown section [decays]"),
+        (
+            ("[decay]", "[output]\nsamples_per_period = 4\n[decay]"),
+            "[output] samples_per_period must be at least 8, got 4",
+        ),
     ],
 )
 def test_cli_bad_study_is_one_line_and_exit_2(

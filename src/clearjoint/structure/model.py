@@ -228,6 +228,9 @@ class Structure:
             )
         set_(self, "masses", masses)
         supports = tuple(self._node("support", s, n_nodes) for s in self.supports)
+        twice = sorted({s for s in supports if supports.count(s) > 1})
+        if twice:  # harmless to the matrices, but a typo for another node more often than not
+            raise StructureError(f"support {twice[0]} is listed twice; list each support once")
         set_(self, "supports", supports)
         for i in range(n_nodes):
             if i not in supports and not (math.isfinite(masses[i]) and masses[i] > 0.0):

@@ -422,6 +422,11 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
             )
         initial = de["initial_amplitude"] * shape / shape[decay_dof]
         duration = de["duration"]
+    samples = values.get("output", {}).get("samples_per_period", 64)
+    if samples < 8:  # time_response would refuse it without naming the file and section
+        raise StructureStudyError(
+            f"{where}: [output] samples_per_period must be at least 8, got {samples}"
+        )
     return StructureStudy(
         structure=structure,
         omega=omega,
@@ -430,6 +435,6 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
         decay_dof=decay_dof,
         decay_initial=initial,
         decay_duration=duration,
-        samples_per_period=values.get("output", {}).get("samples_per_period", 64),
+        samples_per_period=samples,
         source=where,
     )
