@@ -64,6 +64,17 @@ def test_large_structures_return_sparse_matrices_and_eigsh_agrees_with_dense() -
     np.testing.assert_allclose(low, dense, rtol=1e-9)
 
 
+def test_sparse_modes_of_an_open_mechanism_give_its_zero_frequency() -> None:
+    """k0 = 0 and every joint open: K is singular, so no shift-invert about 0 (it raised)."""
+    n = 240
+    free = chain(np.full(n, 0.1), np.full(n, 1e6), [ClearanceJoint(1e-4, 1e7)] + [None] * (n - 1))
+    low = free.modes("open", count=3).omega
+    k_open = free.stiffness_matrix("open").toarray()
+    dense = np.sqrt(np.clip(np.sort(np.linalg.eigvalsh(k_open / 0.1))[:3], 0.0, None))
+    assert low[0] <= 1e-6 * low[1]  # the free chain's rigid-body mode
+    np.testing.assert_allclose(low[1:], dense[1:], rtol=1e-9)
+
+
 def test_member_directions_in_2d_give_the_textbook_stiffness() -> None:
     # a node held by two perpendicular members at +-45 deg: K = k I, so w = sqrt(k/m) twice
     nodes = [[0.0, 0.0], [-1.0, -1.0], [1.0, -1.0]]

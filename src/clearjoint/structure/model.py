@@ -479,8 +479,11 @@ class Structure:
         if count is not None and (not isinstance(count, int) or count < 1):
             raise StructureError(f"count must be a positive integer, got {count!r}")
         if n > SPARSE_ABOVE and count is not None and count < n - 1:
+            # shift-invert just below 0: an open pattern with k0 = 0 has a singular K, so
+            # K - 0 M cannot be factorised; K + s M (s > 0, far below the spectrum) can
+            shift = 1e-9 * float(np.max(np.diag(k) / m))
             w2, shapes = scipy.sparse.linalg.eigsh(
-                scipy.sparse.csr_matrix(k), k=count, M=scipy.sparse.diags(m), sigma=0.0
+                scipy.sparse.csc_matrix(k), k=count, M=scipy.sparse.diags(m), sigma=-shift
             )
             order = np.argsort(w2)
             w2, shapes = w2[order], shapes[:, order]
