@@ -209,3 +209,24 @@ def test_a_3d_node_with_a_joint_matches_solve_ivp_event_for_event() -> None:
     assert np.max(np.abs(mine.u - u)) <= 1e-9 * np.max(np.abs(u))
     assert np.max(np.abs(mine.v - v)) <= 1e-9 * np.max(np.abs(v))
     assert mine.balance_error < 1e-9
+
+
+def test_too_many_events_is_an_error_not_a_truncated_motion(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The event cap ends the run with SimulationError naming the joint, never a short result."""
+    from clearjoint.errors import ClearjointError
+    from clearjoint.simulate import SimulationError
+    from clearjoint.structure import motion
+
+    s = _three_links()
+    omega = 0.9 * float(s.modes("closed").omega[0])
+    args = (s, [500.0, -300.0, 800.0], omega, 2 * 2.0 * math.pi / omega)
+    assert time_response(*args).events > 3  # the same run, uncapped, has events
+    monkeypatch.setattr(motion, "MAX_EVENTS_PER_STEP", 0)  # cap: no event at all
+    with pytest.raises(
+        SimulationError, match=r"more than 0 gap-edge events .* at joint \d"
+    ) as info:
+        time_response(*args)
+    assert isinstance(info.value, ClearjointError)
+    assert "\n" not in str(info.value)
