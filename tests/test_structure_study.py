@@ -476,3 +476,30 @@ def test_a_structure_key_of_another_kind_is_refused_not_dropped(
 ) -> None:
     with pytest.raises(StructureStudyError, match=message):
         load_structure_study(_write(tmp_path, text))
+
+
+def test_cli_decay_reads_the_backbone_of_the_study_mode(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import numpy as np
+
+    from clearjoint.structure import decay_backbone, free_decay
+
+    path = _write(tmp_path)
+    out = tmp_path / "decay.nc"
+    assert main(["structure", str(path), "decay", "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    study = load_structure_study(path)
+    assert study.decay_mode == 1
+    assert study.decay_initial is not None
+    assert study.decay_duration is not None
+    motion = free_decay(
+        study.structure,
+        (study.decay_initial, np.zeros(2)),
+        study.decay_duration,
+        samples_per_period=64,
+    )
+    on_mode = decay_backbone(motion, 1, mode=1).amplitude
+    raw = decay_backbone(motion, 1).amplitude
+    assert np.allclose(summary["amplitude_m"], on_mode, rtol=1e-12)
+    assert not np.allclose(on_mode, raw, rtol=1e-6)  # the projection is not a no-op here

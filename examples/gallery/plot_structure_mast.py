@@ -58,7 +58,7 @@ ax.set_title("free decay of the tip from 3 mm along closed mode 1")
 fig.tight_layout()
 DOCS_FIGURES["structure_decay.png"] = fig
 
-backbone = decay_backbone(decay, tip)
+backbone = decay_backbone(decay, tip, mode=1)  # the tip's share of closed mode 1
 print(repr(backbone))
 fig, ax = plt.subplots(figsize=(6, 4))
 backbone.plot(ax)

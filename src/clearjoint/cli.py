@@ -1342,7 +1342,7 @@ def _run_structure(args: argparse.Namespace) -> int:
             study.decay_duration,
             samples_per_period=max(study.samples_per_period, 64),
         )
-        backbone = decay_backbone(motion, int(study.decay_dof or 0))
+        backbone = decay_backbone(motion, int(study.decay_dof or 0), mode=study.decay_mode)
         data = xr.merge([motion.to_xarray(), backbone.to_xarray()], combine_attrs="drop_conflicts")
         summary |= {
             "events": motion.events,

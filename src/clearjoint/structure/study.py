@@ -27,7 +27,7 @@ Example (a 10-bay mast)::
     force_amplitude = "20N"
     periods = 50
 
-    [decay]                  # for "decay": deflect along closed mode 1
+    [decay]                  # for "decay": deflect along closed mode 1, read its backbone
     dof = "n21x"
     initial_amplitude = "3mm"
     mode = 1
@@ -153,6 +153,7 @@ class StructureStudy:
     decay_duration: float | None
     samples_per_period: int
     source: str
+    decay_mode: int | None = None
 
 
 def _unit_kind(kind: str) -> str:
@@ -392,7 +393,7 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
         force = np.zeros(structure.n_dof)
         force[dof_index("excitation", ex["force_dof"])] = ex["force_amplitude"]
     de = values.get("decay", {})
-    decay_dof = initial = duration = None
+    decay_dof = initial = duration = mode = None
     if de:
         for key in ("dof", "initial_amplitude", "duration"):
             if key not in de:
@@ -437,4 +438,5 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
         decay_duration=duration,
         samples_per_period=samples,
         source=where,
+        decay_mode=mode,
     )
