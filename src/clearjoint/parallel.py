@@ -259,11 +259,16 @@ _DONE = "chunk_done"
 
 @dataclass(frozen=True)
 class Variable:
-    """One array of a store: its name, numpy dtype ('f8', 'i8' or 'str') and attributes."""
+    """One array of a store: its name, numpy dtype ('f8', 'i8' or 'str') and attributes.
+
+    ``shape`` is what each point holds beyond the ``point`` dimension: () for one
+    value, (n,) for n values (a per-joint draw: dimension ``joint``).
+    """
 
     name: str
     dtype: str
     attrs: Mapping[str, Any]
+    shape: tuple[int, ...] = ()
 
 
 class ResultStore:
@@ -319,11 +324,11 @@ class ResultStore:
             fill: Any = "" if var.dtype == "str" else (np.nan if var.dtype == "f8" else 0)
             array = group.create_array(
                 var.name,
-                shape=(n_points,),
-                chunks=(chunk_size,),
+                shape=(n_points, *var.shape),
+                chunks=(chunk_size, *var.shape),
                 dtype=kind,
                 fill_value=fill,
-                dimension_names=["point"],
+                dimension_names=["point", *("joint",) * len(var.shape)],
             )
             array.attrs.update(dict(var.attrs))
         group.create_array(
