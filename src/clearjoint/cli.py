@@ -1012,6 +1012,11 @@ def _run_sweep(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .zarr, got {args.out!r}")
     if args.scheduler and args.workers is not None:
         raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    if Path(args.out).exists() and not (args.resume or args.force):
+        raise OutputExistsError(
+            f"will not overwrite {args.out}; pass --resume to finish it, --force to start "
+            "again, or choose another --out"
+        )
     start = time.perf_counter()
     with contextlib.ExitStack() as stack:
         if args.scheduler:  # an unreachable scheduler is said first, within seconds

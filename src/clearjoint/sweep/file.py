@@ -265,6 +265,11 @@ def _read_axis(where: str, name: str, raw: Any, p: Parameter) -> Axis:
             raise SweepError(f"{where}: {key} num must be a whole number, got {num!r}")
         start = _quantity(where, key, raw["start"], p)
         stop = _quantity(where, key, raw["stop"], p)
+        if num > 1 and start == stop:
+            raise SweepError(
+                f"{where}: {key} start and stop are equal ({start:g} {p.unit}), so its "
+                f"{num} points would all be the same; give a wider range, or num = 1"
+            )
         spacing = raw.get("spacing", "linear")
         if spacing == "log":
             if start <= 0 or stop <= 0:
@@ -279,6 +284,11 @@ def _read_axis(where: str, name: str, raw: Any, p: Parameter) -> Axis:
     if not values:
         raise SweepError(f"{where}: {key} has no values; give at least one")
     array = np.asarray(values, dtype=np.float64)
+    if np.unique(array).size < array.size:
+        raise SweepError(
+            f"{where}: {key} repeats a value (points that would all be the same); "
+            "give each value once"
+        )
     _check_range(where, key, array, p, "change the axis")
     return Axis(name, tuple(float(v) for v in array), p.unit)
 
