@@ -479,6 +479,9 @@ def test_the_shipped_sweep_files_read() -> None:
     tolerance = Sweep.from_toml(examples / "tolerance.toml")
     assert tolerance.shape == (1000, 2)
     assert tolerance.drawn()["joint.clearance"].min() > 0.0
+    mast = Sweep.from_toml(examples / "mast_tolerance_sweep.toml")
+    assert mast.shape == (1000, 2)
+    assert mast.drawn()["joint.clearance"].shape == (1000, 20)
 
 
 def test_the_sweep_file_in_the_docs_reads(tmp_path: Path) -> None:

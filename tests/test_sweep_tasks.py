@@ -261,3 +261,31 @@ per_joint = true
                 continue
             assert results.frequency_hz.values[s, i] == fresh["frequency_hz"]
             assert results.damping_ratio.values[s, i] == fresh["damping_ratio"]
+
+
+def test_the_committed_mast_tolerance_results_come_from_the_shipped_sweep_file() -> None:
+    # examples/mast_tolerance_sweep.nc (drawn by the gallery) is this sweep file's output:
+    # the same hash and draws, and a sample's values are those of a direct call on a mast
+    # built by hand with that sample's 20 clearances (clearjoint.structure.mast)
+    import xarray as xr
+
+    from clearjoint import ClearanceJoint
+    from clearjoint.harmonic import nonlinear_modes
+    from clearjoint.structure import mast
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    sweep = Sweep.from_toml(examples / "mast_tolerance_sweep.toml")
+    results = xr.load_dataset(examples / "mast_tolerance_sweep.nc", engine="h5netcdf")
+    assert results.attrs["clearjoint_sweep_fingerprint"] == sweep.fingerprint
+    drawn = sweep.drawn()["joint.clearance"]
+    done = results.status.values[:, 0] != ""
+    assert done.sum() >= 200
+    np.testing.assert_array_equal(results["joint.clearance"].values[done], drawn[done])
+    s = int(np.flatnonzero(done)[-1])
+    joints = [ClearanceJoint(c, 5e7, gap_stiffness=1e5) for c in drawn[s]]
+    by_hand = mast(10, joints=joints, rayleigh=(0.0, 2e-6))
+    mode = nonlinear_modes(by_hand, 1, [0.01, 0.03], harmonics=3)
+    np.testing.assert_allclose(
+        results.frequency_hz.values[s], mode.frequency / (2 * math.pi), rtol=1e-9
+    )
+    np.testing.assert_allclose(results.damping_ratio.values[s], mode.damping_ratio, rtol=1e-7)
