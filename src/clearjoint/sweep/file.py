@@ -2,7 +2,8 @@
 
 The format (docs/sweep.md; an example in examples/sweep.toml)::
 
-    base = "study.toml"          # a study, a rig campaign or a glob of records; relative here
+    base = "study.toml"          # a study, a structure study, a rig campaign or a glob of
+                                 # records; relative to this file
     seed = 2026                  # the draws and every point's own seed
     samples = 200                # Monte Carlo samples (the `sample` dimension)
     chunk_size = 16              # points per task chunk and per zarr chunk

@@ -1,10 +1,11 @@
 """What a sweep computes at each point: the task registry and the joint tasks.
 
-A :class:`Task` names its base (a ``study`` file of ``clearjoint simulate`` or a rig
-``campaign``), the parameters a sweep may vary or fix, its outputs with their units,
-and ``evaluate(base, values, seed)``: a pure, module-level function of frozen values
-that returns one float per output (it runs on Dask workers). The physics is the
-library's; this module only maps a point's values onto it:
+A :class:`Task` names its base (a ``study`` file of ``clearjoint simulate``, a
+``structure`` study of ``clearjoint structure``, a rig ``campaign`` or ``records``), the
+parameters a sweep may vary or fix, its outputs with their units, and ``evaluate(base,
+values, seed)``: a pure, module-level function of frozen values that returns one float
+per output (it runs on Dask workers). The physics is the library's; this module only
+maps a point's values onto it:
 
 * ``steady_state``: the exact steady cycle of the forced joint (clearjoint.simulate,
   MODEL.md sec. 2): amplitude, extremes, penetrations and the energy ledger per period;
@@ -639,26 +640,26 @@ class _LastLadder:
     """
 
     def __init__(self) -> None:
-        self.base: Any = None
-        self.key: tuple[Any, ...] = ()
-        self.mode: Any = None
+        # one tuple, replaced whole: threads of one worker never see half of another's
+        self._kept: tuple[Any, tuple[Any, ...], Any] = (None, (), None)
 
     def find(self, base: Any, key: tuple[Any, ...], ladder: Any) -> tuple[Any, int]:
         """Return (the kept NonlinearMode, the index of ``ladder[0]`` in it), or (None, 0)."""
-        if self.mode is None or base is not self.base or key != self.key:
+        kept_base, kept_key, mode = self._kept
+        if mode is None or base is not kept_base or key != kept_key:
             return None, 0
-        kept = self.mode.amplitude
+        kept = mode.amplitude
         hits = np.flatnonzero(kept == ladder[0])
         if hits.size != 1:
             return None, 0
         above = kept[kept > ladder[0]]
         if above.shape != ladder[1:].shape or not np.array_equal(above, ladder[1:]):
             return None, 0
-        return self.mode, int(hits[0])
+        return mode, int(hits[0])
 
     def keep(self, base: Any, key: tuple[Any, ...], mode: Any) -> None:
         """Keep ``mode`` (holding ``base`` so that its identity stays unique)."""
-        self.base, self.key, self.mode = base, key, mode
+        self._kept = (base, key, mode)
 
 
 _LAST_LADDER = _LastLadder()
