@@ -236,6 +236,8 @@ def test_a_stopped_sweep_resumes_with_only_the_missing_chunks(tmp_path: Path) ->
         run_sweep(sweep, client=SERIAL, out=out, progress=stop_after_first_chunk)
     partial = open_sweep(out)
     assert partial.attrs["points_missing"] == 3
+    # its picture counts the points not yet computed apart: none failed
+    assert plot_sweep(partial, "amplitude_m").get_title().endswith("(3 not computed)")
     with pytest.raises(OutputExistsError, match=r"pass resume=True .*, force=True"):
         run_sweep(sweep, client=SERIAL, out=out)  # from Python: its arguments, not the flags
     calls.clear()
