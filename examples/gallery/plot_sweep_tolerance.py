@@ -9,8 +9,8 @@ ratio scatter? The sweep ``examples/mast_tolerance_sweep.toml`` draws the 20 cle
 of each of 1000 masts and solves the first nonlinear mode (EPMC by harmonic balance,
 clearjoint.harmonic, H = 3) at two modal amplitudes, 10 mm and 30 mm at the tip.
 
-This script does not run the 1000 samples (half an hour and more on two shared
-cores): it draws the histograms from ``examples/mast_tolerance_sweep.nc``, which
+This script does not run the 1000 samples (50 minutes on two cores shared with other
+jobs): it draws the histograms from ``examples/mast_tolerance_sweep.nc``, which
 these two commands, run from the repository's root, wrote::
 
     clearjoint sweep examples/mast_tolerance_sweep.toml --out mast_tolerance.zarr --workers 2
