@@ -279,7 +279,7 @@ def test_the_committed_mast_tolerance_results_come_from_the_shipped_sweep_file()
     assert results.attrs["clearjoint_sweep_fingerprint"] == sweep.fingerprint
     drawn = sweep.drawn()["joint.clearance"]
     done = results.status.values[:, 0] != ""
-    assert done.sum() >= 200
+    assert done.all()  # all 1000 samples were computed
     np.testing.assert_array_equal(results["joint.clearance"].values[done], drawn[done])
     s = int(np.flatnonzero(done)[-1])
     joints = [ClearanceJoint(c, 5e7, gap_stiffness=1e5) for c in drawn[s]]
