@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import socket
+import subprocess
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -93,6 +95,80 @@ def test_an_unreachable_scheduler_is_one_clear_error_within_ten_seconds() -> Non
     assert "\n" not in str(info.value)
 
 
+def _free_port() -> int:
+    with socket.socket() as s:  # a port nobody listens on once this socket is closed
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+#: An address nothing listens on, and one that does not route (RFC 5737 TEST-NET-1: a
+#: connection there is refused by the network or never answered, never accepted).
+UNREACHABLE = {"free port": "tcp://127.0.0.1:{port}", "no route": "tcp://192.0.2.1:8786"}
+
+
+@pytest.mark.parametrize("kind", sorted(UNREACHABLE))
+def test_the_command_line_says_an_unreachable_scheduler_in_one_line_within_ten_seconds(
+    kind: str, tmp_path: Path
+) -> None:
+    address = UNREACHABLE[kind].format(port=_free_port())
+    sweep = Path(__file__).parents[1] / "examples" / "sweep.toml"
+    command = [sys.executable, "-m", "clearjoint", "sweep", str(sweep)]
+    command += ["--out", str(tmp_path / "x.zarr"), "--scheduler", address]
+    start = time.perf_counter()
+    done = subprocess.run(command, capture_output=True, text=True, timeout=60, check=False)
+    elapsed = time.perf_counter() - start
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert address in lines[0]
+    assert "--scheduler" in lines[0]
+    assert elapsed < 10.0, f"{elapsed:.1f} s end to end"
+    assert not (tmp_path / "x.zarr").exists()
+
+
+def test_an_unreachable_scheduler_is_found_before_dask_is_imported() -> None:
+    # importing dask.distributed alone took 4.8 s on the loaded machine: the probe is a socket
+    code = (
+        "import sys\n"
+        "from clearjoint.parallel import SchedulerError, dask_client\n"
+        "try:\n"
+        f"    with dask_client('tcp://127.0.0.1:{_free_port()}'):\n"
+        "        pass\n"
+        "except SchedulerError as exc:\n"
+        "    print('refused', 'distributed' in sys.modules)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=False
+    )
+    assert done.stdout.strip() == "refused False", done.stdout + done.stderr
+
+
+def test_a_scheduler_address_that_cannot_be_read_is_one_clear_error() -> None:
+    from clearjoint.parallel import probe_scheduler
+
+    with pytest.raises(SchedulerError, match="not an address"):
+        probe_scheduler("tcp://127.0.0.1:99999999")
+    with pytest.raises(SchedulerError, match="no host"):
+        probe_scheduler("tcp://:8786")
+    probe_scheduler("inproc://here")  # other protocols are left to Dask
+
+
+def test_a_scheduler_that_never_answers_is_given_up_after_the_probe_timeout(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # a silent network (a firewall dropping packets) is a connect that times out
+    from clearjoint import parallel
+
+    def silent(address: tuple[str, int], timeout: float) -> None:
+        assert address == ("10.0.0.9", 8786)
+        assert timeout == parallel.PROBE_TIMEOUT_S
+        raise TimeoutError("timed out")
+
+    monkeypatch.setattr(parallel.socket, "create_connection", silent)
+    with pytest.raises(SchedulerError, match=r"'10.0.0.9' \(no answer within 3 s\)"):
+        parallel.probe_scheduler("10.0.0.9")
+
+
 def _store(path: Path, fingerprint: str = "abc", force: bool = False) -> ResultStore:
     return ResultStore.create(
         path,
@@ -121,7 +197,7 @@ def test_the_store_keeps_finished_chunks_and_refuses_what_it_should(tmp_path: Pa
     assert list(values["status"][0][[0, 8, 9, 5]]) == ["ok", "ok", "bad", ""]
     assert again.attrs["title"] == "test"
     assert "2/3 chunks" in repr(again)
-    with pytest.raises(OutputExistsError, match="--resume"):
+    with pytest.raises(OutputExistsError, match="resume=True"):
         _store(path)
     with pytest.raises(StoreError, match="different sweep file"):
         ResultStore.open(path, fingerprint="xyz")

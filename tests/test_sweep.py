@@ -236,8 +236,10 @@ def test_a_stopped_sweep_resumes_with_only_the_missing_chunks(tmp_path: Path) ->
         run_sweep(sweep, client=SERIAL, out=out, progress=stop_after_first_chunk)
     partial = open_sweep(out)
     assert partial.attrs["points_missing"] == 3
-    with pytest.raises(OutputExistsError, match="--resume"):
-        run_sweep(sweep, client=SERIAL, out=out)
+    # its picture counts the points not yet computed apart: none failed
+    assert plot_sweep(partial, "amplitude_m").get_title().endswith("(3 not computed)")
+    with pytest.raises(OutputExistsError, match=r"pass resume=True .*, force=True"):
+        run_sweep(sweep, client=SERIAL, out=out)  # from Python: its arguments, not the flags
     calls.clear()
     resumed = run_sweep(
         sweep, client=SERIAL, out=out, resume=True, progress=lambda d, t: calls.append((d, t))
@@ -301,6 +303,29 @@ def test_a_stopped_sweep_resumes_with_only_the_missing_chunks(tmp_path: Path) ->
             'frequency_start = "1300Hz"\nfrequency_stop = "900Hz"\n[axes.joint]\nmass = ["1kg"]',
             r"frequency_stop \(900 Hz\) must exceed frequency_start \(1300 Hz\)",
         ),
+        (  # a linear axis of zero width would run the same point num times
+            'base = "study.toml"\n[task]\nname = "steady_state"\n'
+            '[axes.joint]\nclearance = { start = "0.1mm", stop = "0.1mm", num = 5 }',
+            r"start and stop are equal \(0.0001 m\), so its 5 points would all be the same",
+        ),
+        (
+            'base = "study.toml"\n[task]\nname = "steady_state"\n'
+            '[axes.joint]\nclearance = { start = "0.1mm", stop = "0.1mm", num = 3, '
+            'spacing = "log" }',
+            "start and stop are equal",
+        ),
+        (
+            'base = "study.toml"\n[task]\nname = "steady_state"\n'
+            '[axes.joint]\nclearance = ["0.1mm", "0.2mm", "0.1mm"]',
+            "repeats a value",
+        ),
+        ('base = "study.toml"\n[task]\nname = "steady_state"', "the sweep has no points"),
+        (  # per_joint needs the joints of a structure
+            'base = "study.toml"\nsamples = 2\n[task]\nname = "steady_state"\n'
+            '[draws.joint.clearance]\ndistribution = "uniform"\nlow = "0.05mm"\n'
+            'high = "0.1mm"\nper_joint = true',
+            "per_joint = true needs a structure task",
+        ),
     ],
 )
 def test_bad_sweep_files_are_one_clear_error(tmp_path: Path, text: str, message: str) -> None:
@@ -324,6 +349,8 @@ def test_the_command_line_runs_refuses_and_plots(
     assert main(["sweep", str(path), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "will not overwrite" in err
+    assert "pass --resume" in err
+    assert "--force" in err
     assert err.count("\n") == 1
     assert main(["sweep", "--plot", str(out), "amplitude_m"]) == 0
     assert (tmp_path / "r_amplitude_m.png").stat().st_size > 1000
@@ -454,6 +481,9 @@ def test_the_shipped_sweep_files_read() -> None:
     tolerance = Sweep.from_toml(examples / "tolerance.toml")
     assert tolerance.shape == (1000, 2)
     assert tolerance.drawn()["joint.clearance"].min() > 0.0
+    mast = Sweep.from_toml(examples / "mast_tolerance_sweep.toml")
+    assert mast.shape == (1000, 2)
+    assert mast.drawn()["joint.clearance"].shape == (1000, 20)
 
 
 def test_the_sweep_file_in_the_docs_reads(tmp_path: Path) -> None:
@@ -519,3 +549,56 @@ def test_sweep_path_errors_come_from_the_one_toml_reader(
         path.write_bytes(content)
     with pytest.raises(SweepError, match=message):
         Sweep.from_toml(path)
+
+
+MAST = """
+[structure]
+kind = "mast"
+bays = 2
+longeron_rigidity = "{rigidity}"
+[joint]
+clearance = "0.1mm"
+compression_stiffness = "5e7N/m"
+"""
+MAST_SWEEP = """
+base = "study.toml"
+samples = 4
+[task]
+name = "structure_mode"
+amplitude = "1mm"
+[draws.joint.clearance]
+distribution = "normal"
+mean = "0.1mm"
+std = "0.02mm"
+lower = "0mm"
+per_joint = {per_joint}
+"""
+
+
+def test_a_structure_sweep_draws_per_joint_and_its_hash_sees_every_value(tmp_path: Path) -> None:
+    sweep = Sweep.from_toml(
+        _files(tmp_path, MAST_SWEEP.format(per_joint="true"), MAST.format(rigidity="2e7N"))
+    )
+    (draw,) = sweep.draws
+    assert draw.per_joint == 4  # a 2-bay mast has a joint in each of its 4 longerons
+    drawn = sweep.drawn()["joint.clearance"]
+    assert drawn.shape == (4, 4)
+    assert np.unique(drawn).size == 16
+    assert (drawn >= 0).all()
+    one = Sweep.from_toml(
+        _files(tmp_path, MAST_SWEEP.format(per_joint="false"), MAST.format(rigidity="2e7N"))
+    )
+    assert one.drawn()["joint.clearance"].shape == (4,)  # the same draw for every joint
+    # the structure's repr is a summary: its hash must still see a member's stiffness
+    stiffer = Sweep.from_toml(
+        _files(tmp_path, MAST_SWEEP.format(per_joint="true"), MAST.format(rigidity="3e7N"))
+    )
+    assert repr(stiffer.base.structure) == repr(sweep.base.structure)
+    assert stiffer.fingerprint != sweep.fingerprint
+    with pytest.raises(SweepError, match="per_joint must be true or false"):
+        Sweep.from_toml(
+            _files(tmp_path, MAST_SWEEP.format(per_joint='"yes"'), MAST.format(rigidity="2e7N"))
+        )
+    no_joints = MAST.format(rigidity="2e7N").split("[joint]")[0]
+    with pytest.raises(SweepError, match="has no clearance joints; add a \\[joint\\] section"):
+        Sweep.from_toml(_files(tmp_path, MAST_SWEEP.format(per_joint="true"), no_joints))

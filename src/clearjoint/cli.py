@@ -114,6 +114,12 @@ def _reproduce_parser(sub: Any) -> None:
     p.add_argument("--out", default="clearjoint-reproduction", help="output folder")
     p.add_argument("--campaign", help="campaign file (TOML); default: the shipped one")
     p.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
+    p.add_argument(
+        "--scheduler",
+        help="run the rig's tests on a running Dask scheduler, e.g. tcp://host:8786 "
+        "(its workers must see --out)",
+    )
+    p.add_argument("--workers", type=int, help="run them on a local Dask cluster of N workers")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
 
 
@@ -819,19 +825,34 @@ def _run_simulate(args: argparse.Namespace) -> int:
 
 
 def _run_reproduce(args: argparse.Namespace) -> int:
+    import contextlib
     import time
 
+    from clearjoint.parallel import dask_client
     from clearjoint.reproduction import reproduce
 
+    if args.scheduler and args.workers is not None:
+        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    if args.jobs is not None and (args.scheduler or args.workers is not None):
+        raise ParameterError(
+            "--jobs sizes a process pool; leave it out with --scheduler or --workers"
+        )
     _refuse_file_as_folder(args.out, "--out")
     start = time.perf_counter()
-    written = reproduce(
-        Path(args.out),
-        force=args.force,
-        jobs=args.jobs,
-        campaign_path=Path(args.campaign) if args.campaign else None,
-        progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
-    )
+    with contextlib.ExitStack() as stack:
+        client = None  # the process pool of --jobs
+        if args.scheduler:  # an unreachable scheduler is said first, within seconds
+            client = stack.enter_context(dask_client(args.scheduler))
+        elif args.workers is not None:
+            client = stack.enter_context(dask_client(workers=args.workers))
+        written = reproduce(
+            Path(args.out),
+            force=args.force,
+            jobs=args.jobs,
+            executor=client,
+            campaign_path=Path(args.campaign) if args.campaign else None,
+            progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+        )
     for path in written:
         print(f"wrote {path}")
     _print_findings(Path(args.out) / "results.json")
@@ -1131,6 +1152,11 @@ def _run_sweep(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .zarr, got {args.out!r}")
     if args.scheduler and args.workers is not None:
         raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    if Path(args.out).exists() and not (args.resume or args.force):
+        raise OutputExistsError(
+            f"will not overwrite {args.out}; pass --resume to finish it, --force to start "
+            "again, or choose another --out"
+        )
     start = time.perf_counter()
     with contextlib.ExitStack() as stack:
         if args.scheduler:  # an unreachable scheduler is said first, within seconds

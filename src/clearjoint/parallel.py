@@ -22,6 +22,7 @@ import contextlib
 import logging
 import os
 import shutil
+import socket
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -38,6 +39,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "CONNECT_TIMEOUT_S",
+    "DEFAULT_SCHEDULER_PORT",
+    "PROBE_TIMEOUT_S",
     "ChunkFailedError",
     "Finished",
     "ResultStore",
@@ -48,6 +51,7 @@ __all__ = [
     "chunk_bounds",
     "dask_client",
     "point_seed",
+    "probe_scheduler",
     "process_pool",
     "run_ordered",
     "run_unordered",
@@ -61,6 +65,12 @@ Runner = Any
 
 #: Seconds to wait for a scheduler before giving up (the issue asks for an answer within 10 s).
 CONNECT_TIMEOUT_S = 4
+
+#: Seconds a plain TCP connection to a scheduler may take before it is called unreachable.
+PROBE_TIMEOUT_S = 3.0
+
+#: Dask's default scheduler port, taken when an address names none.
+DEFAULT_SCHEDULER_PORT = 8786
 
 
 class SchedulerError(ClearjointError, ConnectionError):
@@ -200,6 +210,57 @@ def process_pool(jobs: int | None) -> Iterator[Executor | None]:
         yield pool
 
 
+def _unreachable(address: str, reason: str) -> SchedulerError:
+    return SchedulerError(
+        f"cannot reach the Dask scheduler at {address!r} ({reason}); start one with "
+        f"`dask scheduler`, check the address, or leave out --scheduler to run locally"
+    )
+
+
+def probe_scheduler(address: str, timeout: float = PROBE_TIMEOUT_S) -> None:
+    """Check that something accepts a TCP connection at a scheduler's address, quickly.
+
+    A plain socket with a short timeout, before dask.distributed is imported (that
+    import alone can take seconds on a loaded machine), so that an unreachable
+    scheduler is one line within seconds. Addresses are ``tcp://host:port``,
+    ``tls://host:port`` or ``host[:port]`` (port 8786 by default); other protocols
+    (``inproc://``, ``ucx://``, ``ws://``) are left to Dask.
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address.
+    timeout : float
+        Seconds to wait for the connection.
+
+    Raises
+    ------
+    SchedulerError
+        The address cannot be read, its host not found, or nothing answers at it
+        within ``timeout`` (refused, no route, or silence).
+    """
+    from urllib.parse import urlsplit
+
+    text = address.strip()
+    scheme = text.split("://", 1)[0].lower() if "://" in text else "tcp"
+    if scheme not in ("tcp", "tls"):
+        return
+    try:
+        parts = urlsplit(text if "://" in text else f"tcp://{text}")
+        host, port = parts.hostname, parts.port or DEFAULT_SCHEDULER_PORT
+    except ValueError as exc:
+        raise _unreachable(address, f"not an address: {exc}") from None
+    if not host:
+        raise _unreachable(address, "no host in it; e.g. tcp://host:8786")
+    try:
+        with socket.create_connection((host, port), timeout=timeout):
+            pass
+    except TimeoutError:
+        raise _unreachable(address, f"no answer within {timeout:g} s") from None
+    except OSError as exc:
+        raise _unreachable(address, exc.strerror or type(exc).__name__) from None
+
+
 @contextlib.contextmanager
 def dask_client(
     address: str | None = None, *, workers: int | None = None, processes: bool = True
@@ -219,21 +280,22 @@ def dask_client(
     Raises
     ------
     SchedulerError
-        The scheduler did not answer within :data:`CONNECT_TIMEOUT_S` seconds.
+        Nothing accepts a connection at ``address`` within :data:`PROBE_TIMEOUT_S`
+        seconds (tried with a plain socket before Dask is imported), or the scheduler
+        did not answer within :data:`CONNECT_TIMEOUT_S` seconds.
     """
-    from distributed import Client, LocalCluster
-
     if workers is not None and workers < 1:
         raise ParameterError(f"workers must be >= 1 (--workers), got {workers}")
+    if address is not None:
+        probe_scheduler(address)
+    from distributed import Client, LocalCluster
+
     if address is not None:
         try:
             client = Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")  # type: ignore[no-untyped-call]
         except (OSError, TimeoutError, ValueError) as exc:
             reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise SchedulerError(
-                f"cannot reach the Dask scheduler at {address!r} ({reason}); start one with "
-                f"`dask scheduler`, check the address, or leave out --scheduler to run locally"
-            ) from None
+            raise _unreachable(address, reason) from None
         with client:
             yield client
         return
@@ -259,11 +321,16 @@ _DONE = "chunk_done"
 
 @dataclass(frozen=True)
 class Variable:
-    """One array of a store: its name, numpy dtype ('f8', 'i8' or 'str') and attributes."""
+    """One array of a store: its name, numpy dtype ('f8', 'i8' or 'str') and attributes.
+
+    ``shape`` is what each point holds beyond the ``point`` dimension: () for one
+    value, (n,) for n values (a per-joint draw: dimension ``joint``).
+    """
 
     name: str
     dtype: str
     attrs: Mapping[str, Any]
+    shape: tuple[int, ...] = ()
 
 
 class ResultStore:
@@ -307,8 +374,8 @@ class ResultStore:
         if path.exists():
             if not force:
                 raise OutputExistsError(
-                    f"will not overwrite {path}; pass --resume to finish it, --force to "
-                    f"start again, or choose another --out"
+                    f"will not overwrite {path}; pass resume=True to finish it, force=True "
+                    f"to start again, or choose another out"
                 )
             cls.open(path)  # a StoreError unless it is a sweep store: never delete anything else
             shutil.rmtree(path)
@@ -319,11 +386,11 @@ class ResultStore:
             fill: Any = "" if var.dtype == "str" else (np.nan if var.dtype == "f8" else 0)
             array = group.create_array(
                 var.name,
-                shape=(n_points,),
-                chunks=(chunk_size,),
+                shape=(n_points, *var.shape),
+                chunks=(chunk_size, *var.shape),
                 dtype=kind,
                 fill_value=fill,
-                dimension_names=["point"],
+                dimension_names=["point", *("joint",) * len(var.shape)],
             )
             array.attrs.update(dict(var.attrs))
         group.create_array(

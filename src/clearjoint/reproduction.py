@@ -122,7 +122,8 @@ def reproduce(
     the report follow, with the identification checked against the rig's truth and the
     dissipation model of section 2 set against the exact cycles. The rig's tests run
     over ``jobs`` processes, or on ``executor`` (an Executor or a Dask client whose
-    workers see ``out_dir``: clearjoint.parallel).
+    workers see ``out_dir``: clearjoint.parallel; the control run's records then go to
+    a temporary folder inside ``out_dir``, removed after).
     """
     say = progress or (lambda _m: None)
     out_dir = Path(out_dir)
@@ -144,7 +145,9 @@ def reproduce(
         control, control_text = analysis, "the same records: the sensitivity is already off"
     else:
         say("control run: the same campaign without the installation sensitivity")
-        with tempfile.TemporaryDirectory(prefix="clearjoint-control-") as folder:
+        # on an executor the workers write the records: in out_dir, which they see
+        where = out_dir if executor is not None else None
+        with tempfile.TemporaryDirectory(prefix="clearjoint-control-", dir=where) as folder:
             control_manifest = run_campaign(
                 without_installation_sensitivity(campaign),
                 Path(folder),

@@ -2,7 +2,8 @@
 
 The format (docs/sweep.md; an example in examples/sweep.toml)::
 
-    base = "study.toml"          # a study, a rig campaign or a glob of records; relative here
+    base = "study.toml"          # a study, a structure study, a rig campaign or a glob of
+                                 # records; relative to this file
     seed = 2026                  # the draws and every point's own seed
     samples = 200                # Monte Carlo samples (the `sample` dimension)
     chunk_size = 16              # points per task chunk and per zarr chunk
@@ -22,6 +23,7 @@ The format (docs/sweep.md; an example in examples/sweep.toml)::
     mean = "0.1mm"               #   (median, sigma: the spread of ln x)
     std = "0.02mm"
     lower = "0mm"                # truncate below (and/or upper = ...)
+    per_joint = true             # structure tasks: one draw per joint per sample
 
 Dimensional values need a unit (``"0.1mm"``; a bare number only for zero or a
 dimensionless key), read by clearjoint.io_toml as in study files; unknown keys are
@@ -81,7 +83,9 @@ class Draw:
     """A Monte Carlo draw of one parameter per sample.
 
     ``first``, ``second`` are (mean, std), (low, high) or (median, sigma) by
-    ``distribution``; ``lower``/``upper`` truncate it (None: not truncated).
+    ``distribution``; ``lower``/``upper`` truncate it (None: not truncated);
+    ``per_joint`` > 0 draws that many independent values per sample (one per joint
+    of a structure study), else one.
     """
 
     name: str
@@ -91,9 +95,13 @@ class Draw:
     lower: float | None
     upper: float | None
     unit: str
+    per_joint: int = 0  # > 0: that many independent values per sample, one per joint
 
     def sample(self, rng: np.random.Generator, n: int) -> FloatArray:
-        """Return ``n`` draws, shape (n,)."""
+        """Return ``n`` draws: shape (n,), or (n, per_joint) for a per-joint draw."""
+        if self.per_joint:
+            flat = replace(self, per_joint=0).sample(rng, n * self.per_joint)
+            return flat.reshape(n, self.per_joint)
         if self.distribution == "uniform":
             return rng.uniform(self.first, self.second, n)
         if self.distribution == "lognormal":
@@ -162,7 +170,9 @@ class Sweep:
         return math.prod(self.shape)
 
     def drawn(self) -> dict[str, FloatArray]:
-        """Each drawn parameter's (samples,) values, from ``default_rng(SeedSequence(seed))``.
+        """Each drawn parameter's values, from ``default_rng(SeedSequence(seed))``.
+
+        Shape (samples,), or (samples, n_joints) for a per-joint draw.
 
         Draws are made in file order, each parameter's samples at once, so they do not
         depend on chunking or workers; points' own seeds are ``point_seed(seed, index)``.
@@ -174,7 +184,18 @@ class Sweep:
     def fingerprint(self) -> str:
         """A sha256 of every value that shapes the results (not the file's path)."""
         base = self.base
-        if hasattr(base, "source"):
+        if hasattr(base, "structure"):  # its repr is a summary: take every value instead
+            s = base.structure
+            base = (
+                s.nodes.tolist(),
+                s.masses.tolist(),
+                s.members,
+                s.supports,
+                s.rayleigh,
+                base.omega,
+                None if base.force is None else base.force.tolist(),
+            )
+        elif hasattr(base, "source"):
             base = replace(base, source="")
         text = repr(
             (
@@ -245,6 +266,11 @@ def _read_axis(where: str, name: str, raw: Any, p: Parameter) -> Axis:
             raise SweepError(f"{where}: {key} num must be a whole number, got {num!r}")
         start = _quantity(where, key, raw["start"], p)
         stop = _quantity(where, key, raw["stop"], p)
+        if num > 1 and start == stop:
+            raise SweepError(
+                f"{where}: {key} start and stop are equal ({start:g} {p.unit}), so its "
+                f"{num} points would all be the same; give a wider range, or num = 1"
+            )
         spacing = raw.get("spacing", "linear")
         if spacing == "log":
             if start <= 0 or stop <= 0:
@@ -259,12 +285,31 @@ def _read_axis(where: str, name: str, raw: Any, p: Parameter) -> Axis:
     if not values:
         raise SweepError(f"{where}: {key} has no values; give at least one")
     array = np.asarray(values, dtype=np.float64)
+    if np.unique(array).size < array.size:
+        raise SweepError(
+            f"{where}: {key} repeats a value (points that would all be the same); "
+            "give each value once"
+        )
     _check_range(where, key, array, p, "change the axis")
     return Axis(name, tuple(float(v) for v in array), p.unit)
 
 
-def _read_draw(where: str, name: str, raw: dict[str, Any], p: Parameter) -> Draw:
+def _read_draw(
+    where: str, name: str, raw: dict[str, Any], p: Parameter, joints: int | None
+) -> Draw:
+    """One [draws.X] table; ``joints``: the base structure's joint count (None: not one)."""
     key = f"[draws.{name}]"
+    raw = dict(raw)
+    per_joint = raw.pop("per_joint", False)
+    if not isinstance(per_joint, bool):
+        raise SweepError(f"{where}: {key} per_joint must be true or false, got {per_joint!r}")
+    if per_joint and joints is None:
+        raise SweepError(
+            f"{where}: {key} per_joint = true needs a structure task (its joints); "
+            "remove it for a single joint"
+        )
+    if per_joint and not joints:
+        raise SweepError(f"{where}: {key} per_joint = true, but the base structure has no joints")
     kind = raw.get("distribution")
     if kind not in _DISTRIBUTIONS:
         raise SweepError(
@@ -274,11 +319,12 @@ def _read_draw(where: str, name: str, raw: dict[str, Any], p: Parameter) -> Draw
     allowed = {"distribution", first_key, second_key} | (
         {"lower", "upper"} if kind == "normal" else set()
     )
+    shown = sorted(allowed | ({"per_joint"} if joints is not None else set()))
     extra = sorted(set(raw) - allowed)
     missing = sorted({first_key, second_key} - set(raw))
     if extra or missing:
         raise SweepError(
-            f"{where}: {key} ({kind}) takes {sorted(allowed)}; unknown {extra}, missing {missing}"
+            f"{where}: {key} ({kind}) takes {shown}; unknown {extra}, missing {missing}"
         )
     first = _quantity(where, f"{key} {first_key}", raw[first_key], p)
     spread = Parameter("dimensionless", "") if kind == "lognormal" else replace(p, lower=0.0)
@@ -298,7 +344,7 @@ def _read_draw(where: str, name: str, raw: dict[str, Any], p: Parameter) -> Draw
     lo, hi = bounds
     if lo is not None and hi is not None and not hi > lo:
         raise SweepError(f"{where}: {key} needs upper > lower")
-    return Draw(name, kind, first, second, lo, hi, p.unit)
+    return Draw(name, kind, first, second, lo, hi, p.unit, joints if per_joint and joints else 0)
 
 
 def _load_base(where: str, task: Task, raw: Any, folder: Path) -> Any:
@@ -330,6 +376,22 @@ def _load_base(where: str, task: Task, raw: Any, folder: Path) -> Any:
         if not files:
             raise SweepError(f"{where}: base {raw!r} matches no file; check the folder and pattern")
         return RecordSet(tuple(files), source=raw)
+    if task.base == "structure":
+        from clearjoint.structure.study import StructureStudyError, load_structure_study
+
+        if not isinstance(raw, str):
+            raise SweepError(
+                f'{where}: base must name a structure study file, e.g. base = "mast.toml"'
+            )
+        try:
+            study = load_structure_study(folder / raw)
+        except StructureStudyError as exc:
+            raise SweepError(f"{where}: base: {exc}") from None
+        if not study.structure.joint_members:
+            raise SweepError(
+                f"{where}: base {raw!r} has no clearance joints; add a [joint] section to it"
+            )
+        return study
     raise SweepError(f"{where}: task {task.name!r} needs a {task.base} base, not readable yet")
 
 
@@ -366,7 +428,9 @@ def _read(path: Path) -> Sweep:
     for section, table in _table(where, raw.get("draws", {}), "draws").items():
         for key, value in _table(where, table, f"draws.{section}").items():
             p = _parameter(where, task, f"{section}.{key}")
-            draws.append(_read_draw(where, f"{section}.{key}", _table(where, value, key), p))
+            joints = len(base.structure.joint_members) if task.base == "structure" else None
+            table = _table(where, value, key)
+            draws.append(_read_draw(where, f"{section}.{key}", table, p, joints))
     varied = {a.name for a in axes}
     both = sorted(varied & {d.name for d in draws})
     if both:
@@ -417,7 +481,7 @@ def _read(path: Path) -> Sweep:
     )
     if sweep.chunk_size < 1:
         raise SweepError(f"{where}: chunk_size must be >= 1, got {sweep.chunk_size}")
-    if sweep.n_points == 0:
+    if sweep.n_points == 0 or not sweep.shape:
         raise SweepError(f"{where}: the sweep has no points; give [axes] or samples")
     for draw, values in zip(sweep.draws, sweep.drawn().values(), strict=True):
         _check_range(

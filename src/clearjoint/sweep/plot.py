@@ -2,7 +2,8 @@
 
 Two grid axes give a map (the first axis across), one gives a line, a Monte
 Carlo sample gives a histogram (one per value of a grid axis, overlaid).
-Failed points (NaN) are left blank and counted in the title.
+Failed points (NaN) are left blank and counted in the title, apart from the points of
+a store not yet computed.
 """
 
 from __future__ import annotations
@@ -77,7 +78,12 @@ def plot_sweep(results: Any, variable: str, ax: Any = None) -> Any:
     if ax is None:
         _, ax = plt.subplots(figsize=(6.4, 4.4), layout="constrained")
     grid = [d for d in data.dims if d != "sample"]
-    failed = int(np.count_nonzero(np.isnan(data.values)))
+    blank = np.isnan(data.values)
+    if "status" in results:  # a point not yet computed (empty status) has not failed
+        missing = int(np.count_nonzero(blank & (results["status"].values.astype(str) == "")))
+    else:
+        missing = 0
+    failed = int(np.count_nonzero(blank)) - missing
     if "sample" in data.dims:
         if len(grid) > 1:
             raise ParameterError("a histogram takes at most one grid axis beside `sample`")
@@ -124,5 +130,7 @@ def plot_sweep(results: Any, variable: str, ax: Any = None) -> Any:
             f"{variable} has {len(grid)} grid axes; select down to two with xarray first"
         )
     title = f"{results.attrs.get('task', 'sweep')}: {variable}"
-    ax.set_title(title + (f" ({failed} points failed)" if failed else ""))
+    counts = [f"{failed} points failed"] if failed else []
+    counts += [f"{missing} not computed"] if missing else []
+    ax.set_title(title + (f" ({', '.join(counts)})" if counts else ""))
     return ax

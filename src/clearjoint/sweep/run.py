@@ -103,6 +103,14 @@ def _point_values(sweep: Sweep, drawn: Mapping[str, NDArray[np.float64]], a: int
     return np.column_stack(columns)
 
 
+def _column_names(sweep: Sweep) -> tuple[str, ...]:
+    """The name of each column of :func:`_point_values`: a per-joint draw gives ``name[j]``."""
+    names: list[str] = []
+    for d in sweep.draws:
+        names += [f"{d.name}[{j}]" for j in range(d.per_joint)] if d.per_joint else [d.name]
+    return (*names, *(a.name for a in sweep.axes))
+
+
 def _attrs(sweep: Sweep) -> dict[str, Any]:
     return {
         "title": f"clearjoint sweep: {sweep.task.name}",
@@ -124,7 +132,12 @@ def _attrs(sweep: Sweep) -> dict[str, Any]:
 def _variables(sweep: Sweep) -> list[Variable]:
     out = [Variable(name, "f8", {"units": sweep.task.outputs[name]}) for name in sweep.outputs]
     out += [
-        Variable(d.name, "f8", {"units": d.unit, "distribution": d.distribution})
+        Variable(
+            d.name,
+            "f8",
+            {"units": d.unit, "distribution": d.distribution},
+            shape=(d.per_joint,) if d.per_joint else (),
+        )
         for d in sweep.draws
     ]
     out.append(Variable("status", "str", {"description": "ok, or why the point failed"}))
@@ -209,7 +222,7 @@ def run_sweep(
                 force=force,
             )
     drawn = sweep.drawn()
-    names = tuple(d.name for d in sweep.draws) + tuple(a.name for a in sweep.axes)
+    names = _column_names(sweep)
     chunks = [
         _Chunk(
             task=sweep.task,
@@ -289,12 +302,13 @@ def _dataset(
         coords["file"] = ("record", np.asarray(files, dtype=str))
     variables: dict[str, Any] = {}
     for name, (values, var_attrs) in flat.items():
-        full = values.reshape(shape)
         if name in drawn:
-            first = full.reshape(shape[0], -1)[:, 0]
-            coords[name] = ("sample", first, var_attrs)
+            extra = values.shape[1:]  # (n_joints,) for a per-joint draw
+            full = values.reshape(shape + extra)
+            first = full.reshape(shape[0], -1, *extra)[:, 0]
+            coords[name] = (("sample", "joint")[: 1 + len(extra)], first, var_attrs)
         else:
-            variables[name] = (dims, full, var_attrs)
+            variables[name] = (dims, values.reshape(shape), var_attrs)
     status = flat["status"][0]
     ok = np.char.startswith(status.astype(str), "ok")
     failed = int(np.count_nonzero(~ok & (status != "")))

@@ -1,10 +1,11 @@
 """What a sweep computes at each point: the task registry and the joint tasks.
 
-A :class:`Task` names its base (a ``study`` file of ``clearjoint simulate`` or a rig
-``campaign``), the parameters a sweep may vary or fix, its outputs with their units,
-and ``evaluate(base, values, seed)``: a pure, module-level function of frozen values
-that returns one float per output (it runs on Dask workers). The physics is the
-library's; this module only maps a point's values onto it:
+A :class:`Task` names its base (a ``study`` file of ``clearjoint simulate``, a
+``structure`` study of ``clearjoint structure``, a rig ``campaign`` or ``records``), the
+parameters a sweep may vary or fix, its outputs with their units, and ``evaluate(base,
+values, seed)``: a pure, module-level function of frozen values that returns one float
+per output (it runs on Dask workers). The physics is the library's; this module only
+maps a point's values onto it:
 
 * ``steady_state``: the exact steady cycle of the forced joint (clearjoint.simulate,
   MODEL.md sec. 2): amplitude, extremes, penetrations and the energy ledger per period;
@@ -22,9 +23,13 @@ library's; this module only maps a point's values onto it:
   (clearjoint.periodic, MODEL.md 5.1), reduced to its peak, folds and unstable points; a
   curve the continuation cut short is a failed point (NaN, with where and why);
 * ``nonlinear_mode``: the joint's first nonlinear mode at one modal amplitude by harmonic
-  balance (clearjoint.harmonic, MODEL.md 5.4): frequency, damping ratio, energy per cycle.
+  balance (clearjoint.harmonic, MODEL.md 5.4): frequency, damping ratio, energy per cycle;
+* ``structure_mode``: a nonlinear mode of a structure study (a mast with a clearance
+  joint in every longeron, MODEL.md 5.2 and 5.4) at one modal amplitude: frequency and
+  damping ratio. Its joints may be varied all at once (``joint.clearance``) or one by
+  one (``joint.clearance[3]``, what a per-joint draw gives each point).
 
-Structure tasks register themselves the same way with :func:`register_task`.
+Other tasks register themselves the same way with :func:`register_task`.
 """
 
 from __future__ import annotations
@@ -41,11 +46,13 @@ from clearjoint.errors import ParameterError
 __all__ = [
     "FORCING_PARAMETERS",
     "JOINT_PARAMETERS",
+    "STRUCTURE_JOINT_PARAMETERS",
     "TASKS",
     "Parameter",
     "RecordSet",
     "Task",
     "register_task",
+    "structure_at",
     "study_at",
 ]
 
@@ -501,6 +508,188 @@ register_task(
         description=(
             "the joint's nonlinear mode at modal amplitude task.amplitude by harmonic "
             "balance (EPMC, clearjoint.harmonic, MODEL.md 5.4): frequency and damping"
+        ),
+    )
+)
+
+
+# ---- a structure study: its joints one by one ---------------------------------------------
+
+#: What a structure sweep may vary of its joints (keys as in the study's [joint] section).
+STRUCTURE_JOINT_PARAMETERS: dict[str, Parameter] = {
+    key: JOINT_PARAMETERS[key]
+    for key in (
+        "joint.clearance",
+        "joint.compression_stiffness",
+        "joint.tension_stiffness",
+        "joint.gap_stiffness",
+        "joint.gap_offset",
+    )
+}
+
+
+def _joint_key(key: str) -> tuple[str, int | None]:
+    """``joint.clearance[3]`` -> (clearance, 3); ``joint.clearance`` -> (clearance, None)."""
+    name = key.split(".", 1)[1]
+    if name.endswith("]") and "[" in name:
+        field_name, index = name[:-1].split("[", 1)
+        return field_name, int(index)
+    return name, None
+
+
+def structure_at(study: Any, values: Mapping[str, float]) -> Any:
+    """Return the structure study with the point's joint ``values`` applied.
+
+    ``joint.<key>`` sets that value on every joint of the structure; ``joint.<key>[j]``
+    on joint ``j`` only (0-based, in ``Structure.joint_members`` order: for a mast,
+    bay 1 left, bay 1 right, bay 2 left, ...). A symmetric joint (k_t = k_c) stays
+    symmetric when only k_c is varied, as in :func:`study_at`.
+
+    Raises
+    ------
+    ParameterError
+        A joint index the structure does not have.
+    """
+    from clearjoint.structure import Structure
+
+    structure = study.structure
+    n_joints = len(structure.joint_members)
+    common: dict[str, float] = {}
+    each: dict[int, dict[str, float]] = {}
+    for key, value in values.items():
+        if not key.startswith("joint."):
+            continue
+        name, index = _joint_key(key)
+        if index is None:
+            common[name] = value
+        elif not 0 <= index < n_joints:
+            raise ParameterError(
+                f"{key}: the structure has {n_joints} joints (0 to {n_joints - 1}); "
+                "check the per-joint draw"
+            )
+        else:
+            each.setdefault(index, {})[name] = value
+    if not common and not each:
+        return study
+    members = list(structure.members)
+    for j, m in enumerate(structure.joint_members):
+        joint = members[m].joint
+        changes = {**common, **each.get(j, {})}
+        if (
+            "compression_stiffness" in changes
+            and "tension_stiffness" not in changes
+            and joint.tension_stiffness == joint.compression_stiffness
+        ):
+            changes["tension_stiffness"] = changes["compression_stiffness"]
+        members[m] = replace(members[m], joint=replace(joint, **changes))
+    built = Structure(
+        structure.nodes,
+        structure.masses,
+        tuple(members),
+        supports=structure.supports,
+        rayleigh=structure.rayleigh,
+    )
+    return replace(study, structure=built)
+
+
+def _structure_mode(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.harmonic import nonlinear_modes
+    from clearjoint.simulate import SimulationError
+
+    structure = structure_at(base, values).structure
+    amplitude = values["task.amplitude"]
+    start = values.get("task.start_amplitude", 0.0)
+    steps = int(values["task.ladder_steps"])
+    number, harmonics = int(values["task.mode"]), int(values["task.harmonics"])
+    # from a large amplitude, where the closed-pattern mode is a good first guess, down
+    # to the one asked, each solve starting from the one before (nonlinear_modes does so)
+    ladder = (
+        np.geomspace(amplitude, start, steps + 1) if start > amplitude else np.array([amplitude])
+    )
+    key = (tuple(sorted((k, v) for k, v in values.items() if k.startswith("joint."))), number)
+    mode, at = _LAST_LADDER.find(base, (*key, harmonics), ladder)
+    if mode is None:
+        mode, at = nonlinear_modes(structure, number, ladder, harmonics=harmonics), 0
+        _LAST_LADDER.keep(base, (*key, harmonics), mode)
+    if not bool(mode.converged[at]):
+        raise SimulationError(
+            f"the nonlinear mode did not converge at {amplitude:.4g} m (ladder from {start:.4g} m)"
+        )
+    closed = structure.modes("closed").frequency_hz[number - 1]
+    ref = structure.dof_names.index(mode.reference_dof)
+    return {
+        "frequency_hz": float(mode.frequency[at] / (2.0 * math.pi)),
+        "damping_ratio": float(mode.damping_ratio[at]),
+        "energy_per_cycle_j": float(mode.energy_per_cycle[at]),
+        "x_max_m": float(mode.x_max[at, ref]),
+        "closed_frequency_hz": float(closed),
+    }
+
+
+class _LastLadder:
+    """The last ladder of amplitudes this process solved, to serve a point it already holds.
+
+    ``nonlinear_modes`` solves the amplitudes from the largest down, each from the one
+    before, so its value at amplitude a depends only on the structure, the mode, H and
+    the amplitudes above a. A point whose own ladder has exactly the amplitudes above a
+    that the kept ladder had (the top of a ladder: nothing above) gets the very numbers
+    a new call would give, bit for bit; anything else is solved afresh. It halves the
+    cost of a tolerance study at two amplitudes (the larger is the smaller's start).
+    """
+
+    def __init__(self) -> None:
+        # one tuple, replaced whole: threads of one worker never see half of another's
+        self._kept: tuple[Any, tuple[Any, ...], Any] = (None, (), None)
+
+    def find(self, base: Any, key: tuple[Any, ...], ladder: Any) -> tuple[Any, int]:
+        """Return (the kept NonlinearMode, the index of ``ladder[0]`` in it), or (None, 0)."""
+        kept_base, kept_key, mode = self._kept
+        if mode is None or base is not kept_base or key != kept_key:
+            return None, 0
+        kept = mode.amplitude
+        hits = np.flatnonzero(kept == ladder[0])
+        if hits.size != 1:
+            return None, 0
+        above = kept[kept > ladder[0]]
+        if above.shape != ladder[1:].shape or not np.array_equal(above, ladder[1:]):
+            return None, 0
+        return mode, int(hits[0])
+
+    def keep(self, base: Any, key: tuple[Any, ...], mode: Any) -> None:
+        """Keep ``mode`` (holding ``base`` so that its identity stays unique)."""
+        self._kept = (base, key, mode)
+
+
+_LAST_LADDER = _LastLadder()
+
+
+register_task(
+    Task(
+        name="structure_mode",
+        base="structure",
+        parameters=STRUCTURE_JOINT_PARAMETERS,
+        options={
+            "task.amplitude": (None, Parameter("length", "m", open_lower=True)),
+            "task.mode": (1.0, Parameter("dimensionless", "", lower=1.0)),
+            "task.harmonics": (7.0, Parameter("dimensionless", "", lower=1.0)),
+            "task.start_amplitude": (0.0, Parameter("length", "m")),
+            "task.ladder_steps": (4.0, Parameter("dimensionless", "", lower=1.0)),
+        },
+        outputs={
+            "frequency_hz": "Hz",
+            "damping_ratio": "",
+            "energy_per_cycle_j": "J",
+            "x_max_m": "m",
+            "closed_frequency_hz": "Hz",
+        },
+        evaluate=_structure_mode,
+        description=(
+            "a nonlinear mode of a structure study (EPMC, clearjoint.harmonic, MODEL.md 5.4) "
+            "at modal amplitude task.amplitude on its reference DOF: frequency, damping "
+            "ratio, energy per cycle, the reference DOF's largest displacement, and the "
+            "closed-pattern linear frequency"
         ),
     )
 )
