@@ -376,7 +376,10 @@ def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
     assert grazing[-1] == pytest.approx(max(touch), rel=2e-3)
     # both stable branches and the unstable one are there
     assert (~curve.stable).sum() > 10
-    stable = np.nonzero(curve.stable)[0]
+    # steady_state stops when one period moves the state by ~1e-12; with a multiplier
+    # of modulus 0.995 (next to the grazing) that leaves it ~1e-10 / (1 - 0.995) from the
+    # fixed point: compare where its own error is below the 1e-9 asked
+    stable = np.nonzero(curve.stable & (np.abs(curve.multipliers).max(axis=1) < 0.99))[0]
     for i in stable[:: max(1, stable.size // 6)]:
         start = curve.initial_state[i] * (1.0 + 1e-6)
         ss = steady_state(
