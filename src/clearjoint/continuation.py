@@ -73,6 +73,9 @@ _CUBIC_POINTS = 3
 #: ... and while the last tangents turned by less than arccos of this between points.
 _CUBIC_ALIGN = math.cos(0.1)
 
+#: Scaled distance within which a branch has reached the ``join`` point of another.
+_JOIN_DISTANCE = 1e-3
+
 #: Points in a row running back along the branch's own path after which it stops.
 _BACK_POINTS = 5
 
@@ -154,7 +157,8 @@ class Branch:
         Why it stopped: "reached", "max_points", "left the range", "step too
         small at lambda = ...: ..." (no step converged, the kink jump included),
         or "ran back along its own path from lambda = ...: ..." (a kink crossing
-        led back onto the branch already followed; those points are dropped).
+        led back onto the branch already followed; those points are dropped),
+        or "joined" (it reached the ``join`` point).
     kinks : (k,) ndarray of int
         Indices of the points reached by a natural-parameter jump across a kink
         (the kink lies between point i - 1 and point i).
@@ -310,6 +314,7 @@ def continue_branch(
     restart: Restart | None = None,
     differs: Differs | None = None,
     equivalents: Equivalents | None = None,
+    join: tuple[FloatArray, float, Any] | None = None,
 ) -> Branch:
     """Follow R(u, lambda) = 0 from (u0, lam0) until lambda reaches ``lam_stop``.
 
@@ -338,6 +343,10 @@ def continue_branch(
         (a state on a jump of the section: before and after an impact); at a
         kink Newton starts from them too, and a point near one of them counts as
         near the last point.
+    join : (u (d,), lam, data), optional
+        A point of another branch (where that one stopped): the continuation stops
+        with reason "joined" on reaching it (within ``_JOIN_DISTANCE`` in scaled
+        coordinates, on the same smooth piece by ``differs``).
 
     Returns
     -------
@@ -354,6 +363,14 @@ def continue_branch(
     scale = np.concatenate((np.asarray(u_scale, dtype=np.float64), [float(lam_scale)]))
     direction = 1.0 if lam_stop > lam0 else -1.0
     y = np.concatenate((u0, [lam0])) / scale
+    target = None if join is None else np.concatenate((join[0], [join[1]])) / scale
+
+    def joined(point: FloatArray, point_data: Any) -> bool:
+        if target is None or join is None:
+            return False
+        same = differs is None or not differs(join[2], point_data)
+        return same and float(np.linalg.norm(point - target)) <= _JOIN_DISTANCE
+
     t = np.zeros(d + 1)
     t[-1] = direction
     first = _correct(residual, y, t, scale, settings, fixed_lambda=True)
@@ -384,9 +401,7 @@ def continue_branch(
         else:
             predicted = y + h * t + 0.5 * h * h * curvature
         attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
-        if cubic and (
-            attempt is None or (differs is not None and differs(datas[-1], attempt[2]))
-        ):
+        if cubic and (attempt is None or (differs is not None and differs(datas[-1], attempt[2]))):
             # near a kink the cubic may reach across it: the same step again, predicted
             # from the tangent and curvature (the ordinary way, with its step control)
             retry = True
@@ -454,6 +469,9 @@ def continue_branch(
             datas.append(data_new)
             iters.append(its)
             h = settings.step
+            if joined(y, data_new):
+                reason = "joined"
+                break
             continue
         if attempt is None:
             h = max(0.5 * h, settings.min_step)
@@ -496,6 +514,9 @@ def continue_branch(
         ts.append(t)
         datas.append(data_new)
         iters.append(its)
+        if joined(y, data_new):
+            reason = "joined"
+            break
         if direction * (y[-1] * scale[-1] - lam0) < -abs(lam_scale):
             reason = "left the range"
             break
@@ -612,16 +633,24 @@ def _retraces(
     kinks: list[int],
     differs: Differs | None,
 ) -> bool:
-    """A kink crossing that lands back on a piece the branch left at an earlier kink.
+    """A kink crossing that lands back on a piece the branch left earlier.
 
     True when ``y_new`` lies on the same smooth piece (``differs`` False) as a
-    point before the last kink, and nearer to it than that point's larger spacing
-    to its neighbours: the branch would run back along itself. (Points since the
-    last kink are the current piece, which may fold back close to itself.)
+    point before the current piece, and nearer to it than that point's larger
+    spacing to its neighbours: the branch would run back along itself. The
+    current piece is the run of points since the last kink on the last point's
+    piece (it may fold back close to itself); a piece left by a smooth change of
+    the events (a grazing the arclength step passed) counts as left too.
     """
-    if differs is None or not kinks or kinks[-1] < 2:
+    if differs is None or len(ys) < 3:
         return False
-    before = np.array(ys[: kinks[-1]])
+    # the current piece: the points since the last kink that lie on the last point's piece
+    start = len(ys) - 1
+    while start > (kinks[-1] if kinks else 0) and not differs(datas[start - 1], datas[-1]):
+        start -= 1
+    if start < 2:
+        return False
+    before = np.array(ys[:start])
     gaps = np.linalg.norm(before - y_new, axis=1)
     spacing = np.linalg.norm(np.diff(before, axis=0), axis=1)
     reach = np.maximum(np.append(spacing, 0.0), np.insert(spacing, 0, 0.0))
