@@ -634,7 +634,10 @@ def frequency_response(
 
     Pseudo-arclength continuation of the periodic orbit from ``omega_start`` to
     ``omega_stop`` (rad/s), through folds, stable and unstable branches alike,
-    with folds, period doublings and grazings reported as ``events``. With
+    with folds, period doublings and grazings reported as ``events``. Where the
+    continuation stops short of the end (no step converges, or it runs back along
+    itself), a period-1 orbit is sought further on and the branch followed from it
+    back to that point, then on: the curve stays one ordered path. With
     ``parameter="force"`` it continues in F0 from ``force_amplitude`` to
     ``force_stop`` (N) at the fixed ``omega_start`` (``omega_stop`` is then
     ignored and may be None).
