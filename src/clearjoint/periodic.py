@@ -83,6 +83,9 @@ _REJOINS = 12
 #: Where the orbit further on is sought: these fractions of the way from the furthest
 #: parameter reached to the end of the range.
 _SEED_FACTORS = (0.003, 0.006, 0.01, 0.02)
+#: Points at most on the way back from such an orbit (a seed on a branch that does not
+#: lead back to the stop is given up after them).
+_BACK_POINTS = 500
 
 
 @dataclass(frozen=True)
@@ -872,7 +875,13 @@ def _rejoin(
         u0 = seed(lam)
         if u0 is None or left < 4:
             continue
-        back = follow(u0, lam, start, left, (branch.u[-1], float(branch.lam[-1]), branch.data[-1]))
+        back = follow(
+            u0,
+            lam,
+            start,
+            min(left, _BACK_POINTS),
+            (branch.u[-1], float(branch.lam[-1]), branch.data[-1]),
+        )
         if back.reason != "joined":
             continue
         on = follow(back.u[0], float(back.lam[0]), stop, max(2, left - back.lam.size + 1))
