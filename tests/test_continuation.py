@@ -113,3 +113,25 @@ def test_turns_back_at_a_corner_onto_the_other_piece() -> None:
     )
     assert stuck.reason.startswith("step too small")
     assert np.all(stuck.u < 0.0)
+
+
+def test_cubic_predictor_is_exact_on_a_line_and_fourth_order_on_a_circle() -> None:
+    from clearjoint.continuation import _extrapolate
+
+    # a line: chord length is arclength, so the cubic lands exactly h further on
+    direction = np.array([0.6, -0.8, 0.0])
+    steps = np.array([0.0, 0.013, 0.03, 0.041])  # uneven spacing, as step control gives
+    line = np.array([1.0, 2.0, 3.0]) + steps[:, None] * direction
+    expected = line[-1] + 0.02 * direction
+    assert np.allclose(_extrapolate(line, 0.02), expected, rtol=0.0, atol=1e-13)
+
+    # a circle of radius 1: the miss falls as h^4 when every spacing is halved
+    def miss(h: float) -> float:
+        angles = np.arange(-3, 2) * h  # four points up to angle 0, then the one to predict
+        points = np.stack((np.cos(angles), np.sin(angles), np.zeros(5)), axis=1)
+        # the next point is h (in angle) on: its chord from the last is 2 sin(h / 2)
+        guess = _extrapolate(points[:4], 2.0 * math.sin(h / 2.0))
+        return float(np.linalg.norm(guess - points[4]))
+
+    ratio = miss(0.02) / miss(0.01)
+    assert 12.0 < ratio < 20.0  # 2^4 = 16; a quadratic predictor would give 8

@@ -24,6 +24,7 @@ a finite difference of the exact map; the one in the state is exact. Events:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -31,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import _checks
-from clearjoint.continuation import ContinuationSettings, continue_branch
+from clearjoint.continuation import Branch, ContinuationSettings, continue_branch
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint
 from clearjoint.simulate import _kernel as kn
@@ -77,6 +78,14 @@ FloatArray = NDArray[np.float64]
 #: Transient periods run before Newton when no starting point is given, per attempt.
 _TRANSIENT_PERIODS = 32
 _TOLERANCE = 1e-12
+#: Times the continuation goes on past a point where it stopped, from an orbit further on.
+_REJOINS = 12
+#: Where the orbit further on is sought: these fractions of the way from the furthest
+#: parameter reached to the end of the range.
+_SEED_FACTORS = (0.003, 0.006, 0.01, 0.02)
+#: Points at most on the way back from such an orbit (a seed on a branch that does not
+#: lead back to the stop is given up after them).
+_BACK_POINTS = 500
 
 
 @dataclass(frozen=True)
@@ -628,7 +637,10 @@ def frequency_response(
 
     Pseudo-arclength continuation of the periodic orbit from ``omega_start`` to
     ``omega_stop`` (rad/s), through folds, stable and unstable branches alike,
-    with folds, period doublings and grazings reported as ``events``. With
+    with folds, period doublings and grazings reported as ``events``. Where the
+    continuation stops short of the end (no step converges, or it runs back along
+    itself), a period-1 orbit is sought further on and the branch followed from it
+    back to that point, then on: the curve stays one ordered path. With
     ``parameter="force"`` it continues in F0 from ``force_amplitude`` to
     ``force_stop`` (N) at the fixed ``omega_start`` (``omega_stop`` is then
     ignored and may be None).
@@ -711,25 +723,51 @@ def frequency_response(
             return []
         return [np.array([x, e * v]), np.array([x, v / e])]  # v+ = e v- on entering contact
 
-    branch = continue_branch(
-        _map_residual(p, parameter),
-        np.array(first.initial_state),
-        start,
-        stop,
-        u_scale=np.array([x_scale, v_scale]),
-        lam_scale=abs(stop - start),
-        settings=ContinuationSettings(
-            step=0.002,
-            min_step=1e-7,
-            max_step=0.023,
-            max_points=max_points,
-            tolerance=1e-11,
-            chord_parameter=True,
-        ),
-        restart=restart,
-        differs=differs,
-        equivalents=equivalents,
-    )
+    residual = _map_residual(p, parameter)
+
+    def follow(
+        u0: FloatArray,
+        lam0: float,
+        lam1: float,
+        points: int,
+        join: tuple[FloatArray, float, Any] | None = None,
+    ) -> Branch:
+        return continue_branch(
+            residual,
+            u0,
+            lam0,
+            lam1,
+            u_scale=np.array([x_scale, v_scale]),
+            lam_scale=abs(stop - start),
+            settings=ContinuationSettings(
+                step=0.002,
+                min_step=1e-7,
+                max_step=0.023,
+                max_points=points,
+                tolerance=1e-11,
+                chord_parameter=True,
+            ),
+            restart=restart,
+            differs=differs,
+            equivalents=equivalents,
+            join=join,
+        )
+
+    branch = follow(np.array(first.initial_state), start, stop, max_points)
+    for _ in range(_REJOINS):
+        if not branch.reason.startswith(("step too small", "ran back")):
+            break
+        joined = _rejoin(
+            branch,
+            follow,
+            lambda lam: _seed(joint, f0, w0, lam, parameter, damping_ratio, friction, restitution),
+            start,
+            stop,
+            max_points,
+        )
+        if joined is None:
+            break
+        branch = joined
     rows = np.array(branch.data)
     n = branch.lam.size
     omega = branch.lam.copy() if parameter == "omega" else np.full(n, w0)
@@ -782,6 +820,90 @@ def frequency_response(
             "restitution": restitution,
         },
     )
+
+
+def _seed(
+    joint: Joint,
+    force: float,
+    omega: float,
+    lam: float,
+    parameter: str,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+) -> FloatArray | None:
+    """A period-1 orbit at parameter ``lam`` from a transient (``periodic_orbit``), or None.
+
+    None too when its multiplier is 1 (a continuum of orbits: no single branch).
+    """
+    w, f = (lam, force) if parameter == "omega" else (omega, lam)
+    try:
+        orbit = periodic_orbit(
+            joint, f, w, damping_ratio=damping_ratio, friction=friction, restitution=restitution
+        )
+    except SimulationError:
+        return None
+    if np.min(np.abs(orbit.multipliers - 1.0)) < 1e-9:
+        return None
+    return np.array(orbit.initial_state, dtype=np.float64)
+
+
+def _rejoin(
+    branch: Branch,
+    follow: Callable[..., Branch],
+    seed: Callable[[float], FloatArray | None],
+    start: float,
+    stop: float,
+    max_points: int,
+) -> Branch | None:
+    """Go on past a point where the continuation stopped, from a period-1 orbit further on.
+
+    At parameters beyond the furthest one the branch reached (``_SEED_FACTORS``
+    of the way on to ``stop``), a period-1 orbit is sought by a transient and
+    Newton; from the first one found the branch is followed back towards
+    ``start`` until it reaches the point where ``branch`` stopped ("joined":
+    the crossing the stopped branch could not make, made from the other side),
+    then on to ``stop``. Returns the branch followed through, in order (``branch``,
+    the way back reversed, the way on), with a kink where the two meet; None when
+    no seed's branch joins it.
+    """
+    direction = 1.0 if stop > start else -1.0
+    furthest = float(np.max(direction * branch.lam)) * direction
+    left = max_points - branch.lam.size
+    for factor in _SEED_FACTORS:
+        lam = furthest + factor * (stop - furthest)
+        u0 = seed(lam)
+        if u0 is None or left < 4:
+            continue
+        back = follow(
+            u0,
+            lam,
+            start,
+            min(left, _BACK_POINTS),
+            (branch.u[-1], float(branch.lam[-1]), branch.data[-1]),
+        )
+        if back.reason != "joined":
+            continue
+        on = follow(back.u[0], float(back.lam[0]), stop, max(2, left - back.lam.size + 1))
+        n, m = branch.lam.size, back.lam.size
+        kinks = [
+            *branch.kinks,
+            n,
+            *(n + m - k for k in back.kinks),
+            *(n + m - 1 + k for k in on.kinks),
+        ]
+        return Branch(
+            u=np.concatenate((branch.u, back.u[::-1], on.u[1:])),
+            lam=np.concatenate((branch.lam, back.lam[::-1], on.lam[1:])),
+            tangent=np.concatenate((branch.tangent, -back.tangent[::-1], on.tangent[1:])),
+            iterations=np.concatenate(
+                (branch.iterations, back.iterations[::-1], on.iterations[1:])
+            ),
+            data=[*branch.data, *back.data[::-1], *on.data[1:]],
+            reason=on.reason,
+            kinks=np.array(kinks, dtype=np.int64),
+        )
+    return None
 
 
 def _events(
