@@ -255,7 +255,7 @@ def main() -> None:
         members = tuple(Member(i, i + 1, youngs_modulus=e, area=area) for i in range(n))
         bar = Structure(np.linspace(0, length, n + 1), masses, members, supports=(0,))
         error = bar.modes(count=3).omega / exact - 1.0
-        shown = np.array2string(error, precision=2)
+        shown = np.array2string(error, formatter={"float_kind": lambda x: f"{x:.2e}"})
         print(f"  bar, n = {n:4d}: relative error of modes 1-3 = {shown}")
     m1, m2, k1, k2 = 2.0, 0.5, 3e6, 1e6
     a = (k1 + k2) / m1 + k2 / m2
