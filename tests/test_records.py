@@ -234,6 +234,38 @@ def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
         read_brfd(path)
 
 
+SHIPPED = Path(__file__).resolve().parent / "data" / "brfd"
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in SHIPPED.glob("*.json")))
+def test_brfd_reader_gives_pythons_own_doubles_bit_for_bit(name: str) -> None:
+    # the fast reader (orjson) against the standard library's json, an independent parser
+    path = SHIPPED / name
+    raw = np.array(json.loads(path.read_text())["data"], dtype=np.float64)
+    r = read_brfd(path)
+    assert r.time.size == raw.shape[0] > 1000
+    np.testing.assert_array_equal(r.time, raw[:, 0])  # exactly: the same doubles
+    np.testing.assert_array_equal(r.displacement, raw[:, 1] * 0.0254)
+    np.testing.assert_array_equal(r.velocity, raw[:, 3] * 0.0254)
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b'{"data": [[0.0, 1.0], [1.0, "x"]]}', "not numeric"),
+        (b'{"data": [[0.0, 1.0], [1.0, 2.0]], "note": "caf\xe9"}', "not a JSON file"),
+        (b"[1, 2]", "not a BRFD record"),
+    ],
+)
+def test_brfd_reader_refuses_what_is_not_a_numeric_matrix(
+    tmp_path: Path, content: bytes, message: str
+) -> None:
+    path = tmp_path / "1Hz0lbtension1amplitude.json"
+    path.write_bytes(content)
+    with pytest.raises(RecordError, match=message):
+        read_brfd(path)
+
+
 def test_fast_unit_factors_agree_with_pint() -> None:
     from clearjoint.records import FAST_FACTORS, SI
     from clearjoint.units import registry
