@@ -524,3 +524,41 @@ def test_fft_length_is_the_smallest_even_five_smooth_one() -> None:
         reference = next_fast_len(int(n), real=True)
         if reference % 2 == 0:
             assert length == reference
+
+
+@pytest.mark.parametrize("jobs", [2, 5])
+def test_shares_cover_every_file_once_and_are_near_the_best_split(jobs: int) -> None:
+    import itertools
+
+    from clearjoint.identify.core import _balanced_chunks
+
+    rng = np.random.default_rng(jobs)
+    for n in (1, 3, 7, 9):
+        sizes = [int(s) for s in rng.integers(1, 1000, n)]
+        shares = _balanced_chunks(sizes, jobs)
+        assert sorted(i for share in shares for i in share) == list(range(n))
+        assert all(share == sorted(share) and share for share in shares)
+        assert len(shares) == min(n, jobs)
+        if jobs**n > 100_000:
+            continue
+        # against the best split, found by trying every assignment (LPT: within 4/3)
+        best = min(
+            max(sum(s for s, k in zip(sizes, owner, strict=True) if k == j) for j in range(jobs))
+            for owner in itertools.product(range(jobs), repeat=n)
+        )
+        assert max(sum(sizes[i] for i in share) for share in shares) <= 4 / 3 * best
+
+
+def test_parallel_shares_give_the_serial_outcomes_in_file_order(tmp_path: Path) -> None:
+    files = [str(p) for p in sorted(SHIPPED.glob("*.json"))]
+    files.insert(1, str(tmp_path / "missing.json"))  # refused, with its reason, in its place
+    serial, serial_failures = identify_files(files)
+    seen: list[int] = []
+    parallel, failures = identify_files(files, jobs=3, progress=lambda done, _: seen.append(done))
+    assert failures == serial_failures
+    assert "missing.json: no such file" in failures[0]
+    assert seen == [1, 2, 3, 4]
+    assert [i.source for _, i in parallel] == [i.source for _, i in serial]
+    for (ra, a), (rb, b) in zip(serial, parallel, strict=True):
+        np.testing.assert_equal(a.row(), b.row())  # bit for bit; NaN equals NaN here
+        np.testing.assert_array_equal(ra.displacement, rb.displacement)

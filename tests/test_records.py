@@ -67,6 +67,34 @@ def test_round_trip_keeps_data_and_metadata(tmp_path: Path, suffix: str) -> None
     assert back.source == str(path)
 
 
+def test_netcdf_variables_of_other_types_and_string_kinds_are_read(tmp_path: Path) -> None:
+    # written by h5py by hand (not by xarray): float32, an integer variable (read by h5py's
+    # usual interface), fixed-length and variable-length unit strings
+    import h5py
+
+    path = tmp_path / "lab.nc"
+    t = np.arange(400) / 400.0
+    force = (50 * np.sin(2 * np.pi * 10 * t)).astype(np.float32)
+    steps = np.round(100 * np.sin(2 * np.pi * 10 * t - 0.3)).astype(np.int32)
+    with h5py.File(path, "w") as handle:
+        handle["time"] = t
+        handle["time"].attrs["units"] = "s"
+        handle["force"] = force
+        handle["force"].attrs["units"] = np.bytes_(b"kN")
+        handle["displacement"] = steps
+        handle["displacement"].attrs["units"] = "um"
+        handle.attrs["frequency_hz"] = 10.0
+    back = read_record(path)
+    np.testing.assert_array_equal(back.time, t)
+    np.testing.assert_array_equal(back.force, force.astype(np.float64) * 1000.0)
+    np.testing.assert_allclose(back.displacement, steps * 1e-6, rtol=1e-15)
+    assert back.frequency_hz == 10.0
+    with h5py.File(path, "a") as handle:
+        del handle["force"].attrs["units"]
+    with pytest.raises(RecordError, match="variable 'force' has no units attribute"):
+        read_record(path)
+
+
 def test_csv_units_are_converted_to_si(tmp_path: Path) -> None:
     path = tmp_path / "lab.csv"
     t = np.arange(100) / 100.0
@@ -231,6 +259,38 @@ def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
     path = tmp_path / "1Hz0lbtension1amplitude.json"
     path.write_text(json.dumps({"data": [[0.0, 1.0]] * 20, "displacement units": "in"}))
     with pytest.raises(RecordError, match="must have 6 columns"):
+        read_brfd(path)
+
+
+SHIPPED = Path(__file__).resolve().parent / "data" / "brfd"
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in SHIPPED.glob("*.json")))
+def test_brfd_reader_gives_pythons_own_doubles_bit_for_bit(name: str) -> None:
+    # the fast reader (orjson) against the standard library's json, an independent parser
+    path = SHIPPED / name
+    raw = np.array(json.loads(path.read_text())["data"], dtype=np.float64)
+    r = read_brfd(path)
+    assert r.time.size == raw.shape[0] > 1000
+    np.testing.assert_array_equal(r.time, raw[:, 0])  # exactly: the same doubles
+    np.testing.assert_array_equal(r.displacement, raw[:, 1] * 0.0254)
+    np.testing.assert_array_equal(r.velocity, raw[:, 3] * 0.0254)
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b'{"data": [[0.0, 1.0], [1.0, "x"]]}', "not numeric"),
+        (b'{"data": [[0.0, 1.0], [1.0, 2.0]], "note": "caf\xe9"}', "not a JSON file"),
+        (b"[1, 2]", "not a BRFD record"),
+    ],
+)
+def test_brfd_reader_refuses_what_is_not_a_numeric_matrix(
+    tmp_path: Path, content: bytes, message: str
+) -> None:
+    path = tmp_path / "1Hz0lbtension1amplitude.json"
+    path.write_bytes(content)
+    with pytest.raises(RecordError, match=message):
         read_brfd(path)
 
 

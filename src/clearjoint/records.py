@@ -18,6 +18,7 @@ The layouts are documented in docs/records.md. Nothing is overwritten unless ask
 
 from __future__ import annotations
 
+import gc
 import json
 import math
 import re
@@ -669,7 +670,10 @@ def _read_netcdf(path: Path, resample_: bool) -> Record:
     """Read the HDF5 layer of a netCDF-4 file with h5py: the variables are its datasets.
 
     Writing goes through xarray (h5netcdf engine); reading a handful of 1-D variables
-    does not need it, and h5py takes a tenth of the time.
+    does not need it, and h5py takes a tenth of the time. A 1-D float variable and its
+    ``units`` string are read through h5py's low-level calls (h5py's ``Dataset`` objects
+    cost more than reading their data: a third of the read time of a rig record), anything
+    else through its usual interface.
     """
     import h5py
 
@@ -681,14 +685,20 @@ def _read_netcdf(path: Path, resample_: bool) -> Record:
     with handle:
         columns: dict[str, FloatArray] = {}
         units: dict[str, str] = {}
+        root = handle.id
         for name in ("time", *CHANNELS):
-            variable = handle.get(name)  # one lookup each (h5py's are slow)
-            if variable is None:
+            if name.encode() not in root:
                 continue
-            unit = _text(variable.attrs.get("units", ""))
+            fast = _h5_variable(h5py, root, name.encode())
+            if fast is None:
+                variable = handle[name]
+                unit = _text(variable.attrs.get("units", ""))
+                values = np.asarray(variable[...], dtype=np.float64)
+            else:
+                unit, values = fast
             if not unit:
                 raise RecordError(f"{where}: variable {name!r} has no units attribute")
-            columns[name] = np.asarray(variable[...], dtype=np.float64) * _factor(where, name, unit)
+            columns[name] = values * _factor(where, name, unit)
             units[name] = unit
         meta: dict[str, Any] = {}
         attrs = handle.attrs
@@ -702,6 +712,28 @@ def _read_netcdf(path: Path, resample_: bool) -> Record:
                     else float(np.asarray(value).item())
                 )
     return _assemble(where, columns, units, meta, resample_)
+
+
+def _h5_variable(h5py: Any, root: Any, name: bytes) -> tuple[str, FloatArray] | None:
+    """A 1-D float dataset's ``units`` (a scalar string, or "") and its values as float64,
+    by h5py's low-level calls; None for anything else (read by the usual interface)."""
+    try:
+        dataset = h5py.h5d.open(root, name)
+    except (KeyError, TypeError, ValueError):  # a group, or a link to nothing
+        return None
+    if dataset.dtype.kind != "f" or len(dataset.shape) != 1:
+        return None
+    unit = ""
+    if h5py.h5a.exists(dataset, b"units"):
+        attr = h5py.h5a.open(dataset, b"units")
+        if attr.shape != () or h5py.h5t.check_string_dtype(attr.dtype) is None:
+            return None
+        text = np.empty((), dtype=attr.dtype)
+        attr.read(text)
+        unit = _text(text[()])
+    values = np.empty(dataset.shape, dtype=np.float64)
+    dataset.read(h5py.h5s.ALL, h5py.h5s.ALL, values)
+    return unit, values
 
 
 def _text(value: Any) -> str:
@@ -766,39 +798,30 @@ BRFD_CITATION = (
 )
 
 
-_DATA_KEY = re.compile(rb'"data"\s*:\s*\[')
-_BRACKETS = bytes.maketrans(b"[]", b"  ")
-
-
 def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
     """The JSON's metadata and its 'data' matrix, from the file's bytes.
 
-    The matrix is tens of thousands of rows; it is parsed as numbers straight from
-    the bytes by numpy's C parser (several times faster than building Python lists;
-    the brackets become blanks in one pass, no text is decoded), and the rest of the
-    object by the json module. Anything unexpected goes through json whole.
+    Parsed by orjson: its numbers are the correctly rounded doubles that Python's
+    ``float`` gives, bit for bit, and it is faster than numpy's C parser of the matrix
+    text over the 31 BRFD files, more so with the garbage collector off while the rows'
+    lists are built (they hold only numbers: no cycles to collect); side by side by
+    ``python benchmarks/bench_identify.py --parsers``.
     """
-    match = _DATA_KEY.search(raw)
-    end = raw.find(b"]]", match.end()) if match else -1
-    if match and end > 0:
-        body = raw[match.end() - 1 : end + 2]
-        rows = body.count(b"[") - 1
-        numbers = np.fromstring(body.translate(_BRACKETS), sep=",")
-        if rows > 0 and numbers.size % rows == 0:
-            rest = raw[: match.start()] + b'"data": null' + raw[end + 2 :]
-            try:
-                content = json.loads(rest.decode("utf-8"))
-            except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-                raise RecordError(f"{where}: not a JSON file ({exc})") from None
-            return content, numbers.reshape(rows, numbers.size // rows)
+    import orjson  # only a JSON record needs it
+
+    collecting = gc.isenabled()
+    gc.disable()  # tens of thousands of new lists, no cycles: the collector only costs time
     try:
-        content = json.loads(raw.decode("utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        content = orjson.loads(raw)
+    except orjson.JSONDecodeError as exc:  # also bytes that are not UTF-8
         raise RecordError(f"{where}: not a JSON file ({exc})") from None
+    finally:
+        if collecting:
+            gc.enable()
     if not isinstance(content, dict) or "data" not in content:
         raise RecordError(f"{where}: JSON without a 'data' matrix; not a BRFD record")
     try:
-        data = np.asarray(content["data"], dtype=np.float64)
+        data = np.array(content["data"], dtype=np.float64)
     except (TypeError, ValueError):
         raise RecordError(f"{where}: the 'data' matrix is not numeric") from None
     return content, data
