@@ -323,20 +323,12 @@ class FrequencyResponse:
                 "cycle() re-runs exact orbits of a shooting curve; for a harmonic-balance point "
                 "use clearjoint.periodic.periodic_orbit(..., initial=initial_state[index])"
             )
-        s = self.settings
-        p = _parameters(
-            s["joint"],
-            float(self.force_amplitude[index]),
-            float(self.omega[index]),
-            s["damping_ratio"],
-            s["friction"],
-            s["restitution"],
-        )
+        p = self._point_parameters(index)
         state = np.zeros(4)
         start_state(
             p, float(self.initial_state[index, 0]), float(self.initial_state[index, 1]), state
         )
-        return _orbit_from(p, s["joint"], state, 1, 0, None, 0.0, 64)
+        return _orbit_from(p, self.settings["joint"], state, 1, 0, None, 0.0, 64)
 
     def period_2_orbit(self, event: ResponseEvent) -> PeriodicOrbit:
         """Switch branches at a period doubling: the period-2 orbit born there (MODEL.md sec. 5.1).
@@ -411,10 +403,10 @@ class FrequencyResponse:
             "periodic_orbit(..., period_multiple=2, initial=...) from a steady_state"
         )
 
-    def _monodromy(self, index: int) -> FloatArray:
-        """The monodromy matrix of the period-1 orbit at point ``index`` (re-run exactly)."""
+    def _point_parameters(self, index: int) -> Any:
+        """The kernel's parameters of point ``index`` (its force and frequency)."""
         s = self.settings
-        p = _parameters(
+        return _parameters(
             s["joint"],
             float(self.force_amplitude[index]),
             float(self.omega[index]),
@@ -422,6 +414,10 @@ class FrequencyResponse:
             s["friction"],
             s["restitution"],
         )
+
+    def _monodromy(self, index: int) -> FloatArray:
+        """The monodromy matrix of the period-1 orbit at point ``index`` (re-run exactly)."""
+        p = self._point_parameters(index)
         return shoot(p, self.initial_state[index], 1).monodromy
 
     def plot(self, ax: Axes | None = None) -> Axes:

@@ -286,20 +286,7 @@ def _structure(st: dict[str, Any], joint: ClearanceJoint | None, where: str) -> 
                 'e.g. clearance = "50um", compression_stiffness = "5e7N/m"); without one it '
                 "would have no joints"
             )
-        options = {
-            k: st[k]
-            for k in (
-                "width",
-                "bay_height",
-                "longeron_rigidity",
-                "batten_rigidity",
-                "diagonal_rigidity",
-                "node_mass",
-                "tip_mass",
-                "member_damping",
-            )
-            if k in st
-        }
+        options = {k: st[k] for k in KIND_KEYS["mast"] if k != "bays" and k in st}
         structure = mast(st["bays"], joints=joint, rayleigh=rayleigh, **options)
     elif kind == "chain":
         for key in ("masses", "stiffnesses"):
