@@ -4,9 +4,11 @@ The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the for
 amplitude) by the same continuation as the exact shooting of
 :mod:`clearjoint.periodic`, and returned as the same
 :class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
-kept. Stability comes from Hill's method: for one DOF with constant damping from
-Hill's infinite determinant (one determinant per point), otherwise from the
-eigenvalues of Hill's quadratic eigenproblem; events are located as in
+kept. Stability: for one DOF with constant damping from Hill's infinite
+determinant (one determinant per point); for a Structure from the exact monodromy
+of the HB orbit's piecewise-linear linearisation (:mod:`clearjoint.harmonic.monodromy`,
+no exponent to pick out of Hill's truncated spectrum); for a Joint with friction
+from the eigenvalues of Hill's quadratic eigenproblem; events are located as in
 :mod:`clearjoint.periodic`: folds where the parameter component of the tangent
 changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
 through -1), grazings where a joint's extreme relative displacement crosses a gap
@@ -24,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.continuation import ContinuationSettings, continue_branch
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.harmonic import aft
+from clearjoint.harmonic import aft, monodromy
 from clearjoint.harmonic.solve import TOLERANCE, linear_guess, newton
 from clearjoint.harmonic.system import (
     HarmonicError,
@@ -268,7 +270,11 @@ def _response(
     multipliers = np.empty((n_pts, 2 * n), dtype=np.complex128)
     determinant = n == 1 and model.friction_force is None
     jacobians = np.empty((n_pts, n_c, n_c)) if determinant else None
+    exact = not model.is_joint and model.friction_force is None
     for i in range(n_pts):
+        if exact:  # a structure: the exact monodromy of the orbit's linearisation
+            multipliers[i] = monodromy.multipliers(model, basis, coef[i], float(omega[i]))
+            continue
         ev = evaluations[i] if i < len(evaluations) else None
         if not isinstance(ev, aft.Evaluation):  # a point the continuation did not evaluate
             f = pattern if parameter == "omega" else force[i] * unit_force
