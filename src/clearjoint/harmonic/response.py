@@ -26,8 +26,13 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.continuation import ContinuationSettings, continue_branch
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.harmonic import aft, monodromy
-from clearjoint.harmonic.solve import TOLERANCE, linear_guess, newton
+from clearjoint.harmonic import aft, monodromy, solve
+from clearjoint.harmonic.solve import (
+    TOLERANCE,
+    SparseResidual,
+    linear_guess,
+    newton,
+)
 from clearjoint.harmonic.system import (
     HarmonicError,
     LinearSystem,
@@ -159,8 +164,11 @@ def frequency_response(
             d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
         return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev
 
+    # a large structure: the corrector's bordered solves by sparse LU (continuation hands
+    # them to the residual's own corrector when chord_parameter is set)
+    sparse = not model.is_joint and q0.size > solve.SPARSE_ABOVE
     branch = continue_branch(
-        residual,
+        SparseResidual(residual) if sparse else residual,
         q0,
         start,
         stop,
@@ -172,6 +180,7 @@ def frequency_response(
             max_step=max_step,
             max_points=max_points,
             tolerance=TOLERANCE,
+            chord_parameter=sparse,
         ),
     )
     return _response(
