@@ -167,8 +167,20 @@ def frequency_response(
     # a large structure: the corrector's bordered solves by sparse LU (continuation hands
     # them to the residual's own corrector when chord_parameter is set)
     sparse = not model.is_joint and q0.size > solve.SPARSE_ABOVE
+    # one DOF in w: the whole corrector compiled (one call per correction)
+    compiled = (
+        parameter == "omega"
+        and model.n_dof == 1
+        and model.friction_force is None
+        and basis.assemble is not None
+    )
+    chosen: Any = residual
+    if sparse:
+        chosen = SparseResidual(residual)
+    elif compiled:
+        chosen = aft.OneDofResidual(residual, model, basis, float(pattern[0]), k_ref)
     branch = continue_branch(
-        SparseResidual(residual) if sparse else residual,
+        chosen,
         q0,
         start,
         stop,
@@ -180,7 +192,7 @@ def frequency_response(
             max_step=max_step,
             max_points=max_points,
             tolerance=TOLERANCE,
-            chord_parameter=sparse,
+            chord_parameter=sparse or compiled,
         ),
     )
     return _response(
