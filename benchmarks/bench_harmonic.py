@@ -189,19 +189,94 @@ def mast_benchmarks(points: int) -> None:
             f"  {bays:2d} bays, H = {h:2d}: {took / fr.omega.size:.3f} s per point "
             f"({fr.omega.size} points), of which Hill's eigenproblem {hill:.3f} s"
         )
-    s = mast_model(10)
-    force = np.zeros(s.n_dof)  # type: ignore[attr-defined]
-    force[-2] = 2.0
-    f_open = float(s.modes("open").omega[0])  # type: ignore[attr-defined]
-    f_closed = float(s.modes("closed").omega[0])  # type: ignore[attr-defined]
-    start = time.perf_counter()
-    fr = frequency_response(s, force, 0.8 * f_open, 1.2 * f_closed, harmonics=7, max_points=points)
-    took = time.perf_counter() - start
+    example_mast_curve(points)
+
+
+#: The example mast's curve: from below its open first mode to past its closed one, with
+#: the study's force pattern scaled to 0.1 N (at the study's 20 N the H = 7 orbits near
+#: the first mode are violently unstable, docs/harmonic.md).
+MAST_FROM_HZ, MAST_TO_HZ, MAST_MAX_STEP, MAST_FORCE_N = 0.9, 20.0, 0.05, 0.1
+
+
+def example_mast_curve(points: int) -> None:
+    """The frequency response of examples/mast.toml around its first mode, H = 7, timed."""
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.system import from_structure
+    from clearjoint.structure.study import load_structure_study
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    study = load_structure_study(os.path.join(root, "examples", "mast.toml"))
+    s = study.structure
+    force = study.force * (MAST_FORCE_N / float(np.max(np.abs(study.force))))
+    modes = (float(s.modes(p).omega[0]) / (2 * math.pi) for p in ("open", "closed"))
     print(
-        f"mast, 10 bays, H = 7, tip force 2 N, {0.8 * f_open / (2 * math.pi):.2f} to "
-        f"{1.2 * f_closed / (2 * math.pi):.2f} Hz: {fr.omega.size} points in {took:.1f} s "
-        f"({fr.stop_reason}; reached {fr.omega[-1] / (2 * math.pi):.3f} Hz, "
-        f"{int(np.sum(~fr.stable))} unstable points)"
+        f"examples/mast.toml ({s.n_dof} DOF, {len(s.joint_laws)} joints, first mode open "
+        f"{next(modes):.3f} Hz, closed {next(modes):.3f} Hz), force "
+        f"{MAST_FORCE_N} N at its [excitation] DOF, H = 7, "
+        f"{MAST_FROM_HZ} to {MAST_TO_HZ} Hz, max_step {MAST_MAX_STEP}, {points} points at most:"
+    )
+    start = time.perf_counter()
+    fr = frequency_response(
+        s,
+        force,
+        2 * math.pi * MAST_FROM_HZ,
+        2 * math.pi * MAST_TO_HZ,
+        harmonics=7,
+        max_points=points,
+        max_step=MAST_MAX_STEP,
+    )
+    took = time.perf_counter() - start
+    hz = fr.omega / (2 * math.pi)
+    peak = int(np.argmax(np.max(fr.amplitude, axis=1)))
+    print(
+        f"  {fr.omega.size} points in {took:.1f} s ({took / fr.omega.size:.3f} s per point), "
+        f"{hz.min():.3f} to {hz.max():.3f} Hz, stop: {fr.stop_reason}"
+    )
+    print(
+        f"  largest amplitude {1e3 * np.max(fr.amplitude[peak]):.3f} mm at {hz[peak]:.3f} Hz; "
+        f"{int(np.sum(fr.stable))} stable, {int(np.sum(~fr.stable))} unstable points"
+    )
+    for e in fr.events:
+        print(f"  {e.kind}: {e.omega / (2 * math.pi):.4f} Hz, {1e3 * e.amplitude:.4f} mm")
+    model = from_structure(s)
+    basis = aft.Basis.make(7, int(fr.settings["samples"]))
+    coef, w = fr.coefficients[peak], float(fr.omega[peak])  # type: ignore[index]
+    ev = aft.evaluate(model, basis, coef.ravel(), w, force)
+    start = time.perf_counter()
+    monodromy.multipliers(model, basis, coef, w)
+    mono = time.perf_counter() - start
+    start = time.perf_counter()
+    aft.hill_exponents(model, basis, ev.jacobian, w)
+    hill = time.perf_counter() - start
+    # the verdicts against the exact motion: 30 periods of structure.time_response from the
+    # HB state of the first stable point and of the most unstable one
+    from clearjoint.structure import time_response
+
+    n = s.n_dof
+    dof = int(np.argmax(np.abs(force)))
+    for verdict in (True, False):
+        picks = np.flatnonzero(fr.stable == verdict)
+        if picks.size == 0:
+            continue
+        largest = np.max(np.abs(fr.multipliers[picks]), axis=1)
+        i = int(picks[0]) if verdict else int(picks[np.argmax(largest)])
+        x0 = fr.initial_state[i]
+        w_i = float(fr.omega[i])
+        motion = time_response(
+            s, force, w_i, 30 * 2 * math.pi / w_i, initial=(x0[:n], x0[n:]), samples_per_period=64
+        )
+        peaks = motion.u[: 30 * 64, dof].reshape(30, 64).max(axis=1)
+        print(
+            f"  {'stable' if verdict else 'unstable'} point at {w_i / (2 * math.pi):.4f} Hz "
+            f"(largest multiplier {np.max(np.abs(fr.multipliers[i])):.3f}): HB tip maximum "
+            f"{1e3 * fr.x_max[i, dof]:.4f} mm, exact motion from the HB state over 30 periods "
+            f"{1e3 * peaks.min():.4f} to {1e3 * peaks.max():.4f} mm "
+            f"(last 5 periods {1e3 * peaks[-5:].min():.4f} to {1e3 * peaks[-5:].max():.4f})"
+        )
+    print(
+        f"  stability at the peak: exact monodromy {mono:.3f} s "
+        f"({monodromy.crossings(model, basis, coef).size} gap-edge crossings), "
+        f"Hill's dense eigenproblem (not used) {hill:.3f} s"
     )
 
 
@@ -242,10 +317,16 @@ def main() -> None:
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
     parser.add_argument("--mast", action="store_true", help="the mast timings instead")
     parser.add_argument("--mast-points", type=int, default=300, help="mast curve points")
+    parser.add_argument(
+        "--mast-curve", action="store_true", help="only the example mast's curve (--mast's last)"
+    )
     parser.add_argument("--samples", action="store_true", help="the error against N_t instead")
     args = parser.parse_args()
     if args.samples:
         samples_error()
+        return
+    if args.mast_curve:
+        example_mast_curve(args.mast_points)
         return
     if args.mast:
         mast_benchmarks(args.mast_points)

@@ -177,3 +177,33 @@ def test_stability_is_recomputed_where_the_continuation_kept_no_evaluation(
     anew = run()
     assert anew.omega.size == kept.omega.size
     np.testing.assert_allclose(anew.multipliers, kept.multipliers, rtol=1e-12, atol=1e-15)
+
+
+def test_compiled_one_dof_corrector_follows_the_same_curve(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """aft.OneDofResidual's compiled corrector and continuation's own Python one agree."""
+    from clearjoint.harmonic import aft
+
+    calls = []
+    original = aft.OneDofResidual.corrector
+
+    def counted(self: aft.OneDofResidual, *args: object) -> object:
+        calls.append(1)
+        return original(self, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(aft.OneDofResidual, "corrector", counted)
+    fast = frequency_response(PYHARM, 0.03, 0.6, 1.8, harmonics=7, damping_ratio=PYHARM_ZETA)
+    assert len(calls) >= fast.omega.size
+    monkeypatch.delattr(aft.OneDofResidual, "corrector")
+    plain = frequency_response(PYHARM, 0.03, 0.6, 1.8, harmonics=7, damping_ratio=PYHARM_ZETA)
+    # the same Newton steps from the same start (continuation's own corrector, asked for
+    # the compiled one's, keeps dR/dw as a chord; step sizes then differ a little)
+    np.testing.assert_allclose(fast.omega[:4], plain.omega[:4], rtol=1e-9)
+    np.testing.assert_allclose(fast.coefficients[:4], plain.coefficients[:4], atol=1e-10)
+    assert fast.stop_reason == plain.stop_reason == "reached"
+    assert np.max(fast.amplitude) == pytest.approx(np.max(plain.amplitude), rel=1e-4)
+    mine = sorted((e.kind, e.omega) for e in fast.events)
+    theirs = sorted((e.kind, e.omega) for e in plain.events)
+    assert [k for k, _ in mine] == [k for k, _ in theirs]
+    np.testing.assert_allclose([w for _, w in mine], [w for _, w in theirs], rtol=2e-3)

@@ -149,3 +149,28 @@ def test_sparse_and_dense_newton_give_the_same_mode(
     np.testing.assert_allclose(sparse.frequency, dense.frequency, rtol=1e-9)
     np.testing.assert_allclose(sparse.damping_ratio, dense.damping_ratio, rtol=1e-7)
     np.testing.assert_allclose(sparse.x_max, dense.x_max, rtol=1e-8, atol=1e-14)
+
+
+def test_sparse_and_dense_continuation_give_the_same_curve(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The sparse arclength corrector (solve.SparseResidual, above SPARSE_ABOVE unknowns)
+    follows the same curve as the continuation's own dense one, through the resonance."""
+    from clearjoint.harmonic import solve
+
+    dense = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    calls = []
+    original = solve.SparseResidual.corrector
+
+    def counted(self: solve.SparseResidual, *args: object) -> object:
+        calls.append(1)
+        return original(self, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(solve.SparseResidual, "corrector", counted)
+    sparse = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
+    assert len(calls) >= 24  # every point corrected by the sparse corrector
+    assert dense.omega.size == sparse.omega.size == 25
+    np.testing.assert_allclose(sparse.omega, dense.omega, rtol=1e-9)
+    np.testing.assert_allclose(sparse.coefficients, dense.coefficients, rtol=1e-7, atol=1e-12)
+    assert np.array_equal(sparse.stable, dense.stable)

@@ -26,7 +26,9 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -585,3 +587,174 @@ def hill_multipliers(exponents: NDArray[np.complex128], omega: float) -> NDArray
     """Floquet multipliers exp(lambda T), T = 2 pi / w, largest modulus first."""
     mu = np.exp(exponents * (2.0 * math.pi / omega))
     return np.asarray(mu[np.argsort(-np.abs(mu), kind="stable")], dtype=np.complex128)
+
+
+@njit(cache=True)
+def _correct_one_dof(
+    y0: FloatArray,
+    tangent: FloatArray,
+    scale: FloatArray,
+    tolerance: float,
+    max_iterations: int,
+    fixed_lambda: bool,
+    k_ref: float,
+    force: float,
+    m: float,
+    c: float,
+    k: float,
+    b: FloatArray,
+    k0: FloatArray,
+    k_c: FloatArray,
+    k_t: FloatArray,
+    g_c: FloatArray,
+    g_t: FloatArray,
+    e: FloatArray,
+    p: FloatArray,
+    d: FloatArray,
+    order: FloatArray,
+    moments: FloatArray,
+    assemble: FloatArray,
+) -> tuple[int, FloatArray, FloatArray, int, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The continuation's arclength corrector for one DOF in w, compiled (see one_dof_corrector).
+
+    Returns (status, y, a, iterations, R, dR/dq, dR/dw, tangent): status 1 converged,
+    0 failed.
+    """
+    n = y0.size - 1
+    y = y0.copy()
+    system = np.empty((n + 1, n + 1))
+    rhs = np.empty(n + 1)
+    for iteration in range(max_iterations + 1):
+        lam = y[n] * scale[n]
+        if not lam > 0.0:
+            break
+        q = y[:n] * scale[:n]
+        r, jac, d_omega, kt = _evaluate_one_dof(
+            q, lam, force, m, c, k, b, k0, k_c, k_t, g_c, g_t, e, p, d, order, moments, assemble
+        )
+        size = 0.0
+        finite = True
+        for i in range(n):
+            rs = r[i] / k_ref / scale[i]
+            rhs[i] = -rs
+            size = max(size, abs(rs))
+            for j in range(n):
+                system[i, j] = jac[i, j] / k_ref * (scale[j] / scale[i])
+                finite = finite and math.isfinite(system[i, j])
+            system[i, n] = d_omega[i] / k_ref * (scale[n] / scale[i])
+            finite = finite and math.isfinite(system[i, n])
+        if not (math.isfinite(size) and finite):
+            break
+        if size <= tolerance:
+            return 1, y, system[:n].copy(), iteration, r, jac, d_omega, kt
+        if iteration == max_iterations:
+            break
+        if fixed_lambda:
+            system[n, :] = 0.0
+            system[n, n] = 1.0
+            rhs[n] = 0.0
+        else:
+            system[n, :] = tangent
+            rhs[n] = -np.dot(tangent, y - y0)
+        y = y + np.linalg.solve(system, rhs)
+    empty = np.zeros(0)
+    return 0, y, system[:n].copy(), 0, empty, system, empty, system
+
+
+class OneDofResidual:
+    """The HB residual of one DOF without friction in w, with a compiled arclength corrector.
+
+    :func:`clearjoint.continuation.continue_branch` hands the correction to a
+    residual's ``corrector`` when ``ContinuationSettings.chord_parameter`` is set; this
+    one runs the continuation's own Newton iteration (rows scaled by the unknowns'
+    sizes, the same tolerance) in one compiled call, with the compiled evaluation of
+    :func:`evaluate`, instead of one Python round trip per iteration.
+
+    Parameters
+    ----------
+    function : callable
+        The plain residual(u, lam) -> (R, dR/du, dR/dlam, Evaluation), scaled by k_ref.
+    system : LinearSystem
+        One DOF, without friction.
+    basis : Basis
+        With ``assemble`` (H <= 31).
+    force : float
+        F0, N.
+    k_ref : float
+        The stiffness the residual is divided by, N/m.
+    """
+
+    def __init__(
+        self,
+        function: Callable[[FloatArray, float], tuple[FloatArray, FloatArray, FloatArray, Any]],
+        system: LinearSystem,
+        basis: Basis,
+        force: float,
+        k_ref: float,
+    ) -> None:
+        self.function = function
+        self.system = system
+        self.basis = basis
+        self.force = force
+        self.k_ref = k_ref
+
+    def __call__(
+        self, u: FloatArray, lam: float, want_lambda: bool = True
+    ) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
+        """R, dR/du, dR/dlam and the Evaluation at (u, lam)."""
+        return self.function(u, lam)
+
+    def corrector(
+        self,
+        y0: FloatArray,
+        tangent: FloatArray,
+        scale: FloatArray,
+        settings: Any,
+        fixed_lambda: bool,
+    ) -> tuple[FloatArray, FloatArray, Evaluation, int] | None:
+        """Newton on [R(y); t . (y - y0)] = 0 (or R at fixed w), compiled; None if it fails.
+
+        Parameters
+        ----------
+        y0, tangent : (d + 1,) ndarray
+            Predicted point and arclength direction, scaled coordinates.
+        scale : (d + 1,) ndarray
+            u_scale then lam_scale.
+        settings : ContinuationSettings
+        fixed_lambda : bool
+
+        Returns
+        -------
+        tuple or None
+            (y, the scaled [dR/du, dR/dlam] (d, d + 1), Evaluation, iterations).
+        """
+        s, basis = self.system, self.basis
+        assert basis.assemble is not None
+        status, y, a, its, r, jac, d_omega, kt = _correct_one_dof(
+            np.ascontiguousarray(y0, dtype=np.float64),
+            np.ascontiguousarray(tangent, dtype=np.float64),
+            np.ascontiguousarray(scale, dtype=np.float64),
+            float(settings.tolerance),
+            int(settings.max_iterations),
+            bool(fixed_lambda),
+            self.k_ref,
+            self.force,
+            float(s.mass[0, 0]),
+            float(s.damping[0, 0]),
+            float(s.stiffness[0, 0]),
+            s.directions[:, 0].copy(),
+            s.k0,
+            s.k_c,
+            s.k_t,
+            s.g_c,
+            s.g_t,
+            basis.to_time,
+            basis.to_coefficients,
+            basis.derivative,
+            basis.order,
+            basis.moments,
+            basis.assemble,
+        )
+        if status != 1:
+            return None
+        return y, a, Evaluation(r, jac, d_omega, kt), int(its)

@@ -4,9 +4,11 @@ The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the for
 amplitude) by the same continuation as the exact shooting of
 :mod:`clearjoint.periodic`, and returned as the same
 :class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
-kept. Stability comes from Hill's method: for one DOF with constant damping from
-Hill's infinite determinant (one determinant per point), otherwise from the
-eigenvalues of Hill's quadratic eigenproblem; events are located as in
+kept. Stability: for one DOF with constant damping from Hill's infinite
+determinant (one determinant per point); for a Structure from the exact monodromy
+of the HB orbit's piecewise-linear linearisation (:mod:`clearjoint.harmonic.monodromy`,
+no exponent to pick out of Hill's truncated spectrum); for a Joint with friction
+from the eigenvalues of Hill's quadratic eigenproblem; events are located as in
 :mod:`clearjoint.periodic`: folds where the parameter component of the tangent
 changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
 through -1), grazings where a joint's extreme relative displacement crosses a gap
@@ -24,8 +26,13 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.continuation import ContinuationSettings, continue_branch
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.harmonic import aft
-from clearjoint.harmonic.solve import TOLERANCE, linear_guess, newton
+from clearjoint.harmonic import aft, monodromy, solve
+from clearjoint.harmonic.solve import (
+    TOLERANCE,
+    SparseResidual,
+    linear_guess,
+    newton,
+)
 from clearjoint.harmonic.system import (
     HarmonicError,
     LinearSystem,
@@ -157,8 +164,23 @@ def frequency_response(
             d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
         return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev
 
+    # a large structure: the corrector's bordered solves by sparse LU (continuation hands
+    # them to the residual's own corrector when chord_parameter is set)
+    sparse = not model.is_joint and q0.size > solve.SPARSE_ABOVE
+    # one DOF in w: the whole corrector compiled (one call per correction)
+    compiled = (
+        parameter == "omega"
+        and model.n_dof == 1
+        and model.friction_force is None
+        and basis.assemble is not None
+    )
+    chosen: Any = residual
+    if sparse:
+        chosen = SparseResidual(residual)
+    elif compiled:
+        chosen = aft.OneDofResidual(residual, model, basis, float(pattern[0]), k_ref)
     branch = continue_branch(
-        residual,
+        chosen,
         q0,
         start,
         stop,
@@ -170,6 +192,7 @@ def frequency_response(
             max_step=max_step,
             max_points=max_points,
             tolerance=TOLERANCE,
+            chord_parameter=sparse or compiled,
         ),
     )
     return _response(
@@ -268,7 +291,11 @@ def _response(
     multipliers = np.empty((n_pts, 2 * n), dtype=np.complex128)
     determinant = n == 1 and model.friction_force is None
     jacobians = np.empty((n_pts, n_c, n_c)) if determinant else None
+    exact = not model.is_joint and model.friction_force is None
     for i in range(n_pts):
+        if exact:  # a structure: the exact monodromy of the orbit's linearisation
+            multipliers[i] = monodromy.multipliers(model, basis, coef[i], float(omega[i]))
+            continue
         ev = evaluations[i] if i < len(evaluations) else None
         if not isinstance(ev, aft.Evaluation):  # a point the continuation did not evaluate
             f = pattern if parameter == "omega" else force[i] * unit_force

@@ -7,7 +7,9 @@ every system.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -108,3 +110,103 @@ def newton(
             r_t, jac_t = function(trial)
         q, r, jac, size = trial, r_t, jac_t, size_t
     return (q, max_iterations) if size <= TOLERANCE * scale else None
+
+
+class SparseResidual:
+    """A continuation residual whose arclength corrector solves its bordered systems sparse.
+
+    :func:`clearjoint.continuation.continue_branch` hands the correction to a
+    residual's ``corrector`` method when ``ContinuationSettings.chord_parameter`` is
+    set. This one runs the same Newton iteration as the continuation's own corrector
+    (rows scaled by the unknowns' sizes, converged when every scaled residual is below
+    the tolerance) but factors the bordered matrix [[dR/du, dR/dlam], [t^T or e_lam]]
+    by a sparse LU (scipy's splu) instead of a dense solve: a structure's HB Jacobian
+    is mostly zero blocks.
+
+    Parameters
+    ----------
+    function : callable
+        function(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data), as
+        :data:`clearjoint.continuation.Residual`.
+    """
+
+    def __init__(
+        self,
+        function: Callable[[FloatArray, float], tuple[FloatArray, FloatArray, FloatArray, object]],
+    ) -> None:
+        self.function = function
+
+    def __call__(
+        self, u: FloatArray, lam: float, want_lambda: bool = True
+    ) -> tuple[FloatArray, FloatArray, FloatArray, object]:
+        """R, dR/du, dR/dlam and the data at (u, lam) (``want_lambda`` is accepted, unused)."""
+        return self.function(u, lam)
+
+    def corrector(
+        self,
+        y0: FloatArray,
+        tangent: FloatArray,
+        scale: FloatArray,
+        settings: Any,
+        fixed_lambda: bool,
+    ) -> tuple[FloatArray, FloatArray, object, int] | None:
+        """Newton on [R(y); t . (y - y0)] = 0 (or R at fixed lambda), sparse; None if it fails.
+
+        Parameters
+        ----------
+        y0 : (d + 1,) ndarray
+            The predicted point in scaled coordinates (u / u_scale, lam / lam_scale).
+        tangent : (d + 1,) ndarray
+            The arclength direction.
+        scale : (d + 1,) ndarray
+            u_scale then lam_scale.
+        settings : ContinuationSettings
+        fixed_lambda : bool
+            Correct at the fixed parameter instead.
+
+        Returns
+        -------
+        tuple or None
+            (y (d + 1,), the scaled [dR/du, dR/dlam] (d, d + 1), data, iterations).
+        """
+        import scipy.sparse
+        import scipy.sparse.linalg
+
+        from clearjoint.errors import ClearjointError
+
+        y = y0.copy()
+        d = y.size - 1
+        u_scale = scale[:d]
+        border = np.zeros(d + 1)
+        border[d] = 1.0
+        last_row = border if fixed_lambda else tangent
+        for iteration in range(settings.max_iterations + 1):
+            try:
+                r, jac_u, r_lam, data = self.function(y[:d] * u_scale, float(y[d] * scale[d]))
+            except ClearjointError:
+                return None
+            a = np.empty((d, d + 1))
+            a[:, :d] = jac_u * (u_scale / u_scale[:, None])
+            a[:, d] = r_lam * (scale[d] / u_scale)
+            rs = r / u_scale
+            size = float(np.max(np.abs(rs)))
+            if not math.isfinite(size) or not np.all(np.isfinite(a)):
+                return None
+            if size <= settings.tolerance:
+                return y, a, data, iteration
+            if iteration == settings.max_iterations:
+                return None
+            rhs = np.empty(d + 1)
+            rhs[:d] = -rs
+            rhs[d] = 0.0 if fixed_lambda else -float(tangent @ (y - y0))
+            matrix = scipy.sparse.vstack(
+                (scipy.sparse.csr_matrix(a), scipy.sparse.csr_matrix(last_row[None, :]))
+            ).tocsc()
+            try:
+                dy = scipy.sparse.linalg.splu(matrix).solve(rhs)
+            except RuntimeError:  # "Factor is exactly singular"
+                return None
+            if not np.all(np.isfinite(dy)):
+                return None
+            y = y + dy
+        return None

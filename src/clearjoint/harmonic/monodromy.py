@@ -1,0 +1,163 @@
+"""Floquet multipliers of a harmonic-balance orbit of a structure, from its exact monodromy.
+
+MODEL.md 5.3 (stability of the periodic response). Linearised about the HB orbit
+u(t), a perturbation obeys M y'' + C y' + K_T(t) y = 0 with K_T(t) = K + sum_j
+b_j k_j(t) b_j^T, and each joint's tangent k_j(t) is piecewise constant (k0, k0 + k_c
+or k0 + k_t: MODEL.md section 0). Between two instants where some b_j^T u(t) crosses a
+gap edge the perturbation equation is linear with constant coefficients, so the
+monodromy matrix is exactly the ordered product of matrix exponentials
+
+    Phi = expm(A_m dt_m) ... expm(A_1 dt_1),  A = [[0, I], [-M^-1 K_T, -M^-1 C]],
+
+and the 2N Floquet multipliers are its eigenvalues. The crossing instants are
+roots of the orbit's trigonometric polynomial, located between the AFT samples
+where a joint's state changes. No exponent has to be picked out of Hill's
+truncated eigenproblem (whose 2N (2H + 1) eigenvalues hold each family lambda + i k
+w once per shift, and whose smallest-abs(Im) members are not the resolved ones when
+the structure's higher modes lie above H w): the only approximation left is the
+HB orbit itself (a crossing the samples do not see, shorter than 2 pi / N_t,
+is missed).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from clearjoint.harmonic.aft import Basis
+from clearjoint.harmonic.system import LinearSystem
+
+FloatArray = NDArray[np.float64]
+
+#: Bisection steps that place a gap-edge crossing between two samples (2^-40 of a sample).
+_BISECTIONS = 40
+
+
+def _states(delta: FloatArray, system: LinearSystem) -> NDArray[np.int64]:
+    """Contact state of each joint: 1 beyond the compression edge, -1 beyond tension, 0 open."""
+    return np.asarray(
+        (delta > system.g_c).astype(np.int64) - (delta < -system.g_t).astype(np.int64)
+    )
+
+
+def crossings(system: LinearSystem, basis: Basis, coefficients: FloatArray) -> FloatArray:
+    """Return the phases tau in [0, 2 pi) where some joint's b_j^T u crosses a gap edge.
+
+    Parameters
+    ----------
+    system : LinearSystem
+    basis : Basis
+    coefficients : (2H + 1, N) ndarray
+        The HB orbit, m.
+
+    Returns
+    -------
+    (k,) ndarray
+        Sorted crossing phases, rad (tau = w t), each to 2^-40 of a sample interval.
+    """
+    rel = coefficients @ system.directions.T  # (2H + 1, n_j)
+    n_t = basis.samples
+    delta = basis.to_time @ rel  # (N_t, n_j)
+    state = _states(delta, system)
+    change = state != np.roll(state, -1, axis=0)
+    rows, joints = np.nonzero(change)
+    if rows.size == 0:
+        return np.zeros(0)
+    step = 2.0 * math.pi / n_t
+    lo = np.asarray(rows * step, dtype=np.float64)
+    hi = lo + step
+    # the edge crossed: the compression one if either end is beyond it, else the tension one
+    nxt = (rows + 1) % n_t
+    compress = (state[rows, joints] == 1) | (state[nxt, joints] == 1)
+    edge = np.where(compress, system.g_c[joints], -system.g_t[joints])
+    cols = rel[:, joints]  # (2H + 1, k)
+    f_lo = _at(basis, cols, lo) - edge
+    for _ in range(_BISECTIONS):
+        mid = np.asarray(0.5 * (lo + hi), dtype=np.float64)
+        f_mid = _at(basis, cols, mid) - edge
+        same = np.sign(f_mid) == np.sign(f_lo)
+        lo = np.where(same, mid, lo)
+        f_lo = np.where(same, f_mid, f_lo)
+        hi = np.where(same, hi, mid)
+    return np.sort(np.mod(0.5 * (lo + hi), 2.0 * math.pi))
+
+
+def _at(basis: Basis, columns: FloatArray, tau: FloatArray) -> FloatArray:
+    """Column k of ``columns`` (2H + 1, k) evaluated at its own phase tau[k]."""
+    h = np.arange(1, basis.harmonics + 1)
+    e = np.empty((tau.size, 2 * basis.harmonics + 1))
+    e[:, 0] = 1.0
+    e[:, 1::2] = np.cos(np.outer(tau, h))
+    e[:, 2::2] = np.sin(np.outer(tau, h))
+    return np.asarray(np.einsum("kc,ck->k", e, columns), dtype=np.float64)
+
+
+def monodromy(
+    system: LinearSystem, basis: Basis, coefficients: FloatArray, omega: float
+) -> FloatArray:
+    """Return the monodromy matrix of the HB orbit's linearisation, (2N, 2N).
+
+    Parameters
+    ----------
+    system : LinearSystem
+        Without friction (its tangent would not be piecewise constant).
+    basis : Basis
+    coefficients : (2H + 1, N) ndarray
+        The HB orbit, m.
+    omega : float
+        w, rad/s.
+
+    Returns
+    -------
+    (2N, 2N) ndarray
+        Phi, mapping (y(0), y'(0)) to (y(T), y'(T)), T = 2 pi / w.
+    """
+    n = system.n_dof
+    inv_m = 1.0 / np.diag(system.mass)
+    b = system.directions
+    rel = coefficients @ b.T
+    cuts = crossings(system, basis, coefficients)
+    edges = np.concatenate(([0.0], cuts, [2.0 * math.pi]))
+    widths = np.diff(edges)
+    middles = 0.5 * (edges[:-1] + edges[1:])
+    states = _states(basis.evaluate(rel, middles), system)  # (k + 1, n_j)
+    a = np.zeros((2 * n, 2 * n))
+    a[:n, n:] = np.eye(n)
+    a[n:, n:] = -inv_m[:, None] * system.damping
+    phi = np.eye(2 * n)
+    cache: dict[bytes, FloatArray] = {}
+    for width, state in zip(widths, states, strict=True):
+        if width <= 0.0:
+            continue
+        key = state.tobytes()
+        if key not in cache:
+            k_j = system.k0 + system.k_c * (state == 1) + system.k_t * (state == -1)
+            cache[key] = -inv_m[:, None] * (system.stiffness + (b.T * k_j) @ b)
+        a[n:, :n] = cache[key]
+        phi = scipy.linalg.expm(a * (width / omega)) @ phi
+    return phi
+
+
+def multipliers(
+    system: LinearSystem, basis: Basis, coefficients: FloatArray, omega: float
+) -> NDArray[np.complex128]:
+    """Return the 2N Floquet multipliers of the HB orbit, largest modulus first.
+
+    Parameters
+    ----------
+    system : LinearSystem
+    basis : Basis
+    coefficients : (2H + 1, N) ndarray
+        The HB orbit, m.
+    omega : float
+        w, rad/s.
+
+    Returns
+    -------
+    (2N,) complex ndarray
+    """
+    mu = np.linalg.eigvals(monodromy(system, basis, coefficients, omega))
+    return np.asarray(mu[np.argsort(-np.abs(mu), kind="stable")], dtype=np.complex128)
