@@ -289,3 +289,34 @@ def test_the_committed_mast_tolerance_results_come_from_the_shipped_sweep_file()
         results.frequency_hz.values[s], mode.frequency / (2 * math.pi), rtol=1e-9
     )
     np.testing.assert_allclose(results.damping_ratio.values[s], mode.damping_ratio, rtol=1e-7)
+
+
+def test_periodic_orbit_of_a_joint_without_clearance_is_the_linear_oscillators(
+    tmp_path: Path,
+) -> None:
+    """Amplitude F / |k - m w^2 + i c w|, multipliers of modulus exp(-zeta w_n T), input
+    pi c w X^2 per period: the textbook forced linear oscillator, written out here."""
+    path = _sweep(
+        tmp_path,
+        LINEAR_STUDY,
+        """
+base = "study.toml"
+[task]
+name = "periodic_orbit"
+[axes.excitation]
+frequency = ["300Hz", "1100Hz"]
+""",
+    )
+    results = run_sweep(Sweep.from_toml(path), client=SERIAL)
+    assert (results.status == "ok").all(), results.status.values
+    m, k, zeta, force = 2.0, 8e7, 0.05, 100.0
+    c = 2 * zeta * math.sqrt(k * m)
+    w = 2 * math.pi * results["excitation.frequency"].values
+    amplitude = force / np.hypot(k - m * w**2, c * w)
+    np.testing.assert_allclose(results.amplitude_m, amplitude, rtol=1e-9)
+    w_n = math.sqrt(k / m)
+    np.testing.assert_allclose(
+        results.largest_multiplier, np.exp(-zeta * w_n * 2 * np.pi / w), rtol=1e-6
+    )
+    np.testing.assert_allclose(results.energy_input_j, np.pi * c * w * amplitude**2, rtol=1e-9)
+    assert (results.stable == 1.0).all()

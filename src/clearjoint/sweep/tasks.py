@@ -19,6 +19,8 @@ maps a point's values onto it:
   one point per file along the ``record`` axis;
 * ``rig_test``: one test of the virtual rig (clearjoint.rig), measured with the
   point's own noise seed, then identified (clearjoint.identify): truth beside estimate;
+* ``periodic_orbit``: one exact periodic orbit, stable or unstable, by Newton on the
+  exact map (clearjoint.periodic, MODEL.md 5.1), with its Floquet stability;
 * ``frequency_response``: the whole curve of exact periodic orbits by continuation
   (clearjoint.periodic, MODEL.md 5.1), reduced to its peak, folds and unstable points; a
   curve the continuation cut short is a failed point (NaN, with where and why);
@@ -388,6 +390,58 @@ register_task(
         description=(
             "frequency-response curve by a stepped sine up and down (simulate.frequency_sweep; "
             "no pin contact friction): its peak, where, and the up/down jump"
+        ),
+    )
+)
+
+
+def _periodic_orbit(
+    base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    from clearjoint.periodic import periodic_orbit
+
+    study = study_at(base, values)
+    orbit = periodic_orbit(
+        study.joint,
+        study.force_amplitude,
+        study.omega,
+        damping_ratio=study.damping_ratio,
+        friction=study.friction,
+        restitution=study.restitution,
+        period_multiple=int(values["task.period_multiple"]),
+    )
+    per = 1.0 / int(values["task.period_multiple"])  # per forcing period
+    ledger = orbit.cycle.energy
+    return {
+        "amplitude_m": orbit.amplitude,
+        "x_max_m": orbit.x_max,
+        "x_min_m": orbit.x_min,
+        "stable": float(orbit.stable),
+        "largest_multiplier": float(np.max(np.abs(orbit.multipliers))),
+        "energy_input_j": ledger.input * per,
+        "balance_error": ledger.balance_error,
+    }
+
+
+register_task(
+    Task(
+        name="periodic_orbit",
+        base="study",
+        parameters={**JOINT_PARAMETERS, **FORCING_PARAMETERS},
+        options={"task.period_multiple": (1.0, Parameter("dimensionless", "", lower=1.0))},
+        outputs={
+            "amplitude_m": "m",
+            "x_max_m": "m",
+            "x_min_m": "m",
+            "stable": "",
+            "largest_multiplier": "",
+            "energy_input_j": "J",
+            "balance_error": "",
+        },
+        evaluate=_periodic_orbit,
+        description=(
+            "exact periodic orbit by Newton on the exact map (clearjoint.periodic, MODEL.md "
+            "5.1), stable or not: extremes, stability (Floquet multipliers), input per period"
         ),
     )
 )
