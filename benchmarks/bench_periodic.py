@@ -355,6 +355,7 @@ def stiff_contact() -> None:
     )
     print("  solve_ivp (DOP853), each state with its own step cap (its period / 20), events:")
     matched, best = None, None
+    runs: list[tuple[float, float, float]] = []  # (rtol, error, ratio)
     for rtol in (1e-9, 1e-10, 1e-11, 1e-12, 1e-13):
         ref = per_state_reference(stiff, 1.0, omega, horizon * period, 0.8, rtol)
         err = max(abs(ref[0] - truth[0]) / 0.1, abs(ref[1] - truth[1]) / 0.1)
@@ -364,6 +365,7 @@ def stiff_contact() -> None:
         print(f"    rtol {rtol:g}: {t_ref:.2f} s, error {err:.1e}, ratio {t_ref / t_ed:.0f}x")
         if matched is None and err <= err_ed:
             matched = (rtol, t_ref / t_ed)
+        runs.append((rtol, err, t_ref / t_ed))
         if best is None or err < best[1]:
             best = (rtol, err, t_ref / t_ed)
     if matched is not None:
@@ -372,10 +374,14 @@ def stiff_contact() -> None:
             f"time_response is {matched[1]:.0f}x faster"
         )
     elif best is not None:
+        # the cheapest run within a factor 2 of solve_ivp's best error: that is what its
+        # best accuracy costs (the most accurate run may merely be the slowest of several)
+        cheapest = min((r for r in runs if r[1] <= 2.0 * best[1]), key=lambda r: r[2])
         print(
-            f"  at equal accuracy: no solve_ivp run was as accurate as time_response; its most "
-            f"accurate (rtol {best[0]:g}, error {best[1]:.1e}) is {best[2]:.0f}x slower, a lower "
-            "bound of the ratio at equal accuracy"
+            f"  at equal accuracy: not measurable, no solve_ivp run was as accurate as "
+            f"time_response (its best error {best[1]:.1e}); the cheapest run within 2x of that "
+            f"(rtol {cheapest[0]:g}, error {cheapest[1]:.1e}) is {cheapest[2]:.0f}x slower, the "
+            f"most accurate (rtol {best[0]:g}) {best[2]:.0f}x"
         )
     print(f"  time_response ledger balance over {periods} periods: {base.energy.balance_error:.1e}")
 
