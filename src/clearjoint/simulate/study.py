@@ -22,7 +22,7 @@ import numpy as np
 from clearjoint._checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import read_table, read_toml
-from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.joint import Friction, Joint, Losses, Pin
 from clearjoint.simulate.core import Motion, SteadyState, steady_state, time_response
 
 #: Every key a study may give, with its default (None: required) and the kind of quantity.
@@ -87,6 +87,17 @@ class Study:
     samples_per_period: int
     source: str
     periods: int = 8
+
+    @property
+    def losses(self) -> Losses:
+        """The study's five losses as one value, for the functions that take ``losses=``."""
+        return Losses(
+            damping_ratio=self.damping_ratio,
+            friction=self.friction,
+            restitution=self.restitution,
+            pin=self.pin,
+            contact_friction_coefficient=self.contact_friction_coefficient,
+        )
 
 
 def load_study(path: str | Path) -> Study:

@@ -175,11 +175,7 @@ def _steady_state(
         study.joint,
         study.force_amplitude,
         study.omega,
-        damping_ratio=study.damping_ratio,
-        friction=study.friction,
-        restitution=study.restitution,
-        pin=study.pin,
-        contact_friction_coefficient=study.contact_friction_coefficient,
+        losses=study.losses,
         samples_per_period=int(values.get("task.samples_per_period", 64)),
         max_periods=int(values.get("task.max_periods", 20_000)),
     )
@@ -241,11 +237,7 @@ def _energies(
     result = energies(
         study.joint,
         values["task.amplitude"],
-        friction=study.friction,
-        pin=study.pin,
-        contact_friction_coefficient=study.contact_friction_coefficient,
-        restitution=study.restitution,
-        damping_ratio=study.damping_ratio,
+        losses=study.losses,
     )
     return {key: float(value) for key, value in result.items()}
 
@@ -285,11 +277,7 @@ def _free_cycle(
     damping = energies(
         study.joint,
         amplitude,
-        friction=study.friction,
-        pin=study.pin,
-        contact_friction_coefficient=study.contact_friction_coefficient,
-        restitution=study.restitution,
-        damping_ratio=study.damping_ratio,
+        losses=study.losses,
     )
     return {
         "natural_frequency_hz": 1.0 / period,
