@@ -571,13 +571,16 @@ def _behind(
     datas: list[Any],
     differs: Differs,
 ) -> bool:
-    """``y_new`` lies on the branch's earlier path, travelled the other way.
+    """``y_new`` lies on the branch's earlier path, travelled either way.
 
     On a chord between two earlier points (not among the last ten) to 1e-2 of
     its length, on the same smooth piece, with a tangent turned by more than 155
-    degrees from theirs: the branch runs back along itself (a kink crossing went
-    back onto a piece it had followed). Near a fold the two halves of a branch
-    part quadratically, so a few points in a row tell the two apart.
+    degrees from theirs (the branch runs back along itself: a kink crossing went
+    back onto a piece it had followed) or by less than 25 degrees (it goes round a
+    closed loop of pieces joined at kinks, as between the two grazings with
+    impacts near omega = 0.914 in pyHarm's case with e = 0.8, and would go round
+    until max_points). Near a fold the two halves of a branch part
+    quadratically, so a few points in a row tell the two apart.
     """
     if len(ys) < 12:
         return False
@@ -589,7 +592,7 @@ def _behind(
     miss = np.linalg.norm(offsets - where[:, None] * chords, axis=1)
     near = np.nonzero(miss <= 1e-2 * np.sqrt(lengths) + 1e-12)[0]
     return any(
-        float(t_new @ ts[int(j)]) < -0.9 and not differs(datas[int(j)], data_new) for j in near
+        abs(float(t_new @ ts[int(j)])) > 0.9 and not differs(datas[int(j)], data_new) for j in near
     )
 
 

@@ -39,6 +39,7 @@ from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate._shooting import (
     N_RES,
     R_DLAM,
+    R_EVALS,
     R_EVENTS,
     R_JAC,
     R_RES,
@@ -537,6 +538,8 @@ class _MapResidual:
     def __init__(self, p: FloatArray, parameter: str) -> None:
         self.p = p
         self.code = 0 if parameter == "omega" else 1
+        #: evaluations of the exact map so far (a cost that does not depend on the load)
+        self.evaluations = 0
 
     def __call__(
         self, u: FloatArray, lam: float, derivative: bool = True
@@ -545,6 +548,7 @@ class _MapResidual:
             raise SimulationError(f"the parameter left the positive range ({lam!r})")
         out = np.zeros(N_RES)
         status = map_residual(self.p, self.code, float(u[0]), float(u[1]), lam, out, derivative)
+        self.evaluations += int(out[R_EVALS])
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
         return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
@@ -574,6 +578,7 @@ class _MapResidual:
             system,
             out,
         )
+        self.evaluations += int(out[R_EVALS])
         if its < 0:
             return None
         return y, system[:2].copy(), out, int(its)
