@@ -321,7 +321,13 @@ def continue_branch(
     Parameters
     ----------
     residual : callable
-        residual(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data).
+        residual(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data). With
+        ``settings.chord_parameter`` it may carry compiled versions of the work:
+        ``corrector`` (see ``_correct``) and ``step(points (k, d + 1), h, t,
+        curvature, scale, settings)``, the ordinary step (the predictor from the
+        last k points, or from the last one with ``t`` and ``curvature`` when k = 1,
+        the correction and the new unit tangent oriented along ``t``), returning
+        ((y, a, data, iterations), tangent) or None, as the Python steps here do.
     u0 : (d,) ndarray
         A solution, or a guess close to one, at ``lam0`` (corrected there first).
     lam0, lam_stop : float
@@ -388,19 +394,30 @@ def continue_branch(
     curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
     back_steps = 0  # points in a row that run back along the branch's own path
     smooth = 0  # points in a row reached by an ordinary arclength step (no kink, no retry)
+    aligned = 0  # ... of which the last ones whose tangent turned by less than the cubic's limit
     retry = False  # the last attempt failed: predict from the tangent and curvature only
+    # a residual may carry its ordinary step compiled: step(points, h, t, curvature, scale,
+    # settings) -> ((y, a, data, its), tangent) or None, predicting as below from ``points``
+    fast_step = getattr(residual, "step", None) if settings.chord_parameter else None
     while len(ys) < settings.max_points:
         cubic = (
             smooth >= _CUBIC_POINTS
             and not retry
             and not kinks  # past a kink the pieces lie close: keep the cautious predictor
-            and all(float(a @ b) > _CUBIC_ALIGN for a, b in zip(ts[-4:-1], ts[-3:], strict=True))
+            and aligned >= _CUBIC_POINTS  # the last tangents turned little between points
         )
-        if cubic:
-            predicted = _extrapolate(np.array(ys[-_CUBIC_POINTS - 1 :]), h)
+        fast_tangent: FloatArray | None = None
+        if fast_step is not None:
+            # predictor, corrector and tangent in one call (the same arithmetic compiled)
+            points = np.array(ys[-_CUBIC_POINTS - 1 :]) if cubic else y[None, :]
+            stepped = fast_step(points, h, t, curvature, scale, settings)
+            attempt, fast_tangent = (None, None) if stepped is None else stepped
         else:
-            predicted = y + h * t + 0.5 * h * h * curvature
-        attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
+            if cubic:
+                predicted = _extrapolate(np.array(ys[-_CUBIC_POINTS - 1 :]), h)
+            else:
+                predicted = y + h * t + 0.5 * h * h * curvature
+            attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
         if cubic and (attempt is None or (differs is not None and differs(datas[-1], attempt[2]))):
             # near a kink the cubic may reach across it: the same step again, predicted
             # from the tangent and curvature (the ordinary way, with its step control)
@@ -408,8 +425,12 @@ def continue_branch(
             continue
         if attempt is not None:
             y_new, a_new, data_new, its = attempt
-            t_new = _tangent(a_new, t)
-            turn = math.acos(min(1.0, max(-1.0, float(t_new @ t))))
+            if fast_tangent is not None and math.isfinite(float(fast_tangent[0])):
+                t_new = fast_tangent
+            else:
+                t_new = _tangent(a_new, t)
+            cos_turn = float(t_new @ t)
+            turn = math.acos(min(1.0, max(-1.0, cos_turn)))
             if turn > settings.max_turn and h > settings.min_step:
                 attempt = None
         stuck = attempt is None and h <= settings.min_step
@@ -462,7 +483,7 @@ def continue_branch(
             if not relabelled:
                 kinks.append(len(ys))
             curvature = np.zeros_like(t)
-            smooth, retry = 0, False
+            smooth, aligned, retry = 0, 0, False
             y, t = y_new, t_new
             ys.append(y)
             ts.append(t)
@@ -505,9 +526,11 @@ def continue_branch(
                 del ys[len(ys) - _BACK_POINTS + 1 :], ts[len(ts) - _BACK_POINTS + 1 :]
                 del datas[len(datas) - _BACK_POINTS + 1 :], iters[len(iters) - _BACK_POINTS + 1 :]
                 break
-        step_length = float(np.linalg.norm(y_new - y))
+        chord = y_new - y
+        step_length = math.sqrt(float(chord @ chord))
         curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         smooth = 0 if retry else smooth + 1
+        aligned = aligned + 1 if cos_turn > _CUBIC_ALIGN else 0
         retry = False
         y, t = y_new, t_new
         ys.append(y)

@@ -47,6 +47,7 @@ from clearjoint.simulate._shooting import (
     R_XMIN,
     Shot,
     _set_parameter,
+    arclength_step,
     correct_orbit,
     map_residual,
     newton_orbit,
@@ -582,6 +583,45 @@ class _MapResidual:
         if its < 0:
             return None
         return y, system[:2].copy(), out, int(its)
+
+    def step(
+        self,
+        points: FloatArray,
+        h: float,
+        tangent: FloatArray,
+        curvature: FloatArray,
+        scale: FloatArray,
+        settings: ContinuationSettings,
+    ) -> tuple[tuple[FloatArray, FloatArray, Any, int], FloatArray] | None:
+        """``continuation``'s ordinary step, compiled (``_shooting.arclength_step``).
+
+        Predicts from ``points`` (the last points, or the last one with the
+        ``tangent`` and ``curvature``), corrects as ``corrector`` does, and returns
+        ((y, [R_u, R_lam], data, its), the new unit tangent), or None.
+        """
+        y = np.empty(3)
+        system = np.empty((3, 3))
+        out = np.zeros(N_RES)
+        t_new = np.empty(3)
+        its = arclength_step(
+            self.p,
+            self.code,
+            points,
+            h,
+            tangent,
+            curvature,
+            scale,
+            settings.tolerance,
+            settings.max_iterations,
+            y,
+            system,
+            out,
+            t_new,
+        )
+        self.evaluations += int(out[R_EVALS])
+        if its < 0:
+            return None
+        return (y, system[:2].copy(), out, int(its)), t_new
 
 
 def _map_residual(p: FloatArray, parameter: str) -> _MapResidual:

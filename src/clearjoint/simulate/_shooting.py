@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint._jit import njit  # numba.njit that survives a read-only install
+from clearjoint.continuation import _extrapolate, _tangent_solve
 from clearjoint.simulate import _kernel as kn
 
 FloatArray = NDArray[np.float64]
@@ -582,3 +583,53 @@ def correct_orbit(
         for i in range(3):
             y[i] += dy[i]
     return -1
+
+
+@njit(cache=True)
+def arclength_step(
+    p: np.ndarray,
+    parameter: int,
+    points: np.ndarray,
+    h: float,
+    tangent: np.ndarray,
+    curvature: np.ndarray,
+    scale: np.ndarray,
+    tolerance: float,
+    max_iterations: int,
+    y: np.ndarray,
+    system: np.ndarray,
+    out: np.ndarray,
+    t_new: np.ndarray,
+) -> int:
+    """One ordinary step of the continuation, compiled: predict, correct, new tangent.
+
+    The predictor is ``continuation``'s: the polynomial through the rows of
+    ``points`` (scaled) at chord length ``h`` past the last when it has more than
+    one row, else ``points[0] + h tangent + (h^2 / 2) curvature``. Then
+    ``correct_orbit`` (arclength condition along ``tangent``) and, on success, the
+    unit tangent of the solution in ``t_new``, oriented along ``tangent``
+    (``continuation._tangent``; NaN when that 3x3 solve is singular, for the caller
+    to fall back on its SVD). Returns the corrector's iterations, -1 on failure.
+    """
+    if points.shape[0] > 1:
+        predicted = _extrapolate(points, h)
+    else:
+        predicted = np.empty(3)
+        for i in range(3):
+            predicted[i] = points[0, i] + h * tangent[i] + 0.5 * h * h * curvature[i]
+    its = correct_orbit(
+        p, parameter, predicted, tangent, scale, False, tolerance, max_iterations, y, system, out
+    )
+    if its < 0:
+        return its
+    a = np.empty((2, 3))
+    for i in range(2):
+        for j in range(3):
+            a[i, j] = system[i, j]
+    if not _tangent_solve(a, tangent, t_new):
+        t_new[:] = np.nan
+        return its
+    if t_new[0] * tangent[0] + t_new[1] * tangent[1] + t_new[2] * tangent[2] < 0.0:
+        for i in range(3):
+            t_new[i] = -t_new[i]
+    return its
