@@ -519,4 +519,4 @@ def test_compiled_ordinary_step_follows_the_same_branch_as_the_python_one() -> N
     assert np.array_equal(fast.lam, slow.lam)
     assert np.array_equal(fast.tangent, slow.tangent)
     assert np.array_equal(fast.iterations, slow.iterations)
-    assert int(np.sum(fast.iterations == 1)) > 10  # the cubic predictor was used on the way
+    assert int(np.sum(fast.iterations == 1)) > 10  # the polynomial predictor was used on the way

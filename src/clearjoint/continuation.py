@@ -6,9 +6,9 @@ y = (u / u_scale, lambda / lambda_scale):
 
 - tangent t: the null vector of [dR/du, dR/dlambda], oriented along the last one;
 - predictor y + h t + (h^2 / 2) dt/ds, the curvature taken from the last step; after
-  three ordinary steps in a row with tangents that turn little (and before any kink),
-  the cubic through the last four points in chord length instead (error ~h^4, so
-  most corrections converge in one iteration);
+  n = ``predictor_degree`` ordinary steps in a row with tangents that turn little (and
+  before any kink), the polynomial of degree n through the last n + 1 points in chord
+  length instead (error ~h^(n + 1), so most corrections converge in one iteration);
 - corrector: Newton on R(y) = 0 together with the arclength condition
   t . (y - y_predicted) = 0, so that it passes folds where dR/du is singular;
 - step control from the corrector's iteration count: grow after an easy
@@ -68,10 +68,8 @@ Differs = Callable[[Any, Any], bool]
 Equivalents = Callable[[FloatArray], list[FloatArray]]
 
 
-#: Ordinary steps in a row after which the predictor is the cubic through the last four points.
-_CUBIC_POINTS = 3
 #: ... and while the last tangents turned by less than arccos of this between points.
-_CUBIC_ALIGN = math.cos(0.1)
+_POLY_ALIGN = math.cos(0.1)
 
 #: Scaled distance within which a branch has reached the ``join`` point of another.
 _JOIN_DISTANCE = 1e-3
@@ -112,6 +110,9 @@ class ContinuationSettings:
         keep it (a chord in that one column): the residual is then called as
         ``residual(u, lam, False)`` after the first iteration and may return None
         for dR/dlambda. Worth it when that derivative costs a second evaluation.
+    predictor_degree : int
+        Degree of the polynomial predictor through the last points, used after as
+        many ordinary steps in a row (3: a cubic through four points).
     """
 
     step: float = 0.01
@@ -126,12 +127,19 @@ class ContinuationSettings:
     max_turn: float = 0.3
     max_kink_jump: float = 1e-4
     chord_parameter: bool = False
+    predictor_degree: int = 3
 
     def __post_init__(self) -> None:
         if not 0.0 < self.min_step <= self.step <= self.max_step:
             raise ParameterError(
                 "the steps must satisfy 0 < min_step <= step <= max_step, got "
                 f"{self.min_step!r}, {self.step!r}, {self.max_step!r}"
+            )
+        if isinstance(self.predictor_degree, bool) or not (
+            isinstance(self.predictor_degree, int) and self.predictor_degree >= 1
+        ):
+            raise ParameterError(
+                f"predictor_degree must be an integer >= 1, got {self.predictor_degree!r}"
             )
         if self.max_points < 2:
             raise ParameterError(f"max_points must be >= 2, got {self.max_points!r}")
@@ -394,32 +402,33 @@ def continue_branch(
     curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
     back_steps = 0  # points in a row that run back along the branch's own path
     smooth = 0  # points in a row reached by an ordinary arclength step (no kink, no retry)
-    aligned = 0  # ... of which the last ones whose tangent turned by less than the cubic's limit
+    aligned = 0  # ... of which the last ones whose tangent turned by less than _POLY_ALIGN
     retry = False  # the last attempt failed: predict from the tangent and curvature only
     # a residual may carry its ordinary step compiled: step(points, h, t, curvature, scale,
     # settings) -> ((y, a, data, its), tangent) or None, predicting as below from ``points``
     fast_step = getattr(residual, "step", None) if settings.chord_parameter else None
     while len(ys) < settings.max_points:
-        cubic = (
-            smooth >= _CUBIC_POINTS
+        poly = (
+            smooth >= settings.predictor_degree
             and not retry
             and not kinks  # past a kink the pieces lie close: keep the cautious predictor
-            and aligned >= _CUBIC_POINTS  # the last tangents turned little between points
+            and aligned
+            >= settings.predictor_degree  # the last tangents turned little between points
         )
         fast_tangent: FloatArray | None = None
         if fast_step is not None:
             # predictor, corrector and tangent in one call (the same arithmetic compiled)
-            points = np.array(ys[-_CUBIC_POINTS - 1 :]) if cubic else y[None, :]
+            points = np.array(ys[-settings.predictor_degree - 1 :]) if poly else y[None, :]
             stepped = fast_step(points, h, t, curvature, scale, settings)
             attempt, fast_tangent = (None, None) if stepped is None else stepped
         else:
-            if cubic:
-                predicted = _extrapolate(np.array(ys[-_CUBIC_POINTS - 1 :]), h)
+            if poly:
+                predicted = _extrapolate(np.array(ys[-settings.predictor_degree - 1 :]), h)
             else:
                 predicted = y + h * t + 0.5 * h * h * curvature
             attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
-        if cubic and (attempt is None or (differs is not None and differs(datas[-1], attempt[2]))):
-            # near a kink the cubic may reach across it: the same step again, predicted
+        if poly and (attempt is None or (differs is not None and differs(datas[-1], attempt[2]))):
+            # near a kink the polynomial may reach across it: the same step again, predicted
             # from the tangent and curvature (the ordinary way, with its step control)
             retry = True
             continue
@@ -530,7 +539,7 @@ def continue_branch(
         step_length = math.sqrt(float(chord @ chord))
         curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         smooth = 0 if retry else smooth + 1
-        aligned = aligned + 1 if cos_turn > _CUBIC_ALIGN else 0
+        aligned = aligned + 1 if cos_turn > _POLY_ALIGN else 0
         retry = False
         y, t = y_new, t_new
         ys.append(y)
@@ -564,8 +573,9 @@ def _extrapolate(path: FloatArray, h: float) -> FloatArray:
     """The polynomial through the rows of ``path`` (in chord length) at ``h`` past the last.
 
     Lagrange interpolation in the cumulative chord length s (s = 0 at the last
-    row), evaluated at s = h: with the last four points, a cubic predictor whose
-    error falls as h^4, against h^3 for the tangent-and-curvature one.
+    row), evaluated at s = h: through the last n points, a predictor whose error
+    falls as h^n (h^4 for a cubic through four), against h^3 for the
+    tangent-and-curvature one.
     """
     n, m = path.shape
     s = np.zeros(n)

@@ -787,6 +787,7 @@ def frequency_response(
                 max_points=points,
                 tolerance=1e-11,
                 chord_parameter=True,
+                predictor_degree=5,  # pyHarm curve: 72 of 323 points need 2+ iterations, 105 with 3
             ),
             restart=restart,
             differs=differs,
