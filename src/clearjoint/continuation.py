@@ -395,6 +395,8 @@ def continue_branch(
     y, a, data, its = first
     t = _tangent(a, t)
     ys, ts, datas, iters = [y], [t], [data], [its]
+    trail = np.empty((settings.max_points + 1, d + 1))  # ys as rows, for the predictor
+    trail[0] = y
     h = settings.step
     stop = lam_stop / scale[-1]
     reason = "max_points"
@@ -418,12 +420,16 @@ def continue_branch(
         fast_tangent: FloatArray | None = None
         if fast_step is not None:
             # predictor, corrector and tangent in one call (the same arithmetic compiled)
-            points = np.array(ys[-settings.predictor_degree - 1 :]) if poly else y[None, :]
+            points = (
+                trail[len(ys) - settings.predictor_degree - 1 : len(ys)] if poly else y[None, :]
+            )
             stepped = fast_step(points, h, t, curvature, scale, settings)
             attempt, fast_tangent = (None, None) if stepped is None else stepped
         else:
             if poly:
-                predicted = _extrapolate(np.array(ys[-settings.predictor_degree - 1 :]), h)
+                predicted = _extrapolate(
+                    trail[len(ys) - settings.predictor_degree - 1 : len(ys)], h
+                )
             else:
                 predicted = y + h * t + 0.5 * h * h * curvature
             attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
@@ -495,6 +501,7 @@ def continue_branch(
             smooth, aligned, retry = 0, 0, False
             y, t = y_new, t_new
             ys.append(y)
+            trail[len(ys) - 1] = y
             ts.append(t)
             datas.append(data_new)
             iters.append(its)
@@ -543,6 +550,7 @@ def continue_branch(
         retry = False
         y, t = y_new, t_new
         ys.append(y)
+        trail[len(ys) - 1] = y
         ts.append(t)
         datas.append(data_new)
         iters.append(its)
