@@ -15,7 +15,9 @@ y = (u / u_scale, lambda / lambda_scale):
   correction, shrink after a hard one, halve and retry after a failure or a
   turn of the tangent sharper than ``max_turn`` (that is how the corrector is kept
   from jumping to another branch near a fold). At the smallest step a sharp turn
-  is accepted: the branch has a kink there (grazing), which it must cross.
+  is accepted: the branch has a kink there (grazing), which it must cross; with
+  ``differs`` given it is recorded in ``Branch.kinks`` (so that it is reported whether
+  Newton crosses it or fails on it and a parameter jump does).
 - crossing a kink where no arclength step converges (a grazing with impacts, where the
   map has a square-root singularity and Newton fails on it): a natural-parameter step,
   lambda moved by a fixed increment (growing tenfold from ten times the smallest step
@@ -168,8 +170,10 @@ class Branch:
         led back onto the branch already followed; those points are dropped),
         or "joined" (it reached the ``join`` point).
     kinks : (k,) ndarray of int
-        Indices of the points reached by a natural-parameter jump across a kink
-        (the kink lies between point i - 1 and point i).
+        Indices of the points reached by a natural-parameter jump across a kink,
+        or (with ``differs`` given) by an arclength step at the smallest step that
+        turned sharper than ``max_turn`` (the kink lies between point i - 1 and
+        point i).
     """
 
     u: FloatArray
@@ -446,7 +450,8 @@ def continue_branch(
                 t_new = _tangent(a_new, t)
             cos_turn = float(t_new @ t)
             turn = math.acos(min(1.0, max(-1.0, cos_turn)))
-            if turn > settings.max_turn and h > settings.min_step:
+            sharp = turn > settings.max_turn
+            if sharp and h > settings.min_step:
                 attempt = None
         stuck = attempt is None and h <= settings.min_step
         if stuck:
@@ -549,6 +554,10 @@ def continue_branch(
         aligned = aligned + 1 if cos_turn > _POLY_ALIGN else 0
         retry = False
         y, t = y_new, t_new
+        if sharp and differs is not None:
+            # the sharp turn accepted at the smallest step: a kink (a corner where a stage
+            # appears or sticking begins), crossed by the arclength step itself
+            kinks.append(len(ys))
         ys.append(y)
         trail[len(ys) - 1] = y
         ts.append(t)
