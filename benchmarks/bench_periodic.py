@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import subprocess
 import sys
 import tempfile
@@ -114,6 +115,51 @@ def best_of(fn, repeat: int = 3) -> tuple[float, object]:  # type: ignore[no-unt
         result = fn()
         best = min(best, time.perf_counter() - start)
     return best, result
+
+
+CURVE_CPU_SCRIPT = textwrap.dedent(
+    """
+    import math, sys, time
+    from clearjoint import Joint
+    from clearjoint.periodic import frequency_response
+    joint = Joint(mass=1.0, clearance=2 * 0.1745, gap_stiffness=1.0,
+                  compression_stiffness=3.0, tension_stiffness=3.0)
+    zeta = 0.05 / (2.0 * math.sqrt(3.0))
+    frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)  # compile
+    best = math.inf
+    for _ in range(int(sys.argv[1])):
+        start = time.process_time()
+        curve = frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)
+        best = min(best, time.process_time() - start)
+    print(best, curve.omega.size)
+    """
+)
+
+
+def against_old(old_src: str, rounds: int = 3, repeat: int = 21) -> None:
+    """The curve's best CPU time with another clearjoint ``src`` tree and with this one.
+
+    Each in its own process (PYTHONPATH), alternately, ``rounds`` times: a side-by-side
+    ratio that load sways little.
+    """
+    here = str(Path(__file__).resolve().parents[1] / "src")
+    best = {"old": math.inf, "new": math.inf}
+    for _ in range(rounds):
+        for name, src in (("old", old_src), ("new", here)):
+            done = subprocess.run(
+                [sys.executable, "-c", CURVE_CPU_SCRIPT, str(repeat)],
+                capture_output=True,
+                text=True,
+                env={**os.environ, "PYTHONPATH": src},
+                check=True,
+            )
+            cpu, points = done.stdout.split()
+            best[name] = min(best[name], float(cpu))
+            print(f"  {name} ({src}): {float(cpu):.4f} s CPU, {points} points")
+    print(
+        f"against {old_src}: {best['old']:.4f} s CPU, this tree {best['new']:.4f} s "
+        f"(best of {rounds} x {repeat} each): {best['old'] / best['new']:.2f}x"
+    )
 
 
 def best_cpu(fn, repeat: int = 5) -> float:  # type: ignore[no-untyped-def]
@@ -425,9 +471,17 @@ def main() -> None:
     parser.add_argument(
         "--stiff-only", action="store_true", help="run only the stiff-contact comparison"
     )
+    parser.add_argument(
+        "--old-src",
+        help="only compare the curve's CPU time with another clearjoint src tree, e.g. "
+        "main's (git archive main src | tar -x -C OLD)",
+    )
     args = parser.parse_args()
     if args.stiff_only:
         stiff_contact()
+        return
+    if args.old_src:
+        against_old(args.old_src)
         return
 
     print("case: pyHarm SDOF clearance, F0 = 0.03, omega 0.05 -> 1.8 rad/s, c_v = 0.05")
