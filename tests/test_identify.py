@@ -16,7 +16,7 @@ import pytest
 import xarray as xr
 
 from clearjoint.cli import main
-from clearjoint.identify import IdentificationError, identify, identify_files
+from clearjoint.identify import IdentificationError, damper, identify, identify_files
 from clearjoint.records import Record, read_record
 from clearjoint.rig import load_campaign, run_campaign
 from independent_joint import TrueJoint, steady_truth, write_record
@@ -158,6 +158,21 @@ def test_a_loop_whose_branches_show_different_backlash_is_doubtful() -> None:
     # the same rule on the two other branch ratios: 1.8 passes, 2.2 does not
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 1.8)).flag == "ok"
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 2.2)).flag != "ok"
+
+
+def test_backlash_is_the_distance_between_the_elastic_lines() -> None:
+    """Crossings of an elastic-plastic loop whose 4 mm gap is crossed over a tenth of the
+    level change, the last two crossings delayed 1.5 mm by ringing: the step fit reads the
+    two parallel lines (travel 2 mm per unit of the level change) 4 mm apart exactly."""
+    alphas = damper.ALPHAS
+    gap = 4e-3 * np.clip((alphas - 0.45) / 0.1, 0.0, 1.0)
+    s = 0.3e-3 + 2e-3 * alphas + gap
+    s[-2:] += 1.5e-3
+    intercept, slope, backlash, place = damper._step_fit(s)
+    assert slope == pytest.approx(2e-3, rel=1e-9)
+    assert intercept == pytest.approx(0.3e-3, rel=1e-9)
+    assert backlash == pytest.approx(4e-3, rel=1e-9)
+    assert 0.45 <= damper.ALPHAS[place] <= 0.55 + 1.0 / damper.N_CROSSINGS
 
 
 def test_ringing_as_slip_starts_is_not_backlash() -> None:
