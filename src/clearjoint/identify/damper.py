@@ -13,13 +13,13 @@ an offset mean do not bend it: for fractions alpha_i = (i + 1/2) / N of the leve
 is the travel where the force first reaches L_prev + alpha (L_new - L_prev). The elastic-
 plastic loop with a gap has exactly
 
-    s(alpha) = alpha |L_new - L_prev| / k + b H(alpha - alpha_b),
+    s(alpha) = alpha abs(L_new - L_prev) / k + b H(alpha - alpha_b),
 
 with H the unit step at the backlash level alpha_b: two parallel lines in alpha (the elastic
 unloading before the gap, the elastic loading after it), b apart. The slope is the median
 step between successive crossings (most of them are elastic), so k is read as before; b is
 the distance between the two lines, each placed by least absolute deviations (the median of
-s - alpha |L_new - L_prev| / k before and after the step), at the step place alpha_b, between
+s - alpha abs(L_new - L_prev) / k before and after the step), at the step place alpha_b, between
 two crossings (at least two on each side), whose total absolute deviation is least. No
 threshold decides what is gap: a crossing delayed by ringing as slip starts (the force
 reaching 85 % of the new level, ringing back and reaching 90 % millimetres later) is one
