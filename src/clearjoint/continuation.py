@@ -449,6 +449,11 @@ def continue_branch(
             if differs is not None and (y_new[-1] - y[-1]) * (travel or direction) < 0.0:
                 # a fold at the kink: both pieces may end there, so try which way leads away
                 t_new = _away(residual, y, y_new, t_new, data_new, scale, settings, differs)
+            elif relabelled:
+                # the same orbit written across a jump of the section: keep the way lambda was
+                # moving (the tangent at the jump itself can point anywhere)
+                if t_new[-1] * (travel or direction) < 0.0:
+                    t_new = -t_new
             elif float(t_new @ (y_new - y)) < 0.0:
                 t_new = -t_new  # go on away from the kink (at a grazing fold: back in lambda)
             if direction * (y_new[-1] - stop) >= 0.0:
