@@ -86,6 +86,8 @@ _SEED_FACTORS = (0.003, 0.006, 0.01, 0.02)
 #: Points at most on the way back from such an orbit (a seed on a branch that does not
 #: lead back to the stop is given up after them).
 _BACK_POINTS = 500
+#: Smallest arclength step (scaled units) of the curve.
+_MIN_STEP = 1e-6
 
 
 @dataclass(frozen=True)
@@ -286,6 +288,12 @@ class FrequencyResponse:
         (n, 2H + 1, N) for a Structure (whose x_max, x_min, amplitude are then (n, N)).
     method : {"shooting", "harmonic"}
         Exact shooting (this module) or harmonic balance (``clearjoint.harmonic``).
+    free_play : (n,) ndarray of bool, optional
+        True where the orbit stays inside the gap with gap_stiffness 0: one of a
+        continuum of orbits (any mean position that keeps it off the edges; Floquet
+        multiplier exactly 1, so ``stable`` is False), of which the curve shows the one
+        centred in the gap. Its amplitude is set by the dynamics, its position is not.
+        None for harmonic balance.
     """
 
     omega: FloatArray
@@ -302,6 +310,7 @@ class FrequencyResponse:
     settings: dict[str, Any] = field(repr=False, default_factory=dict)
     coefficients: FloatArray | None = field(repr=False, default=None)
     method: str = "shooting"
+    free_play: NDArray[np.bool_] | None = field(repr=False, default=None)
 
     def __repr__(self) -> str:
         kinds = ", ".join(
@@ -309,6 +318,8 @@ class FrequencyResponse:
             for k in ("fold", "period_doubling", "grazing")
         )
         f = self.omega / (2 * math.pi)
+        if self.free_play is not None and self.free_play.any():
+            kinds += f", {int(np.sum(self.free_play))} free play"
         return (
             f"FrequencyResponse({self.omega.size} points, {f.min():.4g}-{f.max():.4g} Hz, "
             f"F0 {self.force_amplitude.min():.4g}-{self.force_amplitude.max():.4g} N, "
@@ -485,6 +496,21 @@ class FrequencyResponse:
                 "multiplier_imag": (("point", "multiplier"), self.multipliers.imag.copy()),
                 "initial_displacement": (per, x0, {"units": "m"}),
                 "initial_velocity": (per, v0, {"units": "m/s"}),
+                **(
+                    {}
+                    if self.free_play is None
+                    else {
+                        "free_play": (
+                            "point",
+                            self.free_play.astype(np.int8),
+                            {
+                                "units": "1 in the gap (k0 = 0), 0 not",
+                                "note": "1: one of a continuum of orbits; the position is not "
+                                "set by the dynamics, the one centred in the gap is given",
+                            },
+                        )
+                    }
+                ),
                 "event_kind": ("event", np.array([e.kind for e in self.events], dtype=str)),
                 "event_frequency": (
                     "event",
@@ -534,9 +560,14 @@ class _MapResidual:
     ``continuation`` uses in place of its own loop when it finds one.
     """
 
-    def __init__(self, p: FloatArray, parameter: str) -> None:
+    def __init__(self, p: FloatArray, parameter: str, free_play_stop: bool = False) -> None:
         self.p = p
         self.code = 0 if parameter == "omega" else 1
+        #: refuse orbits that never touch an edge (with k0 = 0: a continuum, see _in_gap)
+        self.free_play_stop = free_play_stop
+
+    def _refused(self, out: FloatArray) -> bool:
+        return self.free_play_stop and _in_gap(self.p, out)
 
     def __call__(
         self, u: FloatArray, lam: float, derivative: bool = True
@@ -547,6 +578,8 @@ class _MapResidual:
         status = map_residual(self.p, self.code, float(u[0]), float(u[1]), lam, out, derivative)
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
+        if self._refused(out):
+            raise SimulationError("the orbit stays inside the gap: one of a continuum")
         return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
 
     def corrector(
@@ -574,14 +607,67 @@ class _MapResidual:
             system,
             out,
         )
-        if its < 0:
+        if its < 0 or self._refused(out):
             return None
         return y, system[:2].copy(), out, int(its)
 
 
-def _map_residual(p: FloatArray, parameter: str) -> _MapResidual:
+def _map_residual(p: FloatArray, parameter: str, free_play_stop: bool = False) -> _MapResidual:
     """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
-    return _MapResidual(p, parameter)
+    return _MapResidual(p, parameter, free_play_stop)
+
+
+def _in_gap(p: FloatArray, out: FloatArray) -> bool:
+    """With k0 = 0, an orbit that never reaches a gap edge (``out``: a map_residual row).
+
+    Inside the gap the force does not depend on x, so the orbit shifted by any
+    constant is an orbit too: a continuum, with a Floquet multiplier exactly 1.
+    """
+    return bool(p[kn.P_K0] == 0.0 and out[R_XMAX] < p[kn.P_GC] and out[R_XMIN] > -p[kn.P_GT])
+
+
+def _free_play_orbit(p: FloatArray, omega: float) -> FloatArray | None:
+    """The member centred in the gap of the continuum of in-gap orbits at ``omega`` (k0 = 0).
+
+    Inside the gap with k0 = 0 the velocity obeys m v' + c v + friction(v) = F0 sin(w t)
+    whatever x is: its periodic solution v* is found by Newton on the velocity
+    component of the exact map alone (the position's direction, the multiplier 1,
+    left out); the symmetric orbit (v(t + T/2) = -v(t)) has no drift over a period,
+    so x closes for every starting position, and the one whose extremes sit
+    symmetrically in the gap ((x_max + x_min)/2 = the gap's centre) is returned.
+
+    Returns
+    -------
+    (N_RES,) ndarray or None
+        The map_residual row of that orbit with (x0, v0) in its first two places
+        replaced, i.e. ``[x0, v0, M - I (4), dR/dlam (2), x_max, x_min, edge, events]``;
+        None when the orbit does not fit inside the gap or Newton fails.
+    """
+    q = p.copy()
+    _set_parameter(q, 0, omega)
+    m, c, f0 = q[kn.P_MASS], q[kn.P_DAMP], q[kn.P_F0]
+    v = -f0 * m * omega / (c * c + (m * omega) ** 2)  # v(0) of the viscous free mass
+    # the velocity orbit does not depend on where the edges are: solve it with them far off
+    far = q.copy()
+    far[kn.P_GC] = far[kn.P_GT] = 1e6 * (q[kn.P_GC] + q[kn.P_GT] + f0 / (m * omega**2))
+    out = np.zeros(N_RES)
+    for _ in range(30):
+        if map_residual(far, 0, 0.0, v, omega, out, False) != kn.STATUS_OK:
+            return None
+        dv = -out[R_RES + 1] / out[R_JAC + 3]
+        v += dv
+        if abs(dv) <= 1e-14 * max(abs(v), f0 / (m * omega)):
+            break
+    else:
+        return None
+    x0 = (q[kn.P_GC] - q[kn.P_GT]) / 2.0 - 0.5 * (out[R_XMAX] + out[R_XMIN])
+    if map_residual(q, 0, x0, v, omega, out, True) != kn.STATUS_OK or not _in_gap(q, out):
+        return None
+    size = out[R_XMAX] - out[R_XMIN]
+    if abs(out[R_RES]) > 1e-9 * size or abs(out[R_RES + 1]) > 1e-9 * size * omega:
+        return None  # the velocity orbit drifts: not a closed orbit
+    out[R_RES], out[R_RES + 1] = x0, v
+    return out
 
 
 def _parameter_range(
@@ -719,7 +805,10 @@ def frequency_response(
             return []
         return [np.array([x, e * v]), np.array([x, v / e])]  # v+ = e v- on entering contact
 
-    residual = _map_residual(p, parameter)
+    # k0 = 0: orbits that stay inside the gap are a continuum; the branch stops where it
+    # meets them and the member centred in the gap is followed instead (_free_play_tail)
+    free_play_stop = parameter == "omega" and joint.gap_stiffness == 0.0
+    residual = _map_residual(p, parameter, free_play_stop)
 
     def follow(
         u0: FloatArray,
@@ -737,7 +826,7 @@ def frequency_response(
             lam_scale=abs(stop - start),
             settings=ContinuationSettings(
                 step=0.002,
-                min_step=1e-7,
+                min_step=_MIN_STEP,
                 max_step=0.023,
                 max_points=points,
                 tolerance=1e-11,
@@ -750,8 +839,15 @@ def frequency_response(
         )
 
     branch = follow(np.array(first.initial_state), start, stop, max_points)
-    for _ in range(_REJOINS):
+    tail = None
+    for _ in range(_REJOINS + 1):
         if not branch.reason.startswith(("step too small", "ran back")):
+            break
+        if free_play_stop:
+            tail = _free_play_tail(p, branch, stop, max_points - branch.lam.size)
+            if tail is not None:
+                break
+        if _ == _REJOINS:
             break
         joined = _rejoin(
             branch,
@@ -765,15 +861,28 @@ def frequency_response(
             break
         branch = joined
     rows = np.array(branch.data)
-    n = branch.lam.size
-    omega = branch.lam.copy() if parameter == "omega" else np.full(n, w0)
-    force = branch.lam.copy() if parameter == "force" else np.full(n, f0)
+    lam_all = branch.lam
+    lam_tangent = branch.tangent[:, -1]
+    initial_state = branch.u.copy()
+    free_play = np.zeros(branch.lam.size, dtype=bool)
+    reason = branch.reason
+    if tail is not None:
+        lam_all = np.concatenate((lam_all, tail[:, N_RES]))
+        rows = np.concatenate((rows, tail[:, :N_RES]))
+        lam_tangent = np.concatenate((lam_tangent, np.full(len(tail), np.sign(stop - start))))
+        initial_state = np.concatenate((initial_state, tail[:, R_RES : R_RES + 2]))
+        free_play = np.concatenate((free_play, np.ones(len(tail), dtype=bool)))
+        reason = "reached" if tail[-1, N_RES] == stop else "max_points"
+    n = lam_all.size
+    omega = lam_all.copy() if parameter == "omega" else np.full(n, w0)
+    force = lam_all.copy() if parameter == "force" else np.full(n, f0)
     x_max = rows[:, R_XMAX]
     x_min = rows[:, R_XMIN]
     mono = rows[:, R_JAC : R_JAC + 4].reshape(n, 2, 2) + np.eye(2)
     mu = np.linalg.eigvals(mono).astype(np.complex128)
     mu = np.take_along_axis(mu, np.argsort(-np.abs(mu), axis=1), axis=1)
-    stable = np.max(np.abs(mu), axis=1) < 1.0
+    # a free-play orbit is one of a continuum (multiplier 1): not asymptotically stable
+    stable = (np.max(np.abs(mu), axis=1) < 1.0) & ~free_play
     amplitude = 0.5 * (x_max - x_min)
     sticking = []
     for k in branch.kinks:
@@ -787,7 +896,7 @@ def frequency_response(
         sticking.append(stuck[0] != stuck[1])
     events = _events(
         joint,
-        branch.tangent[:, -1],
+        lam_tangent,
         mono,
         x_max,
         x_min,
@@ -797,6 +906,19 @@ def frequency_response(
         branch.kinks,
         np.array(sticking, dtype=bool),
     )
+    if tail is not None:
+        i = branch.lam.size
+        events.append(
+            ResponseEvent(
+                "free_play",
+                float(omega[i]),
+                float(force[i]),
+                float(amplitude[i]),
+                "from here on the orbit stays inside the gap (gap_stiffness 0): a continuum of "
+                "orbits, one for each mean position, the position not set by the dynamics; the "
+                "curve (free_play True) shows the one centred in the gap",
+            )
+        )
     return FrequencyResponse(
         omega=omega,
         force_amplitude=force,
@@ -805,10 +927,11 @@ def frequency_response(
         amplitude=amplitude,
         stable=stable,
         multipliers=mu,
-        initial_state=branch.u.copy(),
+        initial_state=initial_state,
         events=events,
         parameter=parameter,
-        stop_reason=branch.reason,
+        stop_reason=reason,
+        free_play=free_play,
         settings={
             "joint": joint,
             "damping_ratio": damping_ratio,
@@ -816,6 +939,36 @@ def frequency_response(
             "restitution": restitution,
         },
     )
+
+
+def _free_play_tail(
+    p: FloatArray, branch: Branch, stop: float, points: int
+) -> NDArray[np.float64] | None:
+    """The centred in-gap orbits from where ``branch`` stopped on to ``stop`` (k0 = 0), or None.
+
+    Only when the branch stopped on an orbit that touches a gap edge within 1e-3 of
+    the clearance (where the contact branch meets the continuum of in-gap orbits,
+    whose widest members touch an edge) and the centred member (``_free_play_orbit``)
+    exists at the next grid frequency on. The grid is uniform in omega, 0.5 % of the
+    range a step (at most ``points`` points). Rows: a map_residual row (x0, v0 in
+    the first two places) and omega.
+    """
+    last = branch.data[-1]
+    gap = p[kn.P_GC] + p[kn.P_GT]
+    touching = min(abs(last[R_XMAX] - p[kn.P_GC]), abs(-p[kn.P_GT] - last[R_XMIN]))
+    lam = float(branch.lam[-1])
+    if touching > 1e-3 * gap or points < 1 or lam == stop:
+        return None
+    count = min(points, max(2, math.ceil(abs(stop - lam) / (0.005 * abs(stop - branch.lam[0])))))
+    rows: list[FloatArray] = []
+    for w in np.linspace(lam, stop, count + 1)[1:]:
+        orbit = _free_play_orbit(p, float(w))
+        if orbit is None:
+            if not rows:
+                return None
+            break
+        rows.append(np.append(orbit, w))
+    return np.array(rows)
 
 
 def _seed(

@@ -1,0 +1,96 @@
+"""periodic: where a k0 = 0 joint's curve meets the continuum of orbits inside the gap.
+
+Independent routes: the free mass's closed forms (m v' + c v = F0 sin(w t): the
+amplitude F0 / (w sqrt(m^2 w^2 + c^2)), the velocity multiplier exp(-c T / m), the
+double-grazing frequency where that orbit spans the whole gap), and time_response,
+which closes the orbit from any mean position (the position is not set).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from clearjoint import Joint
+from clearjoint.periodic import FrequencyResponse, frequency_response
+from clearjoint.simulate import time_response
+
+#: k0 = 0, symmetric contact 100 N/m, edges at +-0.1; forced past the contact resonance.
+FREE = Joint(mass=1.0, clearance=0.2, compression_stiffness=100.0, tension_stiffness=100.0)
+ZETA = 0.1  # c_v = 2 zeta sqrt(m k_c) = 2
+C_V = 2.0
+
+
+@pytest.fixture(scope="module")
+def curve() -> FrequencyResponse:
+    return frequency_response(FREE, 1.0, 2.0, 12.0, damping_ratio=ZETA, restitution=0.8)
+
+
+def _free_mass_amplitude(w: np.ndarray | float) -> np.ndarray | float:
+    return 1.0 / (w * np.sqrt(w**2 + C_V**2))
+
+
+def test_curve_goes_on_along_the_centred_free_play_orbits(curve: FrequencyResponse) -> None:
+    assert curve.stop_reason == "reached"
+    assert curve.omega[-1] == pytest.approx(12.0)
+    fp = curve.free_play
+    assert fp is not None
+    assert fp.sum() > 50
+    # one run at the end of the curve, after the contact branch
+    first = int(np.argmax(fp))
+    assert fp[first:].all()
+    assert not fp[:first].any()
+    w = curve.omega[fp]
+    assert np.max(np.abs(curve.amplitude[fp] / _free_mass_amplitude(w) - 1.0)) < 1e-9
+    # centred in the gap, never touching an edge
+    assert np.max(np.abs(curve.x_max[fp] + curve.x_min[fp])) < 1e-9 * 0.1
+    assert np.all(curve.x_max[fp] < 0.1)
+    # multipliers: exactly 1 (the position) and exp(-c T / m) (the velocity)
+    mu = np.sort(np.abs(curve.multipliers[fp]), axis=1)
+    assert np.max(np.abs(mu[:, 1] - 1.0)) < 1e-9
+    assert np.max(np.abs(mu[:, 0] - np.exp(-C_V * 2.0 * math.pi / w))) < 1e-9
+    assert not curve.stable[fp].any()  # a continuum: not asymptotically stable
+    events = [e for e in curve.events if e.kind == "free_play"]
+    assert len(events) == 1
+    assert events[0].omega == pytest.approx(w[0])
+    assert "position not set" in events[0].note
+
+
+def test_contact_branch_ends_at_the_double_grazing_of_the_widest_free_play_orbit(
+    curve: FrequencyResponse,
+) -> None:
+    # the free-mass orbit spans the whole gap (2 X = clearance) at w_g, in closed form
+    w_g = brentq(lambda w: 2.0 * _free_mass_amplitude(w) - 0.2, 1.0, 10.0)
+    fp = curve.free_play
+    assert fp is not None
+    last = int(np.argmax(fp)) - 1  # the last orbit with contact
+    assert curve.omega[last] == pytest.approx(w_g, rel=1e-3)
+    assert curve.x_max[last] == pytest.approx(0.1, rel=1e-3)
+    assert curve.x_min[last] == pytest.approx(-0.1, rel=1e-3)
+    assert curve.omega[last + 1] > w_g
+
+
+def test_free_play_orbit_closes_from_any_mean_position(curve: FrequencyResponse) -> None:
+    # time marching (no Newton), from the curve's start and from it shifted in the gap
+    fp = np.nonzero(curve.free_play)[0]
+    i = int(fp[fp.size // 2])
+    w = float(curve.omega[i])
+    room = 0.1 - float(curve.x_max[i])
+    for shift in (0.0, 0.5 * room, -0.9 * room):
+        start = curve.initial_state[i] + np.array([shift, 0.0])
+        motion = time_response(
+            FREE, 1.0, w, 3 * 2.0 * math.pi / w, initial=start, damping_ratio=ZETA, restitution=0.8
+        )
+        end = np.array(motion.final_state)
+        assert np.max(np.abs(end - start) / np.array([0.1, 0.1 * w])) < 1e-9
+        assert motion.x_max == pytest.approx(curve.x_max[i] + shift, abs=1e-9)
+
+
+def test_result_carries_the_free_play_flag(curve: FrequencyResponse) -> None:
+    ds = curve.to_xarray()
+    assert "free_play" in ds
+    assert ds["free_play"].values.sum() == np.sum(curve.free_play)
+    assert "free play" in repr(curve)
