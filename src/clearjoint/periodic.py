@@ -88,6 +88,8 @@ _SEED_FACTORS = (0.003, 0.006, 0.01, 0.02)
 _BACK_POINTS = 500
 #: Smallest arclength step (scaled units) of the curve.
 _MIN_STEP = 1e-6
+#: Points in a row at tiny steps after which a jump across the kink ahead is tried.
+_CRAWL_POINTS = 20
 
 
 @dataclass(frozen=True)
@@ -831,6 +833,7 @@ def frequency_response(
                 max_points=points,
                 tolerance=1e-11,
                 chord_parameter=True,
+                crawl_points=_CRAWL_POINTS,
             ),
             restart=restart,
             differs=differs,
