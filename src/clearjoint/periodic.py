@@ -1099,6 +1099,11 @@ def _events(
                 # the parameter is extreme at a fold: take the bracketing point that is further
                 # out (a linear interpolation of the tangent is wrong at a grazing kink)
                 lam = omega if np.ptp(omega) > 0.0 else force
+                steps = np.sign(np.diff(lam[max(i - 1, 0) : i + 3]))
+                if steps.size and np.all(steps == steps[0]):
+                    # the parameter goes on the same way through: the tangent flipped at a
+                    # point where the section sits on an impact (the state jumps), no fold
+                    continue
                 turn = float(np.sign(lam[i + 1] - lam[i]) * np.sign(g[i]))
                 frac = 1.0 if turn > 0 else 0.0
 
