@@ -436,6 +436,8 @@ class FrequencyResponse:
     def plot(self, ax: Axes | None = None) -> Axes:
         """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.
 
+        Free-play orbits (``free_play``: a continuum inside the gap) are dotted grey.
+
         Returns
         -------
         matplotlib.axes.Axes
@@ -449,21 +451,20 @@ class FrequencyResponse:
         else:
             xs, label = self.omega / (2 * math.pi), "frequency (Hz)"
         ys = self.amplitude * 1e3
+        free = np.zeros(self.stable.size, dtype=bool) if self.free_play is None else self.free_play
+        style = np.where(free, 2, self.stable.astype(int))  # 0 unstable, 1 stable, 2 free play
+        looks = {0: ("--", "C3"), 1: ("-", "C0"), 2: (":", "0.4")}
         start = 0
-        for i in range(1, self.stable.size + 1):
-            if i == self.stable.size or self.stable[i] != self.stable[start]:
-                end = min(i + 1, self.stable.size)
-                stable = bool(self.stable[start])
-                ax.plot(
-                    xs[start:end],
-                    ys[start:end],
-                    "-" if stable else "--",
-                    color="C0" if stable else "C3",
-                    lw=1.5,
-                )
+        for i in range(1, style.size + 1):
+            if i == style.size or style[i] != style[start]:
+                end = min(i + 1, style.size)
+                line, color = looks[int(style[start])]
+                ax.plot(xs[start:end], ys[start:end], line, color=color, lw=1.5)
                 start = i
         ax.plot([], [], "-", color="C0", label="stable")
         ax.plot([], [], "--", color="C3", label="unstable")
+        if free.any():
+            ax.plot([], [], ":", color="0.4", label="free play (centred; position not set)")
         markers = {"fold": ("o", "k"), "period_doubling": ("s", "C2"), "grazing": ("^", "C1")}
         for kind, (marker, color) in markers.items():
             chosen = [e for e in self.events if e.kind == kind]
