@@ -9,6 +9,7 @@ which closes the orbit from any mean position (the position is not set).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,7 +17,7 @@ from scipy.optimize import brentq
 
 from clearjoint import Joint
 from clearjoint.periodic import FrequencyResponse, frequency_response
-from clearjoint.simulate import time_response
+from clearjoint.simulate import steady_state, time_response
 
 #: k0 = 0, symmetric contact 100 N/m, edges at +-0.1; forced past the contact resonance.
 FREE = Joint(mass=1.0, clearance=0.2, compression_stiffness=100.0, tension_stiffness=100.0)
@@ -94,3 +95,75 @@ def test_result_carries_the_free_play_flag(curve: FrequencyResponse) -> None:
     assert "free_play" in ds
     assert ds["free_play"].values.sum() == np.sum(curve.free_play)
     assert "free play" in repr(curve)
+
+
+@pytest.fixture(scope="module")
+def study_curve() -> tuple[FrequencyResponse, Joint, dict[str, object], float]:
+    from clearjoint.simulate.study import load_study
+
+    study = load_study(Path(__file__).parents[1] / "examples" / "study.toml")
+    kw: dict[str, object] = {
+        "damping_ratio": study.damping_ratio,
+        "friction": study.friction,
+        "restitution": study.restitution,
+    }
+    hz = 2.0 * math.pi
+    curve = frequency_response(study.joint, study.force_amplitude, 20 * hz, 900 * hz, **kw)  # type: ignore[arg-type]
+    return curve, study.joint, kw, study.force_amplitude
+
+
+def test_study_curve_is_whole_from_20_to_900_hz_with_the_default_options(
+    study_curve: tuple[FrequencyResponse, Joint, dict[str, object], float],
+) -> None:
+    # the README study (clearjoint frf examples/study.toml --from 20Hz --to 900Hz)
+    curve, joint, kw, force = study_curve
+    hz = 2.0 * math.pi
+    assert curve.stop_reason == "reached"
+    assert curve.omega.size <= 2000
+    assert curve.omega[0] == pytest.approx(20 * hz)
+    assert curve.omega[-1] == pytest.approx(900 * hz)
+    folds = [e.omega / hz for e in curve.events if e.kind == "fold"]
+    assert any(f == pytest.approx(704.78, abs=0.01) for f in folds)
+    assert curve.free_play is not None
+    first = int(np.argmax(curve.free_play))
+    assert curve.free_play[first:].all()
+    # the contact branch ends where its orbit touches both edges (the widest in-gap orbit)
+    assert 487.0 < curve.omega[first - 1] / hz < 488.0
+    assert curve.x_max[first - 1] == pytest.approx(joint.compression_gap, rel=1e-3)
+    assert curve.x_min[first - 1] == pytest.approx(-joint.tension_gap, rel=1e-3)
+    # stable orbits of the resonance's upper branch, by time marching (no Newton)
+    upper = np.nonzero(curve.stable & (curve.omega > 400 * hz) & ~curve.free_play)[0]
+    assert upper.size > 10
+    for i in upper[:: max(1, upper.size // 3)]:
+        start = curve.initial_state[i] * (1.0 + 1e-6)
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        assert ss.period_multiple == 1
+        assert abs(ss.x_max - curve.x_max[i]) / curve.amplitude[i] < 1e-9
+
+
+@pytest.mark.parametrize("hz", [720.0, 900.0])
+def test_above_the_resonance_every_start_settles_inside_the_gap(
+    study_curve: tuple[FrequencyResponse, Joint, dict[str, object], float], hz: float
+) -> None:
+    # long transients from starts across the gap and beyond it: each ends on an orbit inside
+    # the gap of the curve's amplitude, at a mean position of its own (a continuum)
+    curve, joint, kw, force = study_curve
+    assert curve.free_play is not None
+    i = int(np.argmin(np.where(curve.free_play, abs(curve.omega - 2 * math.pi * hz), np.inf)))
+    w = float(curve.omega[i])
+    means = []
+    for start in ((0.0, 0.0), (4e-5, 0.0), (-6e-5, -0.5), (1e-4, 0.5)):
+        motion = time_response(joint, force, w, 150 * 2 * math.pi / w, initial=start, **kw)  # type: ignore[arg-type]
+        last = time_response(
+            joint,
+            force,
+            w,
+            2 * math.pi / w,
+            initial=motion.final_state,
+            **kw,  # type: ignore[arg-type]
+        )
+        assert last.x_max < joint.compression_gap
+        assert last.x_min > -joint.tension_gap
+        assert last.amplitude == pytest.approx(curve.amplitude[i], rel=1e-9)
+        means.append(0.5 * (last.x_max + last.x_min))
+    assert np.ptp(means) > 1e-6  # not one orbit: the position is not set
