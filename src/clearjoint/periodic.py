@@ -953,8 +953,9 @@ def _free_play_tail(
     Only when the branch stopped on an orbit that touches a gap edge within 1e-3 of
     the clearance (where the contact branch meets the continuum of in-gap orbits,
     whose widest members touch an edge) and the centred member (``_free_play_orbit``)
-    exists at the next grid frequency on. The grid is uniform in omega, 0.5 % of the
-    range a step (at most ``points`` points). Rows: a map_residual row (x0, v0 in
+    exists close to that frequency (at 0.001, 0.01 or 0.1 of the first grid step on).
+    The grid is uniform in omega, 0.5 % of the range a step (at most ``points``
+    points in all). Rows: a map_residual row (x0, v0 in
     the first two places) and omega.
     """
     last = branch.data[-1]
@@ -964,15 +965,18 @@ def _free_play_tail(
     if touching > 1e-3 * gap or points < 1 or lam == stop:
         return None
     count = min(points, max(2, math.ceil(abs(stop - lam) / (0.005 * abs(stop - branch.lam[0])))))
+    grid = np.linspace(lam, stop, count + 1)[1:]
+    # close to the junction first (the widest orbit that fits), then the grid
+    near = lam + np.array([1e-3, 1e-2, 1e-1]) * (grid[0] - lam)
     rows: list[FloatArray] = []
-    for w in np.linspace(lam, stop, count + 1)[1:]:
+    for w in np.concatenate((near, grid)):
         orbit = _free_play_orbit(p, float(w))
         if orbit is None:
-            if not rows:
-                return None
-            break
+            if rows or w > near[-1]:
+                break
+            continue
         rows.append(np.append(orbit, w))
-    return np.array(rows)
+    return np.array(rows[:points]) if rows else None
 
 
 def _seed(
