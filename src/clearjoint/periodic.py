@@ -18,7 +18,13 @@ a finite difference of the exact map; the one in the state is exact. Events:
   changes sign (a multiplier passes -1); a period-2 branch is born there and is
   not followed;
 - grazing: the orbit starts or stops touching a gap edge (x_max - g_c or
-  -g_t - x_min changes sign); the branch has a kink there.
+  -g_t - x_min changes sign); the branch has a kink there;
+- free_play (k0 = 0 only): the branch meets the orbits that never touch an edge.
+  Inside the gap the force does not depend on x, so such an orbit shifted by any
+  constant is an orbit too (a continuum, multiplier exactly 1, Newton singular): the
+  branch stops where it meets them (its orbit touches an edge there) and the curve
+  goes on along the member centred in the gap, flagged ``free_play``: its amplitude is
+  set by the dynamics, its position is not.
 """
 
 from __future__ import annotations
