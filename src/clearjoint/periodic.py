@@ -574,6 +574,8 @@ class _MapResidual:
         self.code = 0 if parameter == "omega" else 1
         #: refuse orbits that never touch an edge (with k0 = 0: a continuum, see _in_gap)
         self.free_play_stop = free_play_stop
+        #: the parameters at which such an orbit was refused
+        self.refused_at: list[float] = []
 
     def _refused(self, out: FloatArray) -> bool:
         return self.free_play_stop and _in_gap(self.p, out)
@@ -588,6 +590,7 @@ class _MapResidual:
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
         if self._refused(out):
+            self.refused_at.append(float(lam))
             raise SimulationError("the orbit stays inside the gap: one of a continuum")
         return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
 
@@ -616,7 +619,10 @@ class _MapResidual:
             system,
             out,
         )
-        if its < 0 or self._refused(out):
+        if its < 0:
+            return None
+        if self._refused(out):
+            self.refused_at.append(float(y[-1] * scale[-1]))
             return None
         return y, system[:2].copy(), out, int(its)
 
@@ -854,7 +860,9 @@ def frequency_response(
         if not branch.reason.startswith(("step too small", "ran back")):
             break
         if free_play_stop:
-            tail = _free_play_tail(p, branch, stop, max_points - branch.lam.size)
+            tail = _free_play_tail(
+                p, branch, residual.refused_at, stop, max_points - branch.lam.size
+            )
             if tail is not None:
                 break
         if _ == _REJOINS:
@@ -952,13 +960,15 @@ def frequency_response(
 
 
 def _free_play_tail(
-    p: FloatArray, branch: Branch, stop: float, points: int
+    p: FloatArray, branch: Branch, refused_at: list[float], stop: float, points: int
 ) -> NDArray[np.float64] | None:
     """The centred in-gap orbits from where ``branch`` stopped on to ``stop`` (k0 = 0), or None.
 
     Only when the branch stopped on an orbit that touches a gap edge within 1e-3 of
     the clearance (where the contact branch meets the continuum of in-gap orbits,
-    whose widest members touch an edge) and the centred member (``_free_play_orbit``)
+    whose widest members touch an edge), the continuation's steps there converged onto
+    in-gap orbits (``refused_at``: within 1e-3 of the range of the stop), and the
+    centred member (``_free_play_orbit``)
     exists close to that frequency (at 0.001, 0.01 or 0.1 of the first grid step on).
     The grid is uniform in omega, 0.5 % of the range a step (at most ``points``
     points in all). Rows: a map_residual row (x0, v0 in
@@ -968,8 +978,11 @@ def _free_play_tail(
     gap = p[kn.P_GC] + p[kn.P_GT]
     touching = min(abs(last[R_XMAX] - p[kn.P_GC]), abs(-p[kn.P_GT] - last[R_XMIN]))
     lam = float(branch.lam[-1])
+    reach = 1e-3 * abs(stop - float(branch.lam[0]))
     if touching > 1e-3 * gap or points < 1 or lam == stop:
         return None
+    if not any(abs(w - lam) <= reach for w in refused_at):
+        return None  # the steps there did not meet in-gap orbits: another kind of stop
     count = min(points, max(2, math.ceil(abs(stop - lam) / (0.005 * abs(stop - branch.lam[0])))))
     grid = np.linspace(lam, stop, count + 1)[1:]
     # close to the junction first (the widest orbit that fits), then the grid
