@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 
 from clearjoint import Joint
 from clearjoint.periodic import FrequencyResponse, frequency_response
-from clearjoint.simulate import steady_state, time_response
+from clearjoint.simulate import SimulationError, steady_state, time_response
 
 #: k0 = 0, symmetric contact 100 N/m, edges at +-0.1; forced past the contact resonance.
 FREE = Joint(mass=1.0, clearance=0.2, compression_stiffness=100.0, tension_stiffness=100.0)
@@ -167,3 +167,21 @@ def test_above_the_resonance_every_start_settles_inside_the_gap(
         assert last.amplitude == pytest.approx(curve.amplitude[i], rel=1e-9)
         means.append(0.5 * (last.x_max + last.x_min))
     assert np.ptp(means) > 1e-6  # not one orbit: the position is not set
+
+
+def test_a_curve_started_on_a_free_play_orbit_is_followed_from_the_other_end(
+    curve: FrequencyResponse,
+) -> None:
+    down = frequency_response(FREE, 1.0, 12.0, 2.0, damping_ratio=ZETA, restitution=0.8)
+    assert down.stop_reason == "reached"
+    assert down.omega[0] == pytest.approx(12.0)
+    assert down.omega[-1] == pytest.approx(2.0)
+    assert down.free_play is not None
+    assert down.free_play[0]
+    assert not down.free_play[-1]
+    w = down.omega[down.free_play]
+    assert np.max(np.abs(down.amplitude[down.free_play] / _free_mass_amplitude(w) - 1.0)) < 1e-9
+    assert np.array_equal(down.omega, curve.omega[::-1])
+    # both ends on free-play orbits: no single curve, said so
+    with pytest.raises(SimulationError, match="multiplier of exactly 1"):
+        frequency_response(FREE, 1.0, 10.0, 12.0, damping_ratio=ZETA, restitution=0.8)

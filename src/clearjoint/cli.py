@@ -1012,7 +1012,8 @@ def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Pa
     lines = [f"study: {source}", repr(curve)]
     if free is not None and free.any():
         lines.append(
-            f"free play from {curve.omega[free][0] / (2 * math.pi):.6g} Hz: the orbit stays inside "
+            f"free play from {curve.omega[free].min() / (2 * math.pi):.6g} to "
+            f"{curve.omega[free].max() / (2 * math.pi):.6g} Hz: the orbit stays inside "
             "the gap (gap_stiffness 0), one of a continuum; its amplitude is set by the dynamics, "
             "its position is not (the curve shows the orbit centred in the gap)"
         )

@@ -742,6 +742,11 @@ def frequency_response(
     ``force_stop`` (N) at the fixed ``omega_start`` (``omega_stop`` is then
     ignored and may be None).
 
+    With gap_stiffness 0, the branch stops where it meets the orbits that stay
+    inside the gap (a continuum: any mean position) and goes on along the one
+    centred in the gap (``free_play``); a start on such an orbit is followed from
+    the other end of the range and turned round (omega only).
+
     Parameters
     ----------
     joint : Joint
@@ -785,11 +790,24 @@ def frequency_response(
         restitution=restitution,
     )
     if np.min(np.abs(first.multipliers - 1.0)) < 1e-9:
-        raise SimulationError(
+        refusal = SimulationError(
             f"the orbit at the start ({first!r}) has a multiplier of exactly 1: it is one of a "
             "continuum of orbits (it stays in the gap with gap_stiffness = 0, or sticks), so "
             "no single curve exists; give gap_stiffness > 0 or start where the joint is in contact"
         )
+        if parameter != "omega" or joint.gap_stiffness != 0.0:
+            raise refusal
+        # a free-play orbit at the start: follow the curve from the other end, which ends on
+        # the free-play orbits (if that end is not one too), and turn it round
+        kw = {"damping_ratio": damping_ratio, "friction": friction, "restitution": restitution}
+        try:
+            other = periodic_orbit(joint, f0, stop, **kw)  # type: ignore[arg-type]
+        except SimulationError:
+            raise refusal from None
+        if np.min(np.abs(other.multipliers - 1.0)) < 1e-9:
+            raise refusal
+        turned = frequency_response(joint, f0, stop, w0, max_points=max_points, **kw)  # type: ignore[arg-type]
+        return _turned_round(turned)
     p = _parameters(joint, f0, w0, damping_ratio, friction, restitution)
     x_scale = max(joint.clearance / 2.0, first.amplitude)
     v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
@@ -932,9 +950,10 @@ def frequency_response(
                 float(omega[i]),
                 float(force[i]),
                 float(amplitude[i]),
-                "from here on the orbit stays inside the gap (gap_stiffness 0): a continuum of "
-                "orbits, one for each mean position, the position not set by the dynamics; the "
-                "curve (free_play True) shows the one centred in the gap",
+                "the junction of the branch with contact and the orbits that stay inside the gap "
+                "(gap_stiffness 0): a continuum of orbits, one for each mean position, the "
+                "position not set by the dynamics; the curve (free_play True) shows the one "
+                "centred in the gap",
             )
         )
     return FrequencyResponse(
@@ -956,6 +975,30 @@ def frequency_response(
             "friction": friction,
             "restitution": restitution,
         },
+    )
+
+
+def _turned_round(curve: FrequencyResponse) -> FrequencyResponse:
+    """``curve`` from its last point to its first (followed from the other end)."""
+    reason = curve.stop_reason
+    if reason != "reached":
+        reason = (
+            f"followed from the other end (the start is a free-play orbit), which stopped: {reason}"
+        )
+    return FrequencyResponse(
+        omega=curve.omega[::-1].copy(),
+        force_amplitude=curve.force_amplitude[::-1].copy(),
+        x_max=curve.x_max[::-1].copy(),
+        x_min=curve.x_min[::-1].copy(),
+        amplitude=curve.amplitude[::-1].copy(),
+        stable=curve.stable[::-1].copy(),
+        multipliers=curve.multipliers[::-1].copy(),
+        initial_state=curve.initial_state[::-1].copy(),
+        events=curve.events[::-1],
+        parameter=curve.parameter,
+        stop_reason=reason,
+        settings=curve.settings,
+        free_play=None if curve.free_play is None else curve.free_play[::-1].copy(),
     )
 
 
