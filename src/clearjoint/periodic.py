@@ -772,7 +772,8 @@ def frequency_response(
         A range of zero width, a value that is not finite and positive, or
         ``force_stop`` missing with ``parameter="force"``.
     SimulationError
-        No periodic orbit at the start.
+        No periodic orbit at the start, or (gap_stiffness 0) orbits inside the gap at
+        both ends of the range.
     """
     if parameter not in ("omega", "force"):
         raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
