@@ -76,6 +76,9 @@ _CUBIC_ALIGN = math.cos(0.1)
 #: Scaled distance within which a branch has reached the ``join`` point of another.
 _JOIN_DISTANCE = 1e-3
 
+#: A step of at most this many smallest steps counts towards ``crawl_points``.
+_CRAWL_STEPS = 100.0
+
 #: Points in a row running back along the branch's own path after which it stops.
 _BACK_POINTS = 5
 
@@ -112,6 +115,11 @@ class ContinuationSettings:
         keep it (a chord in that one column): the residual is then called as
         ``residual(u, lam, False)`` after the first iteration and may return None
         for dR/dlambda. Worth it when that derivative costs a second evaluation.
+    crawl_points : int
+        After this many points in a row reached by steps of at most 100 smallest
+        steps (the branch crawls towards a singular point), the natural-parameter
+        jump across a kink is tried at once; if it finds nothing the branch goes on
+        crawling. 0 (the default) never tries it early.
     """
 
     step: float = 0.01
@@ -126,6 +134,7 @@ class ContinuationSettings:
     max_turn: float = 0.3
     max_kink_jump: float = 1e-4
     chord_parameter: bool = False
+    crawl_points: int = 0
 
     def __post_init__(self) -> None:
         if not 0.0 < self.min_step <= self.step <= self.max_step:
@@ -389,6 +398,7 @@ def continue_branch(
     back_steps = 0  # points in a row that run back along the branch's own path
     smooth = 0  # points in a row reached by an ordinary arclength step (no kink, no retry)
     retry = False  # the last attempt failed: predict from the tangent and curvature only
+    crawl = 0  # points in a row reached by steps of at most _CRAWL_STEPS smallest steps
     while len(ys) < settings.max_points:
         cubic = (
             smooth >= _CUBIC_POINTS
@@ -413,7 +423,11 @@ def continue_branch(
             if turn > settings.max_turn and h > settings.min_step:
                 attempt = None
         stuck = attempt is None and h <= settings.min_step
-        if stuck:
+        # crawling: the last ``crawl_points`` steps all accepted at tiny steps (towards a
+        # grazing whose square-root singularity no larger step passes): try the jump now
+        crawling = not stuck and settings.crawl_points > 0 and crawl >= settings.crawl_points
+        if stuck or crawling:
+            crawl = 0
             # the way the branch was travelling (the tangent at a kink can point anywhere)
             travel = float(np.sign(y[-1] - ys[-2][-1])) if len(ys) > 1 else 0.0
 
@@ -435,20 +449,29 @@ def continue_branch(
                 back,
             )
 
-            if jump is None:
+            if jump is None and not crawling:
                 jump = _other_piece(residual, y, t, datas[-1], scale, settings, differs, back)
-            if jump is None:
+            if jump is None and crawling:
+                stuck = False  # no jump: go on with the small step that converged
+            elif jump is None:
                 reason = (
                     f"step too small at lambda = {y[-1] * scale[-1]:.10g}: no arclength step "
                     "converged, nor a parameter jump of up to "
                     f"{settings.max_kink_jump * scale[-1]:.3g}"
                 )
                 break
+        if stuck or (crawling and jump is not None):
+            assert jump is not None
             (y_new, a_new, data_new, its), relabelled = jump
             t_new = _tangent(a_new, t)
             if differs is not None and (y_new[-1] - y[-1]) * (travel or direction) < 0.0:
                 # a fold at the kink: both pieces may end there, so try which way leads away
                 t_new = _away(residual, y, y_new, t_new, data_new, scale, settings, differs)
+            elif relabelled:
+                # the same orbit written across a jump of the section: keep the way lambda was
+                # moving (the tangent at the jump itself can point anywhere)
+                if t_new[-1] * (travel or direction) < 0.0:
+                    t_new = -t_new
             elif float(t_new @ (y_new - y)) < 0.0:
                 t_new = -t_new  # go on away from the kink (at a grazing fold: back in lambda)
             if direction * (y_new[-1] - stop) >= 0.0:
@@ -508,6 +531,7 @@ def continue_branch(
         step_length = float(np.linalg.norm(y_new - y))
         curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         smooth = 0 if retry else smooth + 1
+        crawl = crawl + 1 if h <= _CRAWL_STEPS * settings.min_step else 0
         retry = False
         y, t = y_new, t_new
         ys.append(y)
