@@ -2,17 +2,19 @@
 
 Not physics: the orchestration behind ``identify_files(..., jobs=N)`` (no MODEL.md
 equation). This process and ``N - 1`` workers forked from it (warm: they inherit every
-module already imported) take the tasks one at a time in a given order (largest first),
-so that a process that drew quick tasks takes more of them; a worker sends its results
-back through a pipe when the order is exhausted and leaves by ``os._exit`` (nothing to
-tear down). A worker that dies sends nothing: the caller finds its tasks without a result
-and runs them itself. An exception a task raises in a worker is raised here.
+module already imported, frozen for their garbage collector, which then does not walk
+them) take the tasks one at a time in a given order (largest first), so that a process
+that drew quick tasks takes more of them; a worker sends its results back through a pipe
+when the order is exhausted and leaves by ``os._exit`` (nothing to tear down). A worker
+that dies sends nothing: the caller finds its tasks without a result and runs them itself.
+An exception a task raises in a worker is raised here.
 """
 
 from __future__ import annotations
 
 import contextlib
 import fcntl
+import gc
 import os
 import pickle
 import signal
@@ -112,14 +114,18 @@ def _run(
 ) -> None:
     workers: list[tuple[int, int]] = []
     try:
-        for _ in range(min(jobs, len(claims.order)) - 1):
-            read, write = os.pipe()
-            pid = os.fork()
-            if pid == 0:
-                os.close(read)
-                _work(function, tasks, claims, write)
-            os.close(write)
-            workers.append((pid, read))
+        gc.freeze()  # the workers' collections then skip every object they inherit
+        try:
+            for _ in range(min(jobs, len(claims.order)) - 1):
+                read, write = os.pipe()
+                pid = os.fork()
+                if pid == 0:
+                    os.close(read)
+                    _work(function, tasks, claims, write)
+                os.close(write)
+                workers.append((pid, read))
+        finally:
+            gc.unfreeze()  # here, everything as it was
         while (i := claims.next()) is not None:
             done(i, function(tasks[i]))
         while workers:
