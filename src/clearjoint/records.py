@@ -800,35 +800,41 @@ BRFD_CITATION = (
 
 
 def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
-    """The JSON's metadata and its 'data' matrix, from the file's bytes.
+    """The JSON's metadata (without 'data') and its 'data' matrix, from the file's bytes.
 
     Parsed by orjson: its numbers are the correctly rounded doubles that Python's
     ``float`` gives, bit for bit, and it is faster than numpy's C parser of the matrix
-    text over the 31 BRFD files, more so with the garbage collector off while the rows'
-    lists are built (they hold only numbers: no cycles to collect); side by side by
-    ``python benchmarks/bench_identify.py --parsers``.
+    text over the 31 BRFD files, more so with the garbage collector off from the parse
+    until the rows' lists are freed (they hold only numbers: no cycles to collect; with the
+    collector back on while they live, its next pass walks every one of them); side by
+    side by ``python benchmarks/bench_identify.py --parsers``.
     """
     import orjson  # only a JSON record needs it
 
     collecting = gc.isenabled()
     gc.disable()  # tens of thousands of new lists, no cycles: the collector only costs time
     try:
-        content = orjson.loads(raw)
-    except orjson.JSONDecodeError as exc:  # also bytes that are not UTF-8
-        raise RecordError(f"{where}: not a JSON file ({exc})") from None
+        return _json_matrix(where, raw, orjson)
     finally:
         if collecting:
             gc.enable()
+
+
+def _json_matrix(where: str, raw: bytes, orjson: Any) -> tuple[dict[str, Any], FloatArray]:
+    try:
+        content = orjson.loads(raw)
+    except orjson.JSONDecodeError as exc:  # also bytes that are not UTF-8
+        raise RecordError(f"{where}: not a JSON file ({exc})") from None
     if not isinstance(content, dict) or "data" not in content:
         raise RecordError(f"{where}: JSON without a 'data' matrix; not a BRFD record")
-    rows = content["data"]
+    rows = content.pop("data")
     data = _rows_matrix(rows) if isinstance(rows, list) else None
     if data is None:  # not a list of equal rows of numbers: numpy says what it is
         try:
             data = np.array(rows, dtype=np.float64)
         except (TypeError, ValueError):
             raise RecordError(f"{where}: the 'data' matrix is not numeric") from None
-    return content, data
+    return content, data  # the rows are freed on return, with the collector still off
 
 
 def _rows_matrix(rows: list[Any]) -> FloatArray | None:
