@@ -3,7 +3,7 @@
 Run on demand::
 
     python benchmarks/bench_identify.py [--brfd DIR] [--records DIR] [--old-src SRC] [--jobs N]
-        [--repeats R] [--split]
+        [--old-jobs N] [--repeats R]
 
 It times the command (process start, reading, identification, writing results.csv) over
 the default rig campaign (written to a temporary folder unless ``--records`` names one)
@@ -12,7 +12,10 @@ and over the BRFD folder, best of ``--repeats``, in wall-clock seconds and in CP
 ``--old-src`` (for example the ``src`` folder of another checkout) the same command runs
 with that code too, in the same loop, and the ratio is printed: on a shared machine only
 ratios measured side by side mean anything; the load average is printed before and after.
-``--split`` also prints the CPU seconds of reading and of identifying in this process;
+``--old-jobs`` gives the old code's ``--jobs`` (for code that has the option). For each
+set it also prints the CPU seconds of reading and of identifying in this process, and the
+identification's own share of the command's CPU seconds (the estimators change; the rest
+is reading, start-up and orchestration);
 ``--parsers`` compares JSON readers of the BRFD files side by side (CPU seconds, best of
 ``--repeats``; each must give the same doubles as Python's json module, bit for bit).
 Target (issue 15): 1e6 samples per second.
@@ -52,7 +55,9 @@ def samples(files: list[Path]) -> int:
     return total
 
 
-def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float, float]:
+def run(
+    files: list[Path], src: str | None, jobs: int, out: Path, old_jobs: int = 1
+) -> tuple[float, float]:
     """Wall-clock and CPU seconds (user + system, of the command's processes) of one run.
 
     Python's compiled bytecode is kept (in a folder of its own, ``PYTHONPYCACHEPREFIX``,
@@ -70,7 +75,8 @@ def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float
     launcher = [str(script)] if script.exists() else [sys.executable, "-m", "clearjoint"]
     command = [*launcher, "identify", *map(str, files)]
     command += ["--out", str(out), "--quiet", "--force"]
-    if jobs > 1 and not src:
+    jobs = old_jobs if src else jobs
+    if jobs > 1:
         command += ["--jobs", str(jobs)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
@@ -81,7 +87,7 @@ def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float
     return wall, cpu
 
 
-def split(files: list[Path]) -> str:
+def split(files: list[Path]) -> tuple[float, float]:
     """CPU seconds of reading and of identifying ``files`` in this process (no start-up)."""
     from clearjoint.errors import ClearjointError
     from clearjoint.identify import identify
@@ -93,7 +99,7 @@ def split(files: list[Path]) -> str:
     for record in records:  # a record refused with its reason costs its time as well
         with contextlib.suppress(ClearjointError):
             identify(record)
-    return f"in-process: reading {read:.2f} CPU s, identifying {time.process_time() - start:.2f}"
+    return read, time.process_time() - start
 
 
 _BRACKETS = bytes.maketrans(b"[]", b"  ")
@@ -143,10 +149,10 @@ def main() -> None:
     parser.add_argument("--records", help="folder of rig records (default: run the campaign)")
     parser.add_argument("--old-src", help="src folder of the code to compare with")
     parser.add_argument("--jobs", type=int, default=1)
-    parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument(
-        "--split", action="store_true", help="also time reading and identifying in-process"
+        "--old-jobs", type=int, default=1, help="--jobs for the old code (if it has the option)"
     )
+    parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument(
         "--parsers", action="store_true", help="only compare JSON readers on the BRFD files"
     )
@@ -175,7 +181,8 @@ def main() -> None:
             for _ in range(args.repeats):
                 best["new"] = min(best["new"], run(files, None, args.jobs, out))
                 if args.old_src:
-                    best["old"] = min(best["old"], run(files, args.old_src, 1, out))
+                    old = run(files, args.old_src, 1, out, args.old_jobs)
+                    best["old"] = min(best["old"], old)
             wall, cpu = best["new"]
             rate = n / wall
             verdict = "meets" if rate >= TARGET else "below"
@@ -187,12 +194,17 @@ def main() -> None:
             if args.old_src:
                 old_wall, old_cpu = best["old"]
                 line += (
-                    f"; old code {old_wall:6.2f} s wall, {old_cpu:6.2f} CPU s: ratio "
+                    f"; old code (jobs={args.old_jobs}) {old_wall:6.2f} s wall, "
+                    f"{old_cpu:6.2f} CPU s: ratio "
                     f"{old_wall / wall:.2f}x wall, {old_cpu / cpu:.2f}x CPU"
                 )
             print(line)
-            if args.split:
-                print(f"{name:22s} {split(files)}")
+            read, identifying = split(files)
+            print(
+                f"{name:22s} in this process: reading {read:.2f} CPU s, identifying "
+                f"{identifying:.2f} CPU s; the identification's own share of the command's "
+                f"{cpu:.2f} CPU s: {identifying / cpu:.0%}"
+            )
         print("load average (1, 5, 15 min) after: " + _load())
 
 
