@@ -16,6 +16,11 @@ ratios measured side by side mean anything; the load average is printed before a
 set it also prints the CPU seconds of reading and of identifying in this process, and the
 identification's own share of the command's CPU seconds (the estimators change; the rest
 is reading, start-up and orchestration);
+``--critical-path`` estimates, for a machine with a free core per process, the wall time
+of ``--jobs N`` from CPU seconds, which contention inflates far less than wall time: this
+process's CPU seconds to the end of ``main``, against its CPU seconds when it forked plus a
+worker's own (the larger of the two; the interpreter's start before ``main`` and its exit
+after are not in it), best of ``--repeats``, old and new code interleaved.
 ``--parsers`` compares JSON readers of the BRFD files side by side (CPU seconds, best of
 ``--repeats``; each must give the same doubles as Python's json module, bit for bit).
 Target (issue 15): 1e6 samples per second.
@@ -139,6 +144,64 @@ def parsers(files: list[Path], repeats: int) -> None:
         )
 
 
+_TRACE = """
+import os, resource, sys, time
+fork, forks = os.fork, []
+def timed_fork():
+    forks.append(time.process_time())
+    return fork()
+os.fork = timed_fork
+from clearjoint.cli import main
+code = main()
+end = time.process_time()
+children = resource.getrusage(resource.RUSAGE_CHILDREN)
+worker = (children.ru_utime + children.ru_stime) / max(len(forks), 1)
+sys.stderr.write(f"\\nCRITICAL {end} {forks[0] if forks else end} {worker}\\n")
+sys.exit(code)
+"""
+
+
+def critical_path(
+    files: list[Path], src: str | None, jobs: int, out: Path
+) -> tuple[float, float, float]:
+    """CPU seconds of this process to the end of ``main``, at its first fork, and of one
+    worker (the mean over the workers), for ``clearjoint identify FILES --jobs JOBS``."""
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env["PYTHONPYCACHEPREFIX"] = str(out.parent / "pycache")
+    env.setdefault("OPENBLAS_NUM_THREADS", "1")
+    if src:
+        env["PYTHONPATH"] = src
+    command = [sys.executable, "-c", _TRACE, "identify", *map(str, files)]
+    command += ["--out", str(out), "--quiet", "--force", "--jobs", str(jobs)]
+    done = subprocess.run(command, env=env, check=True, capture_output=True, text=True)
+    line = [x for x in done.stderr.splitlines() if x.startswith("CRITICAL ")][-1]
+    end, forked, worker = map(float, line.split()[1:])
+    return end, forked, worker
+
+
+def _critical(sets: dict[str, list[Path]], args: argparse.Namespace, out: Path) -> None:
+    codes = {"new": (None, args.jobs)}
+    if args.old_src:
+        codes["old"] = (args.old_src, args.old_jobs)
+    for name, files in sets.items():
+        best: dict[str, tuple[float, float, float, float]] = {}
+        for _ in range(args.repeats):
+            for label, (src, jobs) in codes.items():
+                end, forked, worker = critical_path(files, src, jobs, out)
+                estimate = max(end, forked + worker) if forked < end else end
+                if label not in best or estimate < best[label][0]:
+                    best[label] = (estimate, end, forked, worker)
+        for label, (estimate, end, forked, worker) in best.items():
+            print(
+                f"{name:22s} {label} code (jobs={codes[label][1]}): {estimate:.3f} CPU s on the "
+                f"critical path (this process {end:.3f}, forked at {forked:.3f}, a worker "
+                f"{worker:.3f})"
+            )
+        if "old" in best:
+            print(f"{name:22s} ratio old/new {best['old'][0] / best['new'][0]:.2f}x")
+
+
 def _load() -> str:
     return " ".join(f"{value:.2f}" for value in os.getloadavg())
 
@@ -156,6 +219,11 @@ def main() -> None:
     parser.add_argument(
         "--parsers", action="store_true", help="only compare JSON readers on the BRFD files"
     )
+    parser.add_argument(
+        "--critical-path",
+        action="store_true",
+        help="only estimate --jobs N's wall time on free cores from CPU seconds per process",
+    )
     args = parser.parse_args()
     if args.parsers:
         parsers(sorted(Path(args.brfd).glob("*.json")), args.repeats)
@@ -172,6 +240,10 @@ def main() -> None:
             sets["BRFD folder"] = sorted(brfd.glob("*.json"))
         out = Path(folder) / "results.csv"
         print("load average (1, 5, 15 min) before: " + _load())
+        if args.critical_path:
+            _critical(sets, args, out)
+            print("load average (1, 5, 15 min) after: " + _load())
+            return
         for name, files in sets.items():
             n = samples(files)
             best = {"new": (float("inf"), 0.0), "old": (float("inf"), 0.0)}
