@@ -92,3 +92,13 @@ def test_identify_files_runs_the_files_a_dead_worker_took(
     assert [i.source for _, i in parallel] == [i.source for _, i in serial]
     for (_, a), (_, b) in zip(serial, parallel, strict=True):
         np.testing.assert_equal(a.row(), b.row())
+
+
+def test_without_memfd_the_claims_live_in_a_temporary_file(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.delattr(os, "memfd_create", raising=False)  # as on macOS
+    seen: dict[int, tuple[int, int]] = {}
+    run_forked(_square_where, list(range(30)), list(range(30)), 2, seen.__setitem__)
+    assert sorted(seen) == list(range(30))
+    assert all(seen[i][0] == i * i for i in seen)

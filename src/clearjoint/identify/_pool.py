@@ -18,7 +18,6 @@ import gc
 import os
 import pickle
 import signal
-import tempfile
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
@@ -101,6 +100,15 @@ def run_forked(
         when a worker has finished for that worker's tasks. A task of a worker that died
         is never passed to ``done``.
     """
+    if hasattr(os, "memfd_create"):  # Linux: a file in memory, no tempfile module to import
+        fd = os.memfd_create("clearjoint-claims")
+        try:
+            _run(function, tasks, _Claims(order, fd), jobs, done)
+        finally:
+            os.close(fd)
+        return
+    import tempfile
+
     with tempfile.TemporaryFile() as shared:
         _run(function, tasks, _Claims(order, shared.fileno()), jobs, done)
 
