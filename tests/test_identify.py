@@ -573,29 +573,6 @@ def test_fft_length_is_the_smallest_even_five_smooth_one() -> None:
             assert length == reference
 
 
-@pytest.mark.parametrize("jobs", [2, 5])
-def test_shares_cover_every_file_once_and_are_near_the_best_split(jobs: int) -> None:
-    import itertools
-
-    from clearjoint.identify.core import _balanced_chunks
-
-    rng = np.random.default_rng(jobs)
-    for n in (1, 3, 7, 9):
-        sizes = [int(s) for s in rng.integers(1, 1000, n)]
-        shares = _balanced_chunks(sizes, jobs)
-        assert sorted(i for share in shares for i in share) == list(range(n))
-        assert all(share == sorted(share) and share for share in shares)
-        assert len(shares) == min(n, jobs)
-        if jobs**n > 100_000:
-            continue
-        # against the best split, found by trying every assignment (LPT: within 4/3)
-        best = min(
-            max(sum(s for s, k in zip(sizes, owner, strict=True) if k == j) for j in range(jobs))
-            for owner in itertools.product(range(jobs), repeat=n)
-        )
-        assert max(sum(sizes[i] for i in share) for share in shares) <= 4 / 3 * best
-
-
 def test_parallel_shares_give_the_serial_outcomes_in_file_order(tmp_path: Path) -> None:
     files = [str(p) for p in sorted(SHIPPED.glob("*.json"))]
     files.insert(1, str(tmp_path / "missing.json"))  # refused, with its reason, in its place
