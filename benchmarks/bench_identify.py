@@ -3,7 +3,7 @@
 Run on demand::
 
     python benchmarks/bench_identify.py [--brfd DIR] [--records DIR] [--old-src SRC] [--jobs N]
-        [--repeats R] [--split]
+        [--old-jobs N] [--repeats R]
 
 It times the command (process start, reading, identification, writing results.csv) over
 the default rig campaign (written to a temporary folder unless ``--records`` names one)
@@ -12,7 +12,15 @@ and over the BRFD folder, best of ``--repeats``, in wall-clock seconds and in CP
 ``--old-src`` (for example the ``src`` folder of another checkout) the same command runs
 with that code too, in the same loop, and the ratio is printed: on a shared machine only
 ratios measured side by side mean anything; the load average is printed before and after.
-``--split`` also prints the CPU seconds of reading and of identifying in this process;
+``--old-jobs`` gives the old code's ``--jobs`` (for code that has the option). For each
+set it also prints the CPU seconds of reading and of identifying in this process, and the
+identification's own share of the command's CPU seconds (the estimators change; the rest
+is reading, start-up and orchestration);
+``--critical-path`` estimates, for a machine with a free core per process, the wall time
+of ``--jobs N`` from CPU seconds, which contention inflates far less than wall time: this
+process's CPU seconds to the end of ``main``, against its CPU seconds when it forked plus a
+worker's own (the larger of the two; the interpreter's start before ``main`` and its exit
+after are not in it), best of ``--repeats``, old and new code interleaved.
 ``--parsers`` compares JSON readers of the BRFD files side by side (CPU seconds, best of
 ``--repeats``; each must give the same doubles as Python's json module, bit for bit).
 Target (issue 15): 1e6 samples per second.
@@ -52,7 +60,9 @@ def samples(files: list[Path]) -> int:
     return total
 
 
-def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float, float]:
+def run(
+    files: list[Path], src: str | None, jobs: int, out: Path, old_jobs: int = 1
+) -> tuple[float, float]:
     """Wall-clock and CPU seconds (user + system, of the command's processes) of one run.
 
     Python's compiled bytecode is kept (in a folder of its own, ``PYTHONPYCACHEPREFIX``,
@@ -70,7 +80,8 @@ def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float
     launcher = [str(script)] if script.exists() else [sys.executable, "-m", "clearjoint"]
     command = [*launcher, "identify", *map(str, files)]
     command += ["--out", str(out), "--quiet", "--force"]
-    if jobs > 1 and not src:
+    jobs = old_jobs if src else jobs
+    if jobs > 1:
         command += ["--jobs", str(jobs)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
@@ -81,7 +92,7 @@ def run(files: list[Path], src: str | None, jobs: int, out: Path) -> tuple[float
     return wall, cpu
 
 
-def split(files: list[Path]) -> str:
+def split(files: list[Path]) -> tuple[float, float]:
     """CPU seconds of reading and of identifying ``files`` in this process (no start-up)."""
     from clearjoint.errors import ClearjointError
     from clearjoint.identify import identify
@@ -93,7 +104,7 @@ def split(files: list[Path]) -> str:
     for record in records:  # a record refused with its reason costs its time as well
         with contextlib.suppress(ClearjointError):
             identify(record)
-    return f"in-process: reading {read:.2f} CPU s, identifying {time.process_time() - start:.2f}"
+    return read, time.process_time() - start
 
 
 _BRACKETS = bytes.maketrans(b"[]", b"  ")
@@ -107,6 +118,20 @@ def _numpy_text(raw: bytes) -> np.ndarray:
     return np.fromstring(body.translate(_BRACKETS), sep=",").reshape(rows, -1)
 
 
+def _previous_reader(raw: bytes) -> np.ndarray:
+    """The reader before numpy.fromiter: the collector off while orjson parses only."""
+    import gc
+
+    import orjson
+
+    gc.disable()
+    try:
+        content = orjson.loads(raw)
+    finally:
+        gc.enable()
+    return np.array(content["data"], dtype=np.float64)
+
+
 def parsers(files: list[Path], repeats: int) -> None:
     """CPU seconds of each JSON reader over ``files`` (bytes already read), side by side."""
     import orjson
@@ -116,7 +141,8 @@ def parsers(files: list[Path], repeats: int) -> None:
         "json + numpy.array": lambda raw: np.array(json.loads(raw)["data"], dtype=np.float64),
         "numpy.fromstring of the text": _numpy_text,
         "orjson + numpy.array": lambda raw: np.array(orjson.loads(raw)["data"], dtype=np.float64),
-        "the reader (orjson, no gc)": lambda raw: _brfd_json("", raw)[1],
+        "orjson (no gc) + numpy.array": _previous_reader,
+        "the reader (orjson, fromiter)": lambda raw: _brfd_json("", raw)[1],
     }
     reference = [ways["json + numpy.array"](raw) for raw in raws]
     megabytes = sum(map(len, raws)) / 1e6
@@ -133,6 +159,64 @@ def parsers(files: list[Path], repeats: int) -> None:
         )
 
 
+_TRACE = """
+import os, resource, sys, time
+fork, forks = os.fork, []
+def timed_fork():
+    forks.append(time.process_time())
+    return fork()
+os.fork = timed_fork
+from clearjoint.cli import main
+code = main()
+end = time.process_time()
+children = resource.getrusage(resource.RUSAGE_CHILDREN)
+worker = (children.ru_utime + children.ru_stime) / max(len(forks), 1)
+sys.stderr.write(f"\\nCRITICAL {end} {forks[0] if forks else end} {worker}\\n")
+sys.exit(code)
+"""
+
+
+def critical_path(
+    files: list[Path], src: str | None, jobs: int, out: Path
+) -> tuple[float, float, float]:
+    """CPU seconds of this process to the end of ``main``, at its first fork, and of one
+    worker (the mean over the workers), for ``clearjoint identify FILES --jobs JOBS``."""
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env["PYTHONPYCACHEPREFIX"] = str(out.parent / "pycache")
+    env.setdefault("OPENBLAS_NUM_THREADS", "1")
+    if src:
+        env["PYTHONPATH"] = src
+    command = [sys.executable, "-c", _TRACE, "identify", *map(str, files)]
+    command += ["--out", str(out), "--quiet", "--force", "--jobs", str(jobs)]
+    done = subprocess.run(command, env=env, check=True, capture_output=True, text=True)
+    line = [x for x in done.stderr.splitlines() if x.startswith("CRITICAL ")][-1]
+    end, forked, worker = map(float, line.split()[1:])
+    return end, forked, worker
+
+
+def _critical(sets: dict[str, list[Path]], args: argparse.Namespace, out: Path) -> None:
+    codes = {"new": (None, args.jobs)}
+    if args.old_src:
+        codes["old"] = (args.old_src, args.old_jobs)
+    for name, files in sets.items():
+        best: dict[str, tuple[float, float, float, float]] = {}
+        for _ in range(args.repeats):
+            for label, (src, jobs) in codes.items():
+                end, forked, worker = critical_path(files, src, jobs, out)
+                estimate = max(end, forked + worker) if forked < end else end
+                if label not in best or estimate < best[label][0]:
+                    best[label] = (estimate, end, forked, worker)
+        for label, (estimate, end, forked, worker) in best.items():
+            print(
+                f"{name:22s} {label} code (jobs={codes[label][1]}): {estimate:.3f} CPU s on the "
+                f"critical path (this process {end:.3f}, forked at {forked:.3f}, a worker "
+                f"{worker:.3f})"
+            )
+        if "old" in best:
+            print(f"{name:22s} ratio old/new {best['old'][0] / best['new'][0]:.2f}x")
+
+
 def _load() -> str:
     return " ".join(f"{value:.2f}" for value in os.getloadavg())
 
@@ -143,12 +227,17 @@ def main() -> None:
     parser.add_argument("--records", help="folder of rig records (default: run the campaign)")
     parser.add_argument("--old-src", help="src folder of the code to compare with")
     parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument(
+        "--old-jobs", type=int, default=1, help="--jobs for the old code (if it has the option)"
+    )
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument(
-        "--split", action="store_true", help="also time reading and identifying in-process"
+        "--parsers", action="store_true", help="only compare JSON readers on the BRFD files"
     )
     parser.add_argument(
-        "--parsers", action="store_true", help="only compare JSON readers on the BRFD files"
+        "--critical-path",
+        action="store_true",
+        help="only estimate --jobs N's wall time on free cores from CPU seconds per process",
     )
     args = parser.parse_args()
     if args.parsers:
@@ -166,6 +255,10 @@ def main() -> None:
             sets["BRFD folder"] = sorted(brfd.glob("*.json"))
         out = Path(folder) / "results.csv"
         print("load average (1, 5, 15 min) before: " + _load())
+        if args.critical_path:
+            _critical(sets, args, out)
+            print("load average (1, 5, 15 min) after: " + _load())
+            return
         for name, files in sets.items():
             n = samples(files)
             best = {"new": (float("inf"), 0.0), "old": (float("inf"), 0.0)}
@@ -175,7 +268,8 @@ def main() -> None:
             for _ in range(args.repeats):
                 best["new"] = min(best["new"], run(files, None, args.jobs, out))
                 if args.old_src:
-                    best["old"] = min(best["old"], run(files, args.old_src, 1, out))
+                    old = run(files, args.old_src, 1, out, args.old_jobs)
+                    best["old"] = min(best["old"], old)
             wall, cpu = best["new"]
             rate = n / wall
             verdict = "meets" if rate >= TARGET else "below"
@@ -187,12 +281,17 @@ def main() -> None:
             if args.old_src:
                 old_wall, old_cpu = best["old"]
                 line += (
-                    f"; old code {old_wall:6.2f} s wall, {old_cpu:6.2f} CPU s: ratio "
+                    f"; old code (jobs={args.old_jobs}) {old_wall:6.2f} s wall, "
+                    f"{old_cpu:6.2f} CPU s: ratio "
                     f"{old_wall / wall:.2f}x wall, {old_cpu / cpu:.2f}x CPU"
                 )
             print(line)
-            if args.split:
-                print(f"{name:22s} {split(files)}")
+            read, identifying = split(files)
+            print(
+                f"{name:22s} in this process: reading {read:.2f} CPU s, identifying "
+                f"{identifying:.2f} CPU s; the identification's own share of the command's "
+                f"{cpu:.2f} CPU s: {identifying / cpu:.0%}"
+            )
         print("load average (1, 5, 15 min) after: " + _load())
 
 

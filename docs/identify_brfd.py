@@ -9,17 +9,22 @@ Checks, per the issue: every file a damper loop or refused with its reason; the 
 within 15 % of the median of the accepted tests at the same band tension; the loop energy
 within 15 % of the elastic-plastic-with-gap estimate 2 F_f (2X - b - 2 F_f / k).
 
-``python docs/identify_brfd.py --diagnose [BRFD_FOLDER]`` prints instead, for the files whose
-backlash misses, the travel steps between the level crossings on each branch (what the
-damper estimator reads, :mod:`clearjoint.identify.damper`), and the backlash of every file
-under an alternative rule tried in docs/identify.md (a long step in which the force falls
-back by more than two crossing levels, or one, is ringing, not backlash).
+The table's "b before" column is the estimator this one replaced (the sum of the level-crossing
+steps longer than two elastic steps, :func:`previous_backlash`), on the same cycle average.
+
+``python docs/identify_brfd.py --diagnose [BRFD_FOLDER]`` prints instead, for every file, the
+backlash read on each branch and the level of the step (what the damper estimator fits,
+:mod:`clearjoint.identify.damper`), then the medians and the misses under other choices:
+the number of crossings N (a resolution), and the variant tried and not adopted (the slope
+fitted with the step by least absolute deviations, not read from the median step); last, the
+CPU time of the damper estimator per cycle average.
 """
 
 from __future__ import annotations
 
 import re
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -29,9 +34,13 @@ from clearjoint.identify import damper, identify_files
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _levels(x: np.ndarray, f: np.ndarray) -> tuple[tuple[slice, slice], float, float]:
+def _parts(x: np.ndarray) -> tuple[slice, slice]:
     top = int(np.argmax(x))
-    parts = (slice(0, top + 1), slice(top, x.size))
+    return slice(0, top + 1), slice(top, x.size)
+
+
+def _levels(x: np.ndarray, f: np.ndarray) -> tuple[tuple[slice, slice], float, float]:
+    parts = _parts(x)
     levels = []
     for part in parts:
         travel = np.abs(x[part] - x[part][0])
@@ -39,53 +48,104 @@ def _levels(x: np.ndarray, f: np.ndarray) -> tuple[tuple[slice, slice], float, f
     return parts, levels[0], levels[1]
 
 
-def _steps(x: np.ndarray, f: np.ndarray, dip: float | None) -> tuple[list[np.ndarray], float]:
-    """Crossing steps of both branches and the backlash from them (dip: the alternative)."""
+def previous_backlash(x: np.ndarray, f: np.ndarray) -> float:
+    """The estimator before this one: on each branch, the first crossings of 17 levels
+    (10 % ... 90 % of the level change); b is what the steps longer than two median steps
+    hold beyond one median step; the mean of the two branches."""
     parts, rise, fall = _levels(x, f)
-    steps_all, backlash = [], []
+    alphas = np.linspace(0.1, 0.9, 17)
+    out = []
+    for part, start, stop in ((parts[0], fall, rise), (parts[1], rise, fall)):
+        travel, fb = np.abs(x[part] - x[part][0]), f[part]
+        reached = np.maximum.accumulate(np.sign(stop - start) * (fb - start) / abs(stop - start))
+        s = np.interp(alphas, reached, travel)  # the running maximum is non-decreasing
+        steps = np.diff(s)
+        excess = steps - np.median(steps)
+        out.append(float(np.sum(excess[excess > np.median(steps)])))
+    return 0.5 * sum(out)
+
+
+def _set_resolution(n: int) -> None:
+    """Read n crossings per branch in :mod:`clearjoint.identify.damper` (for --diagnose)."""
+    damper.N_CROSSINGS = n
+    damper.ALPHAS = (np.arange(n) + 0.5) / n
+    damper._PLACES = np.arange(2, n - 1)
+    damper._BEFORE = np.arange(n)[None, :] < damper._PLACES[:, None]
+
+
+def _fitted_slope_backlash(x: np.ndarray, f: np.ndarray) -> float:
+    """The variant not adopted: slope, place and step all by least absolute deviations
+    (the slope on a fine grid about the median step's, 0.25 to 4 times it)."""
+    parts, rise, fall = _levels(x, f)
+    out = []
     for part, start, stop in ((parts[0], fall, rise), (parts[1], rise, fall)):
         travel, fb = np.abs(x[part] - x[part][0]), f[part]
         s = damper._crossings(travel, fb, start, stop)
         assert s is not None
-        steps = np.diff(s)
-        typical = float(np.median(steps))
-        excess = steps - typical
-        long = excess > damper.JUMP * typical
-        if dip is not None:
-            progress = np.sign(stop - start) * (fb - start) / abs(stop - start)
-            for i in range(steps.size):
-                inside = (travel >= s[i]) & (travel <= s[i + 1])
-                if inside.any() and progress[inside].min() < damper.ALPHAS[i] - dip:
-                    long[i] = False
-        steps_all.append(steps)
-        backlash.append(float(np.sum(excess[long])))
-    return steps_all, 0.5 * sum(backlash)
+        d0 = float(np.median(np.diff(s))) * damper.N_CROSSINGS
+        best = (np.inf, 0.0)
+        for d in d0 * np.geomspace(0.25, 4.0, 241):
+            r = s - d * damper.ALPHAS
+            j = int(damper._PLACES[damper._best_place(r)])
+            lo, hi = np.median(r[:j]), np.median(r[j:])
+            loss = float(np.abs(r[:j] - lo).sum() + np.abs(r[j:] - hi).sum())
+            if loss < best[0]:
+                best = (loss, float(hi - lo))
+        out.append(max(best[1], 0.0))
+    return 0.5 * sum(out)
+
+
+def _misses(b: dict[str, float], tension: dict[str, int]) -> str:
+    median = {t: float(np.median([b[k] for k in b if tension[k] == t])) for t in (0, 30, 36)}
+    miss = {k: b[k] / median[tension[k]] - 1 for k in b}
+    out = {k: v for k, v in miss.items() if abs(v) > 0.15}
+    return (
+        "medians (mm) "
+        + ", ".join(f"{t} lb {1e3 * m:.2f}" for t, m in median.items())
+        + f"; {len(out)} miss"
+        + (": " + ", ".join(f"{k} {v:+.0%}" for k, v in sorted(out.items())) if out else "")
+    )
 
 
 def diagnose(results: list[tuple[object, object]]) -> None:
     loops = {Path(i.source).stem: i.loop for _, i in results}  # type: ignore[attr-defined]
     tension = {k: int(re.search(r"(\d+)lbtension", k)[1]) for k in loops}  # type: ignore[index]
-    for dip in (None, 0.1, 0.05):
-        b = {k: _steps(*loop, dip)[1] for k, loop in loops.items()}
-        median = {t: float(np.median([b[k] for k in b if tension[k] == t])) for t in (0, 30, 36)}
-        miss = {
-            k: b[k] / median[tension[k]] for k in b if abs(b[k] / median[tension[k]] - 1) > 0.15
-        }
-        rule = "as shipped" if dip is None else f"ringing dips of more than {dip:.0%} excluded"
+    print("file: backlash rising / falling branch (mm), step level alpha_b rising / falling")
+    for k, (x, f) in loops.items():
+        fit = damper._damper_fit(x, f, _parts(x))
+        assert fit is not None
+        _, rise, fall = _levels(x, f)
+        places = []
+        for part, start, stop in ((_parts(x)[0], fall, rise), (_parts(x)[1], rise, fall)):
+            s = damper._crossings(np.abs(x[part] - x[part][0]), f[part], start, stop)
+            assert s is not None
+            places.append(damper.ALPHAS[damper._step_fit(s)[3]] - 0.5 / damper.N_CROSSINGS)
+        b_rise, b_fall = fit.backlash_branches
         print(
-            f"\nbacklash rule {rule}: medians (mm) "
-            + ", ".join(f"{t} lb {1e3 * m:.2f}" for t, m in median.items())
-            + f"; {len(miss)} miss: "
-            + ", ".join(f"{k} {v - 1:+.0%}" for k, v in sorted(miss.items()))
+            f"  {k}: {1e3 * b_rise:.2f} / {1e3 * b_fall:.2f}, "
+            f"alpha_b {places[0]:.2f} / {places[1]:.2f}"
         )
-        if dip is None:
-            for k in sorted(miss):
-                steps, _ = _steps(*loops[k], None)
-                for name, st in zip(("rising", "falling"), steps, strict=True):
-                    print(
-                        f"  {k} {name} branch, steps (mm): "
-                        + " ".join(f"{1e3 * v:.2f}" for v in st)
-                    )
+    before = {k: previous_backlash(*loop) for k, loop in loops.items()}
+    print(f"\nthe estimator before: {_misses(before, tension)}")
+    for n in (24, 32, 48, 64, 96):
+        _set_resolution(n)
+        b = {}
+        for k, (x, f) in loops.items():
+            fit = damper._damper_fit(x, f, _parts(x))
+            assert fit is not None
+            b[k] = 0.5 * sum(fit.backlash_branches)
+        print(f"N = {n} crossings: {_misses(b, tension)}")
+    _set_resolution(48)
+    fitted = {k: _fitted_slope_backlash(*loop) for k, loop in loops.items()}
+    print(f"variant, slope fitted too (N = 48): {_misses(fitted, tension)}")
+    # the estimator's cost: one call per cycle average (each file: the model choice and
+    # one per jackknife replicate)
+    start = time.process_time()
+    for _ in range(5):
+        for x, f in loops.values():
+            damper._damper_fit(x, f, _parts(x))
+    cost = (time.process_time() - start) / (5 * len(loops))
+    print(f"CPU time of damper._damper_fit per cycle average: {1e3 * cost:.2f} ms")
 
 
 def main() -> None:
@@ -106,11 +166,15 @@ def main() -> None:
     median = {
         t: float(np.median([r[3]["clearance_m"] for r in rows if r[1] == t])) for t in (0, 30, 36)
     }
+    before = {r[0]: previous_backlash(*r[2].loop) for r in rows}
+    median_before = {
+        t: float(np.median([before[r[0]] for r in rows if r[1] == t])) for t in (0, 30, 36)
+    }
     print(
-        "| file | model | cycles | backlash b (mm) | b / median | F+ / F- (kN) | k (MN/m) "
-        "| X (mm) | E (J) | E / 2F_f(2X-b-2F_f/k) | flag |"
+        "| file | model | cycles | backlash b (mm) | b / median | b before (mm) | before / median "
+        "| F+ / F- (kN) | k (MN/m) | X (mm) | E (J) | E / 2F_f(2X-b-2F_f/k) | flag |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     misses_b = misses_e = 0
     for name, t, ident, s, e, k, estimate in rows:
         rb = s["clearance_m"] / median[t]
@@ -120,6 +184,7 @@ def main() -> None:
         print(
             f"| {name} | {ident.model} | {ident.cycles_used}/{ident.cycles_total} "
             f"| {1e3 * s['clearance_m']:.2f} ± {1e3 * e['clearance_m']:.2f} | {rb:.2f} "
+            f"| {1e3 * before[name]:.2f} | {before[name] / median_before[t]:.2f} "
             f"| {s['friction_force_positive_n'] / 1e3:.2f} / "
             f"{s['friction_force_negative_n'] / 1e3:.2f} | {k / 1e6:.2f} "
             f"| {1e3 * s['amplitude_m']:.1f} | {s['energy_per_cycle_j']:.0f} | {re_:.3f} "

@@ -107,3 +107,33 @@ def test_a_study_without_a_force_is_one_line_and_exit_2(
     assert code == 2
     assert len(err.strip().splitlines()) == 1
     assert "force_amplitude" in err
+
+
+def test_free_play_orbits_are_flagged_and_said_to_have_no_set_position(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # k0 = 0, forced past the contact resonance: the curve ends on the continuum of orbits
+    # inside the gap (the free mass: X = F0 / (w sqrt(m^2 w^2 + c^2)), c = 2 N s/m here)
+    study = tmp_path / "free.toml"
+    study.write_text(
+        '[joint]\nmass = "1kg"\nclearance = "0.2m"\ncompression_stiffness = "100N/m"\n'
+        '[excitation]\nforce_amplitude = "1N"\nfrequency = "1Hz"\n'
+        "[losses]\ndamping_ratio = 0.1\nrestitution = 0.8\n"
+    )
+    args = ["frf", str(study), "--from", "0.32Hz", "--to", "1.9Hz", "--out", str(tmp_path / "a.nc")]
+    code, text, err = run(args, capsys)
+    assert code == 0, err
+    assert err == ""
+    assert "free play from 0.4558" in text  # 2.8632 rad/s: 2 X = clearance
+    assert "its position is not" in text
+    code, text, err = run([*args, "--json", "--force"], capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    free = data["free_play"]
+    assert len(free) == len(data["frequency_hz"])
+    assert sum(free) > 20
+    assert free[-1]
+    assert not any(f for f, s in zip(free, data["stable"], strict=True) if s)
+    assert "free_play" in [e["kind"] for e in data["events"]]
+    w = 2.0 * math.pi * data["frequency_hz"][-1]
+    assert data["amplitude_m"][-1] == pytest.approx(1.0 / (w * math.sqrt(w * w + 4.0)), rel=1e-9)

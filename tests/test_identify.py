@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import re
 from pathlib import Path
 
@@ -15,7 +16,7 @@ import pytest
 import xarray as xr
 
 from clearjoint.cli import main
-from clearjoint.identify import IdentificationError, identify, identify_files
+from clearjoint.identify import IdentificationError, damper, identify, identify_files
 from clearjoint.records import Record, read_record
 from clearjoint.rig import load_campaign, run_campaign
 from independent_joint import TrueJoint, steady_truth, write_record
@@ -94,23 +95,28 @@ def friction_loop(
     rate: float = 2000.0,
     frequency: float = 1.0,
     backlash_falling: float | None = None,
+    ringing: float = 0.0,
 ) -> Record:
     """A rigid-plastic friction loop with backlash under imposed x = X sin(w t), exactly.
 
     The force follows, along the travel from each reversal, elastic unloading at
     ``stiffness``, the backlash at zero force, elastic loading, then the slip plateau.
     ``backlash_falling`` (default: ``backlash``) is the free travel after the upper
-    reversal: a loop that is not one gap when the two differ.
+    reversal: a loop that is not one gap when the two differ. ``ringing`` (a fraction of
+    the friction force) holds the loading force back, from where it first reaches 70 % of
+    the slip level, by the dips of a decaying 25 Hz oscillation of that amplitude: the force
+    nears the slip level, rings back and reaches it only later, as when the BRFD's slip
+    starts again (docs/identify.md). The gap, the slopes and the level are unchanged.
     """
     t = np.arange(int(cycles * rate / frequency)) / rate
     envelope = np.clip(t * frequency, 0.0, 1.0)  # a one-cycle ramp in, as the BRFD has
     x = amplitude * envelope * np.sin(2 * np.pi * frequency * t)
     force = np.zeros_like(x)
-    state, anchor, level = 1.0, x[0], 0.0
+    state, anchor, level, contact = 1.0, x[0], 0.0, math.inf
     for n in range(1, x.size):
         direction = np.sign(x[n] - x[n - 1]) or state
         if direction != state:  # reversal: the force starts back from its level there
-            state, anchor, level = direction, x[n - 1], force[n - 1]
+            state, anchor, level, contact = direction, x[n - 1], force[n - 1], math.inf
         travel = abs(x[n] - anchor)
         unload = abs(level) / stiffness
         gap = backlash if state > 0 or backlash_falling is None else backlash_falling
@@ -119,7 +125,12 @@ def friction_loop(
         elif travel <= unload + gap:
             value = 0.0
         else:
-            value = state * stiffness * (travel - unload - gap)
+            elastic = stiffness * (travel - unload - gap)
+            if elastic >= 0.7 * friction:
+                contact = min(contact, t[n])
+            tau = t[n] - contact if t[n] >= contact else 0.0
+            dip = max(np.sin(2 * np.pi * 25.0 * tau), 0.0) * np.exp(-20.0 * tau)
+            value = state * (elastic - ringing * friction * dip)
         force[n] = state * min(abs(value), friction) if np.sign(value) == state else value
     return Record(
         time=t,
@@ -147,6 +158,35 @@ def test_a_loop_whose_branches_show_different_backlash_is_doubtful() -> None:
     # the same rule on the two other branch ratios: 1.8 passes, 2.2 does not
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 1.8)).flag == "ok"
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 2.2)).flag != "ok"
+
+
+def test_backlash_is_the_distance_between_the_elastic_lines() -> None:
+    """Crossings of an elastic-plastic loop whose 4 mm gap is crossed over a tenth of the
+    level change, the last two crossings delayed 1.5 mm by ringing: the step fit reads the
+    two parallel lines (travel 2 mm per unit of the level change) 4 mm apart exactly."""
+    alphas = damper.ALPHAS
+    gap = 4e-3 * np.clip((alphas - 0.45) / 0.1, 0.0, 1.0)
+    s = 0.3e-3 + 2e-3 * alphas + gap
+    s[-2:] += 1.5e-3
+    intercept, slope, backlash, place = damper._step_fit(s)
+    assert slope == pytest.approx(2e-3, rel=1e-9)
+    assert intercept == pytest.approx(0.3e-3, rel=1e-9)
+    assert backlash == pytest.approx(4e-3, rel=1e-9)
+    assert 0.45 <= damper.ALPHAS[place] <= 0.55 + 1.0 / damper.N_CROSSINGS
+
+
+def test_ringing_as_slip_starts_is_not_backlash() -> None:
+    """The force nears the slip level, rings back by 40 % of the friction force and reaches
+    the level millimetres later: that travel is not gap (the estimator before this one read
+    4.64 mm here, +16 %: it summed every long step between level crossings)."""
+    b, f_f, k, x_amp = 4e-3, 1e4, 5e6, 20e-3
+    plain = friction_loop(b, f_f, k, x_amp)
+    ringing = friction_loop(b, f_f, k, x_amp, ringing=0.4)
+    assert np.max(np.abs(ringing.force - plain.force)) > 0.3 * f_f  # the dips are there
+    s = identify(ringing).summary
+    assert s["clearance_m"] == pytest.approx(b, rel=0.01)
+    assert s["compression_stiffness_n_per_m"] == pytest.approx(k, rel=0.03)
+    assert s["friction_force_n"] == pytest.approx(f_f, rel=0.01)
 
 
 def test_exact_friction_loop_with_backlash() -> None:
@@ -180,12 +220,19 @@ def test_real_brfd_records() -> None:
         assert s["energy_per_cycle_j"] == pytest.approx(elastic_plastic_energy(s), rel=0.15)
         tension = result.source.split("Hz")[1].split("lb")[0]
         backlash.setdefault(tension, []).append(s["clearance_m"])
-    # one device: the backlash within 15 % of the median at its band tension; three of the
-    # thirty miss it today (docs/identify.md says which)
-    misses = sum(
-        abs(b / np.median(values) - 1.0) > 0.15 for values in backlash.values() for b in values
-    )
-    assert misses <= 3
+    # one device: the backlash within 15 % of the median at its band tension; two of the
+    # thirty miss it today, both flagged doubtful as not one gap (docs/identify.md says which)
+    misses = [
+        result
+        for _, result in results
+        for values in [backlash[result.source.split("Hz")[1].split("lb")[0]]]
+        if abs(result.summary["clearance_m"] / np.median(values) - 1.0) > 0.15
+    ]
+    assert len(misses) <= 2
+    for result in misses:
+        flag, reason = result.flags["clearance_m"]
+        assert flag == "doubtful", result.source
+        assert "not one gap" in reason, result.source
 
 
 def test_short_and_shapeless_records_are_refused() -> None:
@@ -354,14 +401,14 @@ def test_shipped_brfd_records_are_damper_loops(tension: int) -> None:
     s = result.summary
     assert result.model == "damper"
     assert result.cycles_used >= 3
-    # the device's backlash is a few millimetres (3.5 to 4.1 mm median per band tension over
+    # the device's backlash is a few millimetres (3.8 to 4.2 mm median per band tension over
     # the 31 files, docs/identify.md)
     assert 2e-3 < s["clearance_m"] < 6e-3
     # the slip levels of both directions, with the friction force half their difference
     up, down = s["friction_force_positive_n"], s["friction_force_negative_n"]
     assert up > 0 > down
     assert s["friction_force_n"] == pytest.approx(0.5 * (up - down))
-    # 2 Hz, 0 lb: a backlash of about 4.3 mm on the rising branch, 1.4 mm on the falling one
+    # 2 Hz, 0 lb: a backlash of about 4.7 mm on the rising branch, 1.4 mm on the falling one
     # (docs/identify.md): not one gap, so its backlash is doubtful; the others read alike
     flag, reason = result.flags["clearance_m"]
     assert flag == ("doubtful" if tension == 0 else "ok")
@@ -524,29 +571,6 @@ def test_fft_length_is_the_smallest_even_five_smooth_one() -> None:
         reference = next_fast_len(int(n), real=True)
         if reference % 2 == 0:
             assert length == reference
-
-
-@pytest.mark.parametrize("jobs", [2, 5])
-def test_shares_cover_every_file_once_and_are_near_the_best_split(jobs: int) -> None:
-    import itertools
-
-    from clearjoint.identify.core import _balanced_chunks
-
-    rng = np.random.default_rng(jobs)
-    for n in (1, 3, 7, 9):
-        sizes = [int(s) for s in rng.integers(1, 1000, n)]
-        shares = _balanced_chunks(sizes, jobs)
-        assert sorted(i for share in shares for i in share) == list(range(n))
-        assert all(share == sorted(share) and share for share in shares)
-        assert len(shares) == min(n, jobs)
-        if jobs**n > 100_000:
-            continue
-        # against the best split, found by trying every assignment (LPT: within 4/3)
-        best = min(
-            max(sum(s for s, k in zip(sizes, owner, strict=True) if k == j) for j in range(jobs))
-            for owner in itertools.product(range(jobs), repeat=n)
-        )
-        assert max(sum(sizes[i] for i in share) for share in shares) <= 4 / 3 * best
 
 
 def test_parallel_shares_give_the_serial_outcomes_in_file_order(tmp_path: Path) -> None:

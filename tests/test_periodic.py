@@ -520,3 +520,52 @@ def test_compiled_ordinary_step_follows_the_same_branch_as_the_python_one() -> N
     assert np.array_equal(fast.tangent, slow.tangent)
     assert np.array_equal(fast.iterations, slow.iterations)
     assert int(np.sum(fast.iterations == 1)) > 10  # the polynomial predictor was used on the way
+
+
+def test_study_unstable_branch_passes_where_the_section_sits_on_an_impact_near_636_hz() -> None:
+    # examples/study.toml: the unstable branch coming down from the fold at 704.8 Hz used to
+    # stop at 636.04 Hz. There its tension impact passes through forcing phase 0, so the
+    # state at phase 0 jumps (v -> v / e) while the orbit itself changes smoothly
+    # (multipliers about 2.36 and 0.13 on both sides): not a fold.
+    joint, kw = _study_losses()
+    force = float(kw.pop("force"))  # type: ignore[arg-type]
+    hz = 2.0 * math.pi
+    curve = frequency_response(joint, force, 500.0 * hz, 720.0 * hz, **kw)  # type: ignore[arg-type]
+    assert curve.stop_reason == "reached"
+    f = curve.omega / hz
+    assert f.min() < 490.0  # on down past 636.04 Hz, the way it was going
+    folds = [e.omega / hz for e in curve.events if e.kind == "fold"]
+    assert any(e == pytest.approx(704.78, abs=0.01) for e in folds)
+    assert not any(600.0 < e < 700.0 for e in folds)
+    assert curve.free_play is not None
+    top = int(np.argmax(np.where(curve.free_play, 0.0, f)))  # the fold at 704.78 Hz
+    # where the phase-0 state crosses the tension edge: after the impact (in contact) above,
+    # before it (in the gap) below, the parameter still going down
+    gap = joint.tension_gap
+    x0 = curve.initial_state[:, 0]
+    above = top + int(np.nonzero(x0[top:] > -gap)[0][0]) - 1
+    below = above + 1
+    assert 636.0 < f[below] < f[above] < 636.1
+    ratio = curve.initial_state[above, 1] / curve.initial_state[below, 1]
+    assert ratio == pytest.approx(kw["restitution"], rel=1e-3)  # v after = e v before
+    assert np.abs(curve.multipliers[above]) == pytest.approx(
+        np.abs(curve.multipliers[below]), rel=1e-3
+    )
+    # independent route: time marching closes both orbits after a period; perturbed, they leave
+    unstable_branch = (np.arange(f.size) > top) & ~curve.free_play
+    for i in (above, below, int(np.argmin(np.where(unstable_branch, abs(f - 620.0), np.inf)))):
+        assert not curve.stable[i]
+        w = float(curve.omega[i])
+        z = curve.initial_state[i]
+        size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
+        one = time_response(joint, force, w, 2.0 * math.pi / w, initial=z, **kw)  # type: ignore[arg-type]
+        assert np.max(np.abs(np.array(one.final_state) - z) / size) < 1e-8
+        kicked = time_response(
+            joint,
+            force,
+            w,
+            60 * 2.0 * math.pi / w,
+            initial=z + 1e-6 * size,
+            **kw,  # type: ignore[arg-type]
+        )
+        assert np.max(np.abs(np.array(kicked.final_state) - z) / size) > 1e-3

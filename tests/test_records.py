@@ -294,6 +294,37 @@ def test_brfd_reader_refuses_what_is_not_a_numeric_matrix(
         read_brfd(path)
 
 
+@pytest.mark.parametrize(
+    ("rows", "taken"),
+    [
+        ([[0, 1.5, -2e-300], [3, 4.25, True]], True),  # ints, a bool, a subnormal
+        ([[1.0, 2.0], [3.0]], False),  # ragged: refused by numpy, as before
+        (["123456", "654321"], False),  # strings of equal length are not rows of numbers
+        ([[1.0, "2.5"], [3.0, 4.0]], None),  # either way, the same numbers
+        ([[1.0, None], [3.0, 4.0]], None),
+        ([[[1.0], [2.0]], [[3.0], [4.0]]], False),
+        ([], False),
+    ],
+)
+def test_fast_matrix_reader_agrees_with_numpy_or_declines(
+    rows: list[object], taken: bool | None
+) -> None:
+    from clearjoint.records import _rows_matrix
+
+    fast = _rows_matrix(rows)
+    if taken is not None:
+        assert (fast is not None) == taken
+    if fast is not None:  # declined, the reader converts by numpy.array: its own behaviour
+        np.testing.assert_array_equal(fast, np.array(rows, dtype=np.float64), strict=True)
+
+
+def test_brfd_reader_refuses_rows_that_are_strings(tmp_path: Path) -> None:
+    path = tmp_path / "1Hz0lbtension1amplitude.json"
+    path.write_text(json.dumps({"data": ["123456", "654321"]}))
+    with pytest.raises(RecordError, match="must have 6 columns"):
+        read_brfd(path)
+
+
 def test_fast_unit_factors_agree_with_pint() -> None:
     from clearjoint.records import FAST_FACTORS, SI
     from clearjoint.units import registry

@@ -166,3 +166,14 @@ def test_a_3d_node_on_three_skew_orthogonal_members_has_their_three_frequencies(
     )
     open_omega = jointed.modes("open").omega
     np.testing.assert_allclose(open_omega, [0.0, *np.sqrt(k[:2] / m)], atol=1e-6)
+
+
+def test_structures_compare_by_value_and_are_not_hashable() -> None:
+    joint = ClearanceJoint(1e-4, 8e7)
+    a = chain([2.0, 1.0], [3e6, 1e6], [joint, None])
+    assert a == chain([2.0, 1.0], [3e6, 1e6], [joint, None])  # it used to raise on the arrays
+    assert a != chain([2.0, 1.5], [3e6, 1e6], [joint, None])
+    assert a != chain([2.0, 1.0], [3e6, 1e6], [None, None])
+    assert a != "a structure"
+    with pytest.raises(TypeError):
+        hash(a)

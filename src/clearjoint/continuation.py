@@ -76,6 +76,9 @@ _POLY_ALIGN = math.cos(0.1)
 #: Scaled distance within which a branch has reached the ``join`` point of another.
 _JOIN_DISTANCE = 1e-3
 
+#: A step of at most this many smallest steps counts towards ``crawl_points``.
+_CRAWL_STEPS = 100.0
+
 #: Points in a row running back along the branch's own path after which it stops.
 _BACK_POINTS = 5
 
@@ -115,6 +118,11 @@ class ContinuationSettings:
     predictor_degree : int
         Degree of the polynomial predictor through the last points, used after as
         many ordinary steps in a row (3: a cubic through four points).
+    crawl_points : int
+        After this many points in a row reached by steps of at most 100 smallest
+        steps (the branch crawls towards a singular point), the natural-parameter
+        jump across a kink is tried at once; if it finds nothing the branch goes on
+        crawling. 0 (the default) never tries it early.
     """
 
     step: float = 0.01
@@ -130,6 +138,7 @@ class ContinuationSettings:
     max_kink_jump: float = 1e-4
     chord_parameter: bool = False
     predictor_degree: int = 3
+    crawl_points: int = 0
 
     def __post_init__(self) -> None:
         if not 0.0 < self.min_step <= self.step <= self.max_step:
@@ -413,6 +422,7 @@ def continue_branch(
     # a residual may carry its ordinary step compiled: step(points, h, t, curvature, scale,
     # settings) -> ((y, a, data, its), tangent) or None, predicting as below from ``points``
     fast_step = getattr(residual, "step", None) if settings.chord_parameter else None
+    crawl = 0  # points in a row reached by steps of at most _CRAWL_STEPS smallest steps
     while len(ys) < settings.max_points:
         poly = (
             smooth >= settings.predictor_degree
@@ -454,7 +464,11 @@ def continue_branch(
             if sharp and h > settings.min_step:
                 attempt = None
         stuck = attempt is None and h <= settings.min_step
-        if stuck:
+        # crawling: the last ``crawl_points`` steps all accepted at tiny steps (towards a
+        # grazing whose square-root singularity no larger step passes): try the jump now
+        crawling = not stuck and settings.crawl_points > 0 and crawl >= settings.crawl_points
+        if stuck or crawling:
+            crawl = 0
             # the way the branch was travelling (the tangent at a kink can point anywhere)
             travel = float(np.sign(y[-1] - ys[-2][-1])) if len(ys) > 1 else 0.0
 
@@ -476,20 +490,29 @@ def continue_branch(
                 back,
             )
 
-            if jump is None:
+            if jump is None and not crawling:
                 jump = _other_piece(residual, y, t, datas[-1], scale, settings, differs, back)
-            if jump is None:
+            if jump is None and crawling:
+                stuck = False  # no jump: go on with the small step that converged
+            elif jump is None:
                 reason = (
                     f"step too small at lambda = {y[-1] * scale[-1]:.10g}: no arclength step "
                     "converged, nor a parameter jump of up to "
                     f"{settings.max_kink_jump * scale[-1]:.3g}"
                 )
                 break
+        if stuck or (crawling and jump is not None):
+            assert jump is not None
             (y_new, a_new, data_new, its), relabelled = jump
             t_new = _tangent(a_new, t)
             if differs is not None and (y_new[-1] - y[-1]) * (travel or direction) < 0.0:
                 # a fold at the kink: both pieces may end there, so try which way leads away
                 t_new = _away(residual, y, y_new, t_new, data_new, scale, settings, differs)
+            elif relabelled:
+                # the same orbit written across a jump of the section: keep the way lambda was
+                # moving (the tangent at the jump itself can point anywhere)
+                if t_new[-1] * (travel or direction) < 0.0:
+                    t_new = -t_new
             elif float(t_new @ (y_new - y)) < 0.0:
                 t_new = -t_new  # go on away from the kink (at a grazing fold: back in lambda)
             if direction * (y_new[-1] - stop) >= 0.0:
@@ -552,6 +575,7 @@ def continue_branch(
         curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         smooth = 0 if retry else smooth + 1
         aligned = aligned + 1 if cos_turn > _POLY_ALIGN else 0
+        crawl = crawl + 1 if h <= _CRAWL_STEPS * settings.min_step else 0
         retry = False
         y, t = y_new, t_new
         if sharp and differs is not None:
@@ -621,16 +645,13 @@ def _behind(
     datas: list[Any],
     differs: Differs,
 ) -> bool:
-    """``y_new`` lies on the branch's earlier path, travelled either way.
+    """``y_new`` lies on the branch's earlier path, travelled the other way.
 
     On a chord between two earlier points (not among the last ten) to 1e-2 of
     its length, on the same smooth piece, with a tangent turned by more than 155
-    degrees from theirs (the branch runs back along itself: a kink crossing went
-    back onto a piece it had followed) or by less than 25 degrees (it goes round a
-    closed loop of pieces joined at kinks, as between the two grazings with
-    impacts near omega = 0.914 in pyHarm's case with e = 0.8, and would go round
-    until max_points). Near a fold the two halves of a branch part
-    quadratically, so a few points in a row tell the two apart.
+    degrees from theirs: the branch runs back along itself (a kink crossing went
+    back onto a piece it had followed). Near a fold the two halves of a branch
+    part quadratically, so a few points in a row tell the two apart.
     """
     if len(ys) < 12:
         return False
@@ -642,7 +663,7 @@ def _behind(
     miss = np.linalg.norm(offsets - where[:, None] * chords, axis=1)
     near = np.nonzero(miss <= 1e-2 * np.sqrt(lengths) + 1e-12)[0]
     return any(
-        abs(float(t_new @ ts[int(j)])) > 0.9 and not differs(datas[int(j)], data_new) for j in near
+        float(t_new @ ts[int(j)]) < -0.9 and not differs(datas[int(j)], data_new) for j in near
     )
 
 

@@ -18,7 +18,13 @@ a finite difference of the exact map; the one in the state is exact. Events:
   changes sign (a multiplier passes -1); a period-2 branch is born there and is
   not followed;
 - grazing: the orbit starts or stops touching a gap edge (x_max - g_c or
-  -g_t - x_min changes sign); the branch has a kink there.
+  -g_t - x_min changes sign); the branch has a kink there;
+- free_play (k0 = 0 only): the branch meets the orbits that never touch an edge.
+  Inside the gap the force does not depend on x, so such an orbit shifted by any
+  constant is an orbit too (a continuum, multiplier exactly 1, Newton singular): the
+  branch stops where it meets them (its orbit touches an edge there) and the curve
+  goes on along the member centred in the gap, flagged ``free_play``: its amplitude is
+  set by the dynamics, its position is not.
 """
 
 from __future__ import annotations
@@ -88,6 +94,10 @@ _SEED_FACTORS = (0.003, 0.006, 0.01, 0.02)
 #: Points at most on the way back from such an orbit (a seed on a branch that does not
 #: lead back to the stop is given up after them).
 _BACK_POINTS = 500
+#: Smallest arclength step (scaled units) of the curve.
+_MIN_STEP = 1e-6
+#: Points in a row at tiny steps after which a jump across the kink ahead is tried.
+_CRAWL_POINTS = 20
 
 
 @dataclass(frozen=True)
@@ -288,6 +298,12 @@ class FrequencyResponse:
         (n, 2H + 1, N) for a Structure (whose x_max, x_min, amplitude are then (n, N)).
     method : {"shooting", "harmonic"}
         Exact shooting (this module) or harmonic balance (``clearjoint.harmonic``).
+    free_play : (n,) ndarray of bool, optional
+        True where the orbit stays inside the gap with gap_stiffness 0: one of a
+        continuum of orbits (any mean position that keeps it off the edges; Floquet
+        multiplier exactly 1, so ``stable`` is False), of which the curve shows the one
+        centred in the gap. Its amplitude is set by the dynamics, its position is not.
+        None for harmonic balance.
     """
 
     omega: FloatArray
@@ -304,6 +320,7 @@ class FrequencyResponse:
     settings: dict[str, Any] = field(repr=False, default_factory=dict)
     coefficients: FloatArray | None = field(repr=False, default=None)
     method: str = "shooting"
+    free_play: NDArray[np.bool_] | None = field(repr=False, default=None)
 
     def __repr__(self) -> str:
         kinds = ", ".join(
@@ -311,6 +328,8 @@ class FrequencyResponse:
             for k in ("fold", "period_doubling", "grazing")
         )
         f = self.omega / (2 * math.pi)
+        if self.free_play is not None and self.free_play.any():
+            kinds += f", {int(np.sum(self.free_play))} free play"
         return (
             f"FrequencyResponse({self.omega.size} points, {f.min():.4g}-{f.max():.4g} Hz, "
             f"F0 {self.force_amplitude.min():.4g}-{self.force_amplitude.max():.4g} N, "
@@ -425,6 +444,8 @@ class FrequencyResponse:
     def plot(self, ax: Axes | None = None) -> Axes:
         """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.
 
+        Free-play orbits (``free_play``: a continuum inside the gap) are dotted grey.
+
         Returns
         -------
         matplotlib.axes.Axes
@@ -438,21 +459,20 @@ class FrequencyResponse:
         else:
             xs, label = self.omega / (2 * math.pi), "frequency (Hz)"
         ys = self.amplitude * 1e3
+        free = np.zeros(self.stable.size, dtype=bool) if self.free_play is None else self.free_play
+        style = np.where(free, 2, self.stable.astype(int))  # 0 unstable, 1 stable, 2 free play
+        looks = {0: ("--", "C3"), 1: ("-", "C0"), 2: (":", "0.4")}
         start = 0
-        for i in range(1, self.stable.size + 1):
-            if i == self.stable.size or self.stable[i] != self.stable[start]:
-                end = min(i + 1, self.stable.size)
-                stable = bool(self.stable[start])
-                ax.plot(
-                    xs[start:end],
-                    ys[start:end],
-                    "-" if stable else "--",
-                    color="C0" if stable else "C3",
-                    lw=1.5,
-                )
+        for i in range(1, style.size + 1):
+            if i == style.size or style[i] != style[start]:
+                end = min(i + 1, style.size)
+                line, color = looks[int(style[start])]
+                ax.plot(xs[start:end], ys[start:end], line, color=color, lw=1.5)
                 start = i
         ax.plot([], [], "-", color="C0", label="stable")
         ax.plot([], [], "--", color="C3", label="unstable")
+        if free.any():
+            ax.plot([], [], ":", color="0.4", label="free play (centred; position not set)")
         markers = {"fold": ("o", "k"), "period_doubling": ("s", "C2"), "grazing": ("^", "C1")}
         for kind, (marker, color) in markers.items():
             chosen = [e for e in self.events if e.kind == kind]
@@ -487,6 +507,21 @@ class FrequencyResponse:
                 "multiplier_imag": (("point", "multiplier"), self.multipliers.imag.copy()),
                 "initial_displacement": (per, x0, {"units": "m"}),
                 "initial_velocity": (per, v0, {"units": "m/s"}),
+                **(
+                    {}
+                    if self.free_play is None
+                    else {
+                        "free_play": (
+                            "point",
+                            self.free_play.astype(np.int8),
+                            {
+                                "units": "1 in the gap (k0 = 0), 0 not",
+                                "note": "1: one of a continuum of orbits; the position is not "
+                                "set by the dynamics, the one centred in the gap is given",
+                            },
+                        )
+                    }
+                ),
                 "event_kind": ("event", np.array([e.kind for e in self.events], dtype=str)),
                 "event_frequency": (
                     "event",
@@ -536,11 +571,18 @@ class _MapResidual:
     ``continuation`` uses in place of its own loop when it finds one.
     """
 
-    def __init__(self, p: FloatArray, parameter: str) -> None:
+    def __init__(self, p: FloatArray, parameter: str, free_play_stop: bool = False) -> None:
         self.p = p
         self.code = 0 if parameter == "omega" else 1
         #: evaluations of the exact map so far (a cost that does not depend on the load)
         self.evaluations = 0
+        #: refuse orbits that never touch an edge (with k0 = 0: a continuum, see _in_gap)
+        self.free_play_stop = free_play_stop
+        #: the parameters at which such an orbit was refused
+        self.refused_at: list[float] = []
+
+    def _refused(self, out: FloatArray) -> bool:
+        return self.free_play_stop and _in_gap(self.p, out)
 
     def __call__(
         self, u: FloatArray, lam: float, derivative: bool = True
@@ -552,6 +594,9 @@ class _MapResidual:
         self.evaluations += int(out[R_EVALS])
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
+        if self._refused(out):
+            self.refused_at.append(float(lam))
+            raise SimulationError("the orbit stays inside the gap: one of a continuum")
         return out[R_RES : R_RES + 2], out[R_JAC : R_JAC + 4].reshape(2, 2), out[R_DLAM:R_XMAX], out
 
     def corrector(
@@ -581,6 +626,9 @@ class _MapResidual:
         )
         self.evaluations += int(out[R_EVALS])
         if its < 0:
+            return None
+        if self._refused(out):
+            self.refused_at.append(float(y[-1] * scale[-1]))
             return None
         return y, system[:2].copy(), out, int(its)
 
@@ -621,12 +669,68 @@ class _MapResidual:
         self.evaluations += int(out[R_EVALS])
         if its < 0:
             return None
+        if self._refused(out):
+            self.refused_at.append(float(y[-1] * scale[-1]))
+            return None
         return (y, system[:2].copy(), out, int(its)), t_new
 
 
-def _map_residual(p: FloatArray, parameter: str) -> _MapResidual:
+def _map_residual(p: FloatArray, parameter: str, free_play_stop: bool = False) -> _MapResidual:
     """The continuation's residual R(z, lam) = P_1(z; lam) - z, closed over ``p``."""
-    return _MapResidual(p, parameter)
+    return _MapResidual(p, parameter, free_play_stop)
+
+
+def _in_gap(p: FloatArray, out: FloatArray) -> bool:
+    """With k0 = 0, an orbit that never reaches a gap edge (``out``: a map_residual row).
+
+    Inside the gap the force does not depend on x, so the orbit shifted by any
+    constant is an orbit too: a continuum, with a Floquet multiplier exactly 1.
+    """
+    return bool(p[kn.P_K0] == 0.0 and out[R_XMAX] < p[kn.P_GC] and out[R_XMIN] > -p[kn.P_GT])
+
+
+def _free_play_orbit(p: FloatArray, omega: float) -> FloatArray | None:
+    """The member centred in the gap of the continuum of in-gap orbits at ``omega`` (k0 = 0).
+
+    Inside the gap with k0 = 0 the velocity obeys m v' + c v + friction(v) = F0 sin(w t)
+    whatever x is: its periodic solution v* is found by Newton on the velocity
+    component of the exact map alone (the position's direction, the multiplier 1,
+    left out); the symmetric orbit (v(t + T/2) = -v(t)) has no drift over a period,
+    so x closes for every starting position, and the one whose extremes sit
+    symmetrically in the gap ((x_max + x_min)/2 = the gap's centre) is returned.
+
+    Returns
+    -------
+    (N_RES,) ndarray or None
+        The map_residual row of that orbit with (x0, v0) in its first two places
+        replaced, i.e. ``[x0, v0, M - I (4), dR/dlam (2), x_max, x_min, edge, events]``;
+        None when the orbit does not fit inside the gap or Newton fails.
+    """
+    q = p.copy()
+    _set_parameter(q, 0, omega)
+    m, c, f0 = q[kn.P_MASS], q[kn.P_DAMP], q[kn.P_F0]
+    v = -f0 * m * omega / (c * c + (m * omega) ** 2)  # v(0) of the viscous free mass
+    # the velocity orbit does not depend on where the edges are: solve it with them far off
+    far = q.copy()
+    far[kn.P_GC] = far[kn.P_GT] = 1e6 * (q[kn.P_GC] + q[kn.P_GT] + f0 / (m * omega**2))
+    out = np.zeros(N_RES)
+    for _ in range(30):
+        if map_residual(far, 0, 0.0, v, omega, out, False) != kn.STATUS_OK:
+            return None
+        dv = -out[R_RES + 1] / out[R_JAC + 3]
+        v += dv
+        if abs(dv) <= 1e-14 * max(abs(v), f0 / (m * omega)):
+            break
+    else:
+        return None
+    x0 = (q[kn.P_GC] - q[kn.P_GT]) / 2.0 - 0.5 * (out[R_XMAX] + out[R_XMIN])
+    if map_residual(q, 0, x0, v, omega, out, True) != kn.STATUS_OK or not _in_gap(q, out):
+        return None
+    size = out[R_XMAX] - out[R_XMIN]
+    if abs(out[R_RES]) > 1e-9 * size or abs(out[R_RES + 1]) > 1e-9 * size * omega:
+        return None  # the velocity orbit drifts: not a closed orbit
+    out[R_RES], out[R_RES + 1] = x0, v
+    return out
 
 
 def _parameter_range(
@@ -686,6 +790,11 @@ def frequency_response(
     ``force_stop`` (N) at the fixed ``omega_start`` (``omega_stop`` is then
     ignored and may be None).
 
+    With gap_stiffness 0, the branch stops where it meets the orbits that stay
+    inside the gap (a continuum: any mean position) and goes on along the one
+    centred in the gap (``free_play``); a start on such an orbit is followed from
+    the other end of the range and turned round (omega only).
+
     Parameters
     ----------
     joint : Joint
@@ -711,7 +820,8 @@ def frequency_response(
         A range of zero width, a value that is not finite and positive, or
         ``force_stop`` missing with ``parameter="force"``.
     SimulationError
-        No periodic orbit at the start.
+        No periodic orbit at the start, or (gap_stiffness 0) orbits inside the gap at
+        both ends of the range.
     """
     if parameter not in ("omega", "force"):
         raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
@@ -729,11 +839,24 @@ def frequency_response(
         restitution=restitution,
     )
     if np.min(np.abs(first.multipliers - 1.0)) < 1e-9:
-        raise SimulationError(
+        refusal = SimulationError(
             f"the orbit at the start ({first!r}) has a multiplier of exactly 1: it is one of a "
             "continuum of orbits (it stays in the gap with gap_stiffness = 0, or sticks), so "
             "no single curve exists; give gap_stiffness > 0 or start where the joint is in contact"
         )
+        if parameter != "omega" or joint.gap_stiffness != 0.0:
+            raise refusal
+        # a free-play orbit at the start: follow the curve from the other end, which ends on
+        # the free-play orbits (if that end is not one too), and turn it round
+        kw = {"damping_ratio": damping_ratio, "friction": friction, "restitution": restitution}
+        try:
+            other = periodic_orbit(joint, f0, stop, **kw)  # type: ignore[arg-type]
+        except SimulationError:
+            raise refusal from None
+        if np.min(np.abs(other.multipliers - 1.0)) < 1e-9:
+            raise refusal
+        turned = frequency_response(joint, f0, stop, w0, max_points=max_points, **kw)  # type: ignore[arg-type]
+        return _turned_round(turned)
     p = _parameters(joint, f0, w0, damping_ratio, friction, restitution)
     x_scale = max(joint.clearance / 2.0, first.amplitude)
     v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
@@ -764,7 +887,10 @@ def frequency_response(
             return []
         return [np.array([x, e * v]), np.array([x, v / e])]  # v+ = e v- on entering contact
 
-    residual = _map_residual(p, parameter)
+    # k0 = 0: orbits that stay inside the gap are a continuum; the branch stops where it
+    # meets them and the member centred in the gap is followed instead (_free_play_tail)
+    free_play_stop = parameter == "omega" and joint.gap_stiffness == 0.0
+    residual = _map_residual(p, parameter, free_play_stop)
 
     def follow(
         u0: FloatArray,
@@ -782,12 +908,13 @@ def frequency_response(
             lam_scale=abs(stop - start),
             settings=ContinuationSettings(
                 step=0.002,
-                min_step=1e-7,
+                min_step=_MIN_STEP,
                 max_step=0.023,
                 max_points=points,
                 tolerance=1e-11,
                 chord_parameter=True,
                 predictor_degree=5,  # pyHarm curve: 72 of 323 points need 2+ iterations, 105 with 3
+                crawl_points=_CRAWL_POINTS,
             ),
             restart=restart,
             differs=differs,
@@ -796,8 +923,17 @@ def frequency_response(
         )
 
     branch = follow(np.array(first.initial_state), start, stop, max_points)
-    for _ in range(_REJOINS):
+    tail = None
+    for _ in range(_REJOINS + 1):
         if not branch.reason.startswith(("step too small", "ran back")):
+            break
+        if free_play_stop:
+            tail = _free_play_tail(
+                p, branch, residual.refused_at, stop, max_points - branch.lam.size
+            )
+            if tail is not None:
+                break
+        if _ == _REJOINS:
             break
         joined = _rejoin(
             branch,
@@ -811,15 +947,28 @@ def frequency_response(
             break
         branch = joined
     rows = np.array(branch.data)
-    n = branch.lam.size
-    omega = branch.lam.copy() if parameter == "omega" else np.full(n, w0)
-    force = branch.lam.copy() if parameter == "force" else np.full(n, f0)
+    lam_all = branch.lam
+    lam_tangent = branch.tangent[:, -1]
+    initial_state = branch.u.copy()
+    free_play = np.zeros(branch.lam.size, dtype=bool)
+    reason = branch.reason
+    if tail is not None:
+        lam_all = np.concatenate((lam_all, tail[:, N_RES]))
+        rows = np.concatenate((rows, tail[:, :N_RES]))
+        lam_tangent = np.concatenate((lam_tangent, np.full(len(tail), np.sign(stop - start))))
+        initial_state = np.concatenate((initial_state, tail[:, R_RES : R_RES + 2]))
+        free_play = np.concatenate((free_play, np.ones(len(tail), dtype=bool)))
+        reason = "reached" if tail[-1, N_RES] == stop else "max_points"
+    n = lam_all.size
+    omega = lam_all.copy() if parameter == "omega" else np.full(n, w0)
+    force = lam_all.copy() if parameter == "force" else np.full(n, f0)
     x_max = rows[:, R_XMAX]
     x_min = rows[:, R_XMIN]
     mono = rows[:, R_JAC : R_JAC + 4].reshape(n, 2, 2) + np.eye(2)
     mu = np.linalg.eigvals(mono).astype(np.complex128)
     mu = np.take_along_axis(mu, np.argsort(-np.abs(mu), axis=1), axis=1)
-    stable = np.max(np.abs(mu), axis=1) < 1.0
+    # a free-play orbit is one of a continuum (multiplier 1): not asymptotically stable
+    stable = (np.max(np.abs(mu), axis=1) < 1.0) & ~free_play
     amplitude = 0.5 * (x_max - x_min)
     sticking = []
     for k in branch.kinks:
@@ -833,7 +982,7 @@ def frequency_response(
         sticking.append(stuck[0] != stuck[1])
     events = _events(
         joint,
-        branch.tangent[:, -1],
+        lam_tangent,
         mono,
         x_max,
         x_min,
@@ -843,6 +992,20 @@ def frequency_response(
         branch.kinks,
         np.array(sticking, dtype=bool),
     )
+    if tail is not None:
+        i = branch.lam.size
+        events.append(
+            ResponseEvent(
+                "free_play",
+                float(omega[i]),
+                float(force[i]),
+                float(amplitude[i]),
+                "the junction of the branch with contact and the orbits that stay inside the gap "
+                "(gap_stiffness 0): a continuum of orbits, one for each mean position, the "
+                "position not set by the dynamics; the curve (free_play True) shows the one "
+                "centred in the gap",
+            )
+        )
     return FrequencyResponse(
         omega=omega,
         force_amplitude=force,
@@ -851,10 +1014,11 @@ def frequency_response(
         amplitude=amplitude,
         stable=stable,
         multipliers=mu,
-        initial_state=branch.u.copy(),
+        initial_state=initial_state,
         events=events,
         parameter=parameter,
-        stop_reason=branch.reason,
+        stop_reason=reason,
+        free_play=free_play,
         settings={
             "joint": joint,
             "damping_ratio": damping_ratio,
@@ -862,6 +1026,69 @@ def frequency_response(
             "restitution": restitution,
         },
     )
+
+
+def _turned_round(curve: FrequencyResponse) -> FrequencyResponse:
+    """``curve`` from its last point to its first (followed from the other end)."""
+    reason = curve.stop_reason
+    if reason != "reached":
+        reason = (
+            f"followed from the other end (the start is a free-play orbit), which stopped: {reason}"
+        )
+    return FrequencyResponse(
+        omega=curve.omega[::-1].copy(),
+        force_amplitude=curve.force_amplitude[::-1].copy(),
+        x_max=curve.x_max[::-1].copy(),
+        x_min=curve.x_min[::-1].copy(),
+        amplitude=curve.amplitude[::-1].copy(),
+        stable=curve.stable[::-1].copy(),
+        multipliers=curve.multipliers[::-1].copy(),
+        initial_state=curve.initial_state[::-1].copy(),
+        events=curve.events[::-1],
+        parameter=curve.parameter,
+        stop_reason=reason,
+        settings=curve.settings,
+        free_play=None if curve.free_play is None else curve.free_play[::-1].copy(),
+    )
+
+
+def _free_play_tail(
+    p: FloatArray, branch: Branch, refused_at: list[float], stop: float, points: int
+) -> NDArray[np.float64] | None:
+    """The centred in-gap orbits from where ``branch`` stopped on to ``stop`` (k0 = 0), or None.
+
+    Only when the branch stopped on an orbit that touches a gap edge within 1e-3 of
+    the clearance (where the contact branch meets the continuum of in-gap orbits,
+    whose widest members touch an edge), the continuation's steps there converged onto
+    in-gap orbits (``refused_at``: within 1e-3 of the range of the stop), and the
+    centred member (``_free_play_orbit``)
+    exists close to that frequency (at 0.001, 0.01 or 0.1 of the first grid step on).
+    The grid is uniform in omega, 0.5 % of the range a step (at most ``points``
+    points in all). Rows: a map_residual row (x0, v0 in
+    the first two places) and omega.
+    """
+    last = branch.data[-1]
+    gap = p[kn.P_GC] + p[kn.P_GT]
+    touching = min(abs(last[R_XMAX] - p[kn.P_GC]), abs(-p[kn.P_GT] - last[R_XMIN]))
+    lam = float(branch.lam[-1])
+    reach = 1e-3 * abs(stop - float(branch.lam[0]))
+    if touching > 1e-3 * gap or points < 1 or lam == stop:
+        return None
+    if not any(abs(w - lam) <= reach for w in refused_at):
+        return None  # the steps there did not meet in-gap orbits: another kind of stop
+    count = min(points, max(2, math.ceil(abs(stop - lam) / (0.005 * abs(stop - branch.lam[0])))))
+    grid = np.linspace(lam, stop, count + 1)[1:]
+    # close to the junction first (the widest orbit that fits), then the grid
+    near = lam + np.array([1e-3, 1e-2, 1e-1]) * (grid[0] - lam)
+    rows: list[FloatArray] = []
+    for w in np.concatenate((near, grid)):
+        orbit = _free_play_orbit(p, float(w))
+        if orbit is None:
+            if rows or w > near[-1]:
+                break
+            continue
+        rows.append(np.append(orbit, w))
+    return np.array(rows[:points]) if rows else None
 
 
 def _seed(
@@ -989,6 +1216,11 @@ def _events(
                 # the parameter is extreme at a fold: take the bracketing point that is further
                 # out (a linear interpolation of the tangent is wrong at a grazing kink)
                 lam = omega if np.ptp(omega) > 0.0 else force
+                steps = np.sign(np.diff(lam[max(i - 1, 0) : i + 3]))
+                if steps.size and np.all(steps == steps[0]):
+                    # the parameter goes on the same way through: the tangent flipped at a
+                    # point where the section sits on an impact (the state jumps), no fold
+                    continue
                 turn = float(np.sign(lam[i + 1] - lam[i]) * np.sign(g[i]))
                 frac = 1.0 if turn > 0 else 0.0
 

@@ -19,6 +19,7 @@ The layouts are documented in docs/records.md. Nothing is overwritten unless ask
 from __future__ import annotations
 
 import gc
+import itertools
 import json
 import math
 import re
@@ -799,32 +800,64 @@ BRFD_CITATION = (
 
 
 def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
-    """The JSON's metadata and its 'data' matrix, from the file's bytes.
+    """The JSON's metadata (without 'data') and its 'data' matrix, from the file's bytes.
 
     Parsed by orjson: its numbers are the correctly rounded doubles that Python's
     ``float`` gives, bit for bit, and it is faster than numpy's C parser of the matrix
-    text over the 31 BRFD files, more so with the garbage collector off while the rows'
-    lists are built (they hold only numbers: no cycles to collect); side by side by
-    ``python benchmarks/bench_identify.py --parsers``.
+    text over the 31 BRFD files, more so with the garbage collector off from the parse
+    until the rows' lists are freed (they hold only numbers: no cycles to collect; with the
+    collector back on while they live, its next pass walks every one of them); side by
+    side by ``python benchmarks/bench_identify.py --parsers``.
     """
     import orjson  # only a JSON record needs it
 
     collecting = gc.isenabled()
     gc.disable()  # tens of thousands of new lists, no cycles: the collector only costs time
     try:
-        content = orjson.loads(raw)
-    except orjson.JSONDecodeError as exc:  # also bytes that are not UTF-8
-        raise RecordError(f"{where}: not a JSON file ({exc})") from None
+        return _json_matrix(where, raw, orjson)
     finally:
         if collecting:
             gc.enable()
+
+
+def _json_matrix(where: str, raw: bytes, orjson: Any) -> tuple[dict[str, Any], FloatArray]:
+    try:
+        content = orjson.loads(raw)
+    except orjson.JSONDecodeError as exc:  # also bytes that are not UTF-8
+        raise RecordError(f"{where}: not a JSON file ({exc})") from None
     if not isinstance(content, dict) or "data" not in content:
         raise RecordError(f"{where}: JSON without a 'data' matrix; not a BRFD record")
+    rows = content.pop("data")
+    data = _rows_matrix(rows) if isinstance(rows, list) else None
+    if data is None:  # not a list of equal rows of numbers: numpy says what it is
+        try:
+            data = np.array(rows, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise RecordError(f"{where}: the 'data' matrix is not numeric") from None
+    return content, data  # the rows are freed on return, with the collector still off
+
+
+def _rows_matrix(rows: list[Any]) -> FloatArray | None:
+    """A list of equally long lists of numbers as a float64 matrix, or None if it is not one.
+
+    The numbers are taken one after the other by ``numpy.fromiter`` (the same doubles as
+    ``numpy.array``, which first walks the nested lists to learn their shape and costs
+    about 1.6 times as much here); the checks that make the shape certain (every row a
+    list, all of one length) cost a fifth of it.
+    """
+    if not rows or set(map(type, rows)) != {list}:
+        return None
+    widths = set(map(len, rows))
+    if len(widths) != 1:
+        return None
+    width = widths.pop()
     try:
-        data = np.array(content["data"], dtype=np.float64)
-    except (TypeError, ValueError):
-        raise RecordError(f"{where}: the 'data' matrix is not numeric") from None
-    return content, data
+        flat = np.fromiter(
+            itertools.chain.from_iterable(rows), dtype=np.float64, count=len(rows) * width
+        )
+    except (TypeError, ValueError, OverflowError):  # a string, a nested list, a null...
+        return None
+    return flat.reshape(len(rows), width)
 
 
 def read_brfd(path: str | Path, *, resample: bool = False) -> Record:

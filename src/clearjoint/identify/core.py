@@ -31,6 +31,7 @@ MODEL.md section 3. The steps:
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -619,39 +620,6 @@ def _identify_path(args: tuple[str, bool, float]) -> tuple[Record, Identificatio
 Outcome = tuple[Record, Identification] | str
 
 
-def _identify_chunk(tasks: list[tuple[str, bool, float]]) -> list[Outcome]:
-    """A worker's share: its files' outcomes, in the order given."""
-    return [_identify_path(task) for task in tasks]
-
-
-def _balanced_chunks(sizes: list[int], jobs: int) -> list[list[int]]:
-    """Split file indices into ``jobs`` shares of about equal total size.
-
-    The largest file first, each to the share with the least bytes so far (the
-    longest-processing-time rule: the largest share is at most 4/3 of the best split);
-    each share keeps file order. Empty shares are dropped.
-
-    Parameters
-    ----------
-    sizes : list of int
-        Size of each file in bytes (a proxy for its reading and identifying time).
-    jobs : int
-        Number of shares.
-
-    Returns
-    -------
-    list of list of int
-        Indices into ``sizes``, one sorted list per non-empty share.
-    """
-    loads = [0] * jobs
-    shares: list[list[int]] = [[] for _ in range(jobs)]
-    for i in sorted(range(len(sizes)), key=lambda i: (-sizes[i], i)):
-        k = min(range(jobs), key=lambda k: (loads[k], k))
-        loads[k] += sizes[i]
-        shares[k].append(i)
-    return [sorted(share) for share in shares if share]
-
-
 def _warm_readers(paths: list[str]) -> None:
     """Import the readers these files need before the workers fork, so that each starts
     with them loaded instead of importing them again."""
@@ -665,7 +633,7 @@ def _warm_readers(paths: list[str]) -> None:
 def _size(path: str) -> int:
     try:
         return Path(path).stat().st_size
-    except OSError:  # missing: refused by its reader, in its share, with its reason
+    except OSError:  # missing: refused by its reader, with its reason
         return 0
 
 
@@ -686,13 +654,13 @@ def identify_files(
     resample, tolerance
         As for :func:`~clearjoint.records.read_record` and :func:`identify`.
     jobs : int
-        Processes over the files: the files are split into ``jobs`` shares of about equal
-        size (:func:`_balanced_chunks`); this process identifies the first share while
-        ``jobs - 1`` workers, forked after the readers are imported, identify the others.
-        The results are those of one process, in file order.
+        Processes over the files: this one and ``jobs - 1`` workers forked after the
+        readers are imported (``clearjoint.identify._pool.run_forked``); each takes
+        the largest file not yet taken whenever it is free. The results are those of one
+        process, in file order.
     progress : callable, optional
-        ``progress(done, total)``, called after each file (a worker's files when its
-        share is done).
+        ``progress(done, total)``, called after each file (a worker's files when that
+        worker is done).
 
     Returns
     -------
@@ -706,32 +674,23 @@ def identify_files(
     outcomes: list[Outcome | None] = [None] * len(tasks)
     done = 0
 
-    def finished(indices: list[int], values: list[Outcome]) -> None:
+    def finished(i: int, value: Outcome) -> None:
         nonlocal done
-        for i, value in zip(indices, values, strict=True):
-            outcomes[i] = value
-            done += 1
-            if progress:
-                progress(done, len(tasks))
+        outcomes[i] = value
+        done += 1
+        if progress:
+            progress(done, len(tasks))
 
-    shares = _balanced_chunks([_size(path) for path, _, _ in tasks], jobs) if jobs > 1 else []
-    if len(shares) > 1:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
+    if jobs > 1 and len(tasks) > 1 and hasattr(os, "fork"):
+        from clearjoint.identify._pool import run_forked
 
         _warm_readers([path for path, _, _ in tasks])
-        fork = multiprocessing.get_context("fork")  # warm: the workers inherit the imports
-        with ProcessPoolExecutor(max_workers=len(shares) - 1, mp_context=fork) as pool:
-            futures = [
-                pool.submit(_identify_chunk, [tasks[i] for i in share]) for share in shares[1:]
-            ]
-            for i in shares[0]:
-                finished([i], [_identify_path(tasks[i])])
-            for share, future in zip(shares[1:], futures, strict=True):
-                finished(share, future.result())
-    else:
-        for i, task in enumerate(tasks):
-            finished([i], [_identify_path(task)])
+        sizes = [_size(path) for path, _, _ in tasks]
+        order = sorted(range(len(tasks)), key=lambda i: (-sizes[i], i))
+        run_forked(_identify_path, tasks, order, jobs, finished)
+    for i, task in enumerate(tasks):  # one process; or a file whose worker died
+        if outcomes[i] is None:
+            finished(i, _identify_path(task))
     results = [o for o in outcomes if o is not None and not isinstance(o, str)]
     failures = [o for o in outcomes if isinstance(o, str)]
     flagged = flag_outliers([ident for _, ident in results])

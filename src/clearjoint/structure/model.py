@@ -172,7 +172,7 @@ class Modes:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Structure:
     """Lumped masses on nodes, axial members with optional clearance joints, supports.
 
@@ -206,6 +206,20 @@ class Structure:
     _laws: tuple[ClearanceJoint, ...] = field(init=False, repr=False, compare=False)
     _b: FloatArray = field(init=False, repr=False, compare=False)
     _k_member: FloatArray = field(init=False, repr=False, compare=False)
+
+    def __eq__(self, other: object) -> bool:
+        """Equal when nodes, masses, members, supports and damping are (arrays by value)."""
+        if not isinstance(other, Structure):
+            return NotImplemented
+        return (
+            np.array_equal(self.nodes, other.nodes)
+            and np.array_equal(self.masses, other.masses)
+            and self.members == other.members
+            and self.supports == other.supports
+            and self.rayleigh == other.rayleigh
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # mutable-by-content arrays: not hashable
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__

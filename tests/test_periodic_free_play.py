@@ -1,0 +1,187 @@
+"""periodic: where a k0 = 0 joint's curve meets the continuum of orbits inside the gap.
+
+Independent routes: the free mass's closed forms (m v' + c v = F0 sin(w t): the
+amplitude F0 / (w sqrt(m^2 w^2 + c^2)), the velocity multiplier exp(-c T / m), the
+double-grazing frequency where that orbit spans the whole gap), and time_response,
+which closes the orbit from any mean position (the position is not set).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from clearjoint import Joint
+from clearjoint.periodic import FrequencyResponse, frequency_response
+from clearjoint.simulate import SimulationError, steady_state, time_response
+
+#: k0 = 0, symmetric contact 100 N/m, edges at +-0.1; forced past the contact resonance.
+FREE = Joint(mass=1.0, clearance=0.2, compression_stiffness=100.0, tension_stiffness=100.0)
+ZETA = 0.1  # c_v = 2 zeta sqrt(m k_c) = 2
+C_V = 2.0
+
+
+@pytest.fixture(scope="module")
+def curve() -> FrequencyResponse:
+    return frequency_response(FREE, 1.0, 2.0, 12.0, damping_ratio=ZETA, restitution=0.8)
+
+
+def _free_mass_amplitude(w: np.ndarray | float) -> np.ndarray | float:
+    return 1.0 / (w * np.sqrt(w**2 + C_V**2))
+
+
+def test_curve_goes_on_along_the_centred_free_play_orbits(curve: FrequencyResponse) -> None:
+    assert curve.stop_reason == "reached"
+    assert curve.omega[-1] == pytest.approx(12.0)
+    fp = curve.free_play
+    assert fp is not None
+    assert fp.sum() > 50
+    # one run at the end of the curve, after the contact branch
+    first = int(np.argmax(fp))
+    assert fp[first:].all()
+    assert not fp[:first].any()
+    w = curve.omega[fp]
+    assert np.max(np.abs(curve.amplitude[fp] / _free_mass_amplitude(w) - 1.0)) < 1e-9
+    # centred in the gap, never touching an edge
+    assert np.max(np.abs(curve.x_max[fp] + curve.x_min[fp])) < 1e-9 * 0.1
+    assert np.all(curve.x_max[fp] < 0.1)
+    # multipliers: exactly 1 (the position) and exp(-c T / m) (the velocity)
+    mu = np.sort(np.abs(curve.multipliers[fp]), axis=1)
+    assert np.max(np.abs(mu[:, 1] - 1.0)) < 1e-9
+    assert np.max(np.abs(mu[:, 0] - np.exp(-C_V * 2.0 * math.pi / w))) < 1e-9
+    assert not curve.stable[fp].any()  # a continuum: not asymptotically stable
+    events = [e for e in curve.events if e.kind == "free_play"]
+    assert len(events) == 1
+    assert events[0].omega == pytest.approx(w[0])
+    assert "position not set" in events[0].note
+
+
+def test_contact_branch_ends_at_the_double_grazing_of_the_widest_free_play_orbit(
+    curve: FrequencyResponse,
+) -> None:
+    # the free-mass orbit spans the whole gap (2 X = clearance) at w_g, in closed form
+    w_g = brentq(lambda w: 2.0 * _free_mass_amplitude(w) - 0.2, 1.0, 10.0)
+    fp = curve.free_play
+    assert fp is not None
+    last = int(np.argmax(fp)) - 1  # the last orbit with contact
+    assert curve.omega[last] == pytest.approx(w_g, rel=1e-3)
+    assert curve.x_max[last] == pytest.approx(0.1, rel=1e-3)
+    assert curve.x_min[last] == pytest.approx(-0.1, rel=1e-3)
+    assert w_g < curve.omega[last + 1] < w_g * (1.0 + 1e-3)  # the widest in-gap orbit
+
+
+def test_free_play_orbit_closes_from_any_mean_position(curve: FrequencyResponse) -> None:
+    # time marching (no Newton), from the curve's start and from it shifted in the gap
+    fp = np.nonzero(curve.free_play)[0]
+    i = int(fp[fp.size // 2])
+    w = float(curve.omega[i])
+    room = 0.1 - float(curve.x_max[i])
+    for shift in (0.0, 0.5 * room, -0.9 * room):
+        start = curve.initial_state[i] + np.array([shift, 0.0])
+        motion = time_response(
+            FREE, 1.0, w, 3 * 2.0 * math.pi / w, initial=start, damping_ratio=ZETA, restitution=0.8
+        )
+        end = np.array(motion.final_state)
+        assert np.max(np.abs(end - start) / np.array([0.1, 0.1 * w])) < 1e-9
+        assert motion.x_max == pytest.approx(curve.x_max[i] + shift, abs=1e-9)
+
+
+def test_result_carries_the_free_play_flag(curve: FrequencyResponse) -> None:
+    ds = curve.to_xarray()
+    assert "free_play" in ds
+    assert ds["free_play"].values.sum() == np.sum(curve.free_play)
+    assert "free play" in repr(curve)
+
+
+@pytest.fixture(scope="module")
+def study_curve() -> tuple[FrequencyResponse, Joint, dict[str, object], float]:
+    from clearjoint.simulate.study import load_study
+
+    study = load_study(Path(__file__).parents[1] / "examples" / "study.toml")
+    kw: dict[str, object] = {
+        "damping_ratio": study.damping_ratio,
+        "friction": study.friction,
+        "restitution": study.restitution,
+    }
+    hz = 2.0 * math.pi
+    curve = frequency_response(study.joint, study.force_amplitude, 20 * hz, 900 * hz, **kw)  # type: ignore[arg-type]
+    return curve, study.joint, kw, study.force_amplitude
+
+
+def test_study_curve_is_whole_from_20_to_900_hz_with_the_default_options(
+    study_curve: tuple[FrequencyResponse, Joint, dict[str, object], float],
+) -> None:
+    # the README study (clearjoint frf examples/study.toml --from 20Hz --to 900Hz)
+    curve, joint, kw, force = study_curve
+    hz = 2.0 * math.pi
+    assert curve.stop_reason == "reached"
+    assert curve.omega.size <= 2000
+    assert curve.omega[0] == pytest.approx(20 * hz)
+    assert curve.omega[-1] == pytest.approx(900 * hz)
+    folds = [e.omega / hz for e in curve.events if e.kind == "fold"]
+    assert any(f == pytest.approx(704.78, abs=0.01) for f in folds)
+    assert curve.free_play is not None
+    first = int(np.argmax(curve.free_play))
+    assert curve.free_play[first:].all()
+    # the contact branch ends where its orbit touches both edges (the widest in-gap orbit)
+    assert 487.0 < curve.omega[first - 1] / hz < 488.0
+    assert curve.x_max[first - 1] == pytest.approx(joint.compression_gap, rel=1e-3)
+    assert curve.x_min[first - 1] == pytest.approx(-joint.tension_gap, rel=1e-3)
+    # stable orbits of the resonance's upper branch, by time marching (no Newton)
+    upper = np.nonzero(curve.stable & (curve.omega > 400 * hz) & ~curve.free_play)[0]
+    assert upper.size > 10
+    for i in upper[:: max(1, upper.size // 3)]:
+        start = curve.initial_state[i] * (1.0 + 1e-6)
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        assert ss.period_multiple == 1
+        assert abs(ss.x_max - curve.x_max[i]) / curve.amplitude[i] < 1e-9
+
+
+@pytest.mark.parametrize("hz", [720.0, 900.0])
+def test_above_the_resonance_every_start_settles_inside_the_gap(
+    study_curve: tuple[FrequencyResponse, Joint, dict[str, object], float], hz: float
+) -> None:
+    # long transients from starts across the gap and beyond it: each ends on an orbit inside
+    # the gap of the curve's amplitude, at a mean position of its own (a continuum)
+    curve, joint, kw, force = study_curve
+    assert curve.free_play is not None
+    i = int(np.argmin(np.where(curve.free_play, abs(curve.omega - 2 * math.pi * hz), np.inf)))
+    w = float(curve.omega[i])
+    means = []
+    for start in ((0.0, 0.0), (4e-5, 0.0), (-6e-5, -0.5), (1e-4, 0.5)):
+        motion = time_response(joint, force, w, 150 * 2 * math.pi / w, initial=start, **kw)  # type: ignore[arg-type]
+        last = time_response(
+            joint,
+            force,
+            w,
+            2 * math.pi / w,
+            initial=motion.final_state,
+            **kw,  # type: ignore[arg-type]
+        )
+        assert last.x_max < joint.compression_gap
+        assert last.x_min > -joint.tension_gap
+        assert last.amplitude == pytest.approx(curve.amplitude[i], rel=1e-9)
+        means.append(0.5 * (last.x_max + last.x_min))
+    assert np.ptp(means) > 1e-6  # not one orbit: the position is not set
+
+
+def test_a_curve_started_on_a_free_play_orbit_is_followed_from_the_other_end(
+    curve: FrequencyResponse,
+) -> None:
+    down = frequency_response(FREE, 1.0, 12.0, 2.0, damping_ratio=ZETA, restitution=0.8)
+    assert down.stop_reason == "reached"
+    assert down.omega[0] == pytest.approx(12.0)
+    assert down.omega[-1] == pytest.approx(2.0)
+    assert down.free_play is not None
+    assert down.free_play[0]
+    assert not down.free_play[-1]
+    w = down.omega[down.free_play]
+    assert np.max(np.abs(down.amplitude[down.free_play] / _free_mass_amplitude(w) - 1.0)) < 1e-9
+    assert np.array_equal(down.omega, curve.omega[::-1])
+    # both ends on free-play orbits: no single curve, said so
+    with pytest.raises(SimulationError, match="multiplier of exactly 1"):
+        frequency_response(FREE, 1.0, 10.0, 12.0, damping_ratio=ZETA, restitution=0.8)
