@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import subprocess
 import sys
 import tempfile
@@ -84,18 +85,20 @@ PYHARM_SCRIPT = textwrap.dedent(
             },
         }
 
-    times = []
+    times, cpu = [], []
     for _ in range(2):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         m = pyHarm.Maestro(problem())
         m.operate()
         times.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
     sols = [s for s in m.nls["frf"].SolList if s.flag_accepted]
     dft = compute_DFT(m.system.nti, m.system.nh)
     idx = m.getIndex("sdof", 0, 0)
     xt = np.array([s.x[idx] @ dft["ft"] for s in sols])
     out = {
         "times": times,
+        "cpu": cpu,
         "omega": [float(s.x[-1]) for s in sols],
         "amplitude": ((xt.max(axis=1) - xt.min(axis=1)) / 2).tolist(),
     }
@@ -112,6 +115,81 @@ def best_of(fn, repeat: int = 3) -> tuple[float, object]:  # type: ignore[no-unt
         result = fn()
         best = min(best, time.perf_counter() - start)
     return best, result
+
+
+CURVE_CPU_SCRIPT = textwrap.dedent(
+    """
+    import math, sys, time
+    from clearjoint import Joint
+    from clearjoint.periodic import frequency_response
+    joint = Joint(mass=1.0, clearance=2 * 0.1745, gap_stiffness=1.0,
+                  compression_stiffness=3.0, tension_stiffness=3.0)
+    zeta = 0.05 / (2.0 * math.sqrt(3.0))
+    frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)  # compile
+    best = math.inf
+    for _ in range(int(sys.argv[1])):
+        start = time.process_time()
+        curve = frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)
+        best = min(best, time.process_time() - start)
+    print(best, curve.omega.size)
+    """
+)
+
+
+def against_old(old_src: str, rounds: int = 3, repeat: int = 21) -> None:
+    """The curve's best CPU time with another clearjoint ``src`` tree and with this one.
+
+    Each in its own process (PYTHONPATH), alternately, ``rounds`` times: a side-by-side
+    ratio that load sways little.
+    """
+    here = str(Path(__file__).resolve().parents[1] / "src")
+    best = {"old": math.inf, "new": math.inf}
+    for _ in range(rounds):
+        for name, src in (("old", old_src), ("new", here)):
+            done = subprocess.run(
+                [sys.executable, "-c", CURVE_CPU_SCRIPT, str(repeat)],
+                capture_output=True,
+                text=True,
+                env={**os.environ, "PYTHONPATH": src},
+                check=True,
+            )
+            cpu, points = done.stdout.split()
+            best[name] = min(best[name], float(cpu))
+            print(f"  {name} ({src}): {float(cpu):.4f} s CPU, {points} points")
+    print(
+        f"against {old_src}: {best['old']:.4f} s CPU, this tree {best['new']:.4f} s "
+        f"(best of {rounds} x {repeat} each): {best['old'] / best['new']:.2f}x"
+    )
+
+
+def best_cpu(fn, repeat: int = 5) -> float:  # type: ignore[no-untyped-def]
+    """The least CPU time of the process over ``repeat`` calls (less sensitive to load)."""
+    best = math.inf
+    for _ in range(repeat):
+        start = time.process_time()
+        fn()
+        best = min(best, time.process_time() - start)
+    return best
+
+
+def count_map_evaluations() -> int:
+    """Evaluations of the exact one-period map the curve takes (a cost load does not change)."""
+    import clearjoint.periodic as periodic
+
+    made: list[object] = []
+    build = periodic._map_residual
+
+    def counting(*args: object, **kwargs: object) -> object:
+        residual = build(*args, **kwargs)  # type: ignore[arg-type]
+        made.append(residual)
+        return residual
+
+    periodic._map_residual = counting  # type: ignore[assignment]
+    try:
+        frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, damping_ratio=ZETA)
+    finally:
+        periodic._map_residual = build
+    return sum(int(r.evaluations) for r in made)  # type: ignore[attr-defined]
 
 
 def run_pyharm(python: str) -> dict[str, object] | None:
@@ -393,9 +471,17 @@ def main() -> None:
     parser.add_argument(
         "--stiff-only", action="store_true", help="run only the stiff-contact comparison"
     )
+    parser.add_argument(
+        "--old-src",
+        help="only compare the curve's CPU time with another clearjoint src tree, e.g. "
+        "main's (git archive main src | tar -x -C OLD)",
+    )
     args = parser.parse_args()
     if args.stiff_only:
         stiff_contact()
+        return
+    if args.old_src:
+        against_old(args.old_src)
         return
 
     print("case: pyHarm SDOF clearance, F0 = 0.03, omega 0.05 -> 1.8 rad/s, c_v = 0.05")
@@ -403,11 +489,16 @@ def main() -> None:
     t_curve, curve = best_of(
         lambda: frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, damping_ratio=ZETA)
     )
+    cpu_curve = best_cpu(
+        lambda: frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, damping_ratio=ZETA)
+    )
+    evaluations = count_map_evaluations()
     fr = curve  # type: ignore[assignment]
     n = fr.omega.size  # type: ignore[attr-defined]
     print(
-        f"continuation (exact orbits): {t_curve:.3f} s, {n} points, "
-        f"{int(np.sum(~fr.stable))} unstable, events: "  # type: ignore[attr-defined]
+        f"continuation (exact orbits): {t_curve:.4f} s wall, {cpu_curve:.4f} s CPU (best of 5), "
+        f"{n} points, {int(np.sum(~fr.stable))} unstable, "  # type: ignore[attr-defined]
+        f"{evaluations} evaluations of the exact map ({evaluations / n:.2f} a point), events: "
         + ", ".join(f"{e.kind} {e.omega:.4f}" for e in fr.events)  # type: ignore[attr-defined]
     )
     print("  " + curve_summary(fr.omega, fr.amplitude))  # type: ignore[attr-defined]
@@ -437,6 +528,12 @@ def main() -> None:
             print(
                 f"pyHarm (12 harmonics): first run {times[0]:.3f} s, second {times[1]:.3f} s, "  # type: ignore[index]
                 f"{om.size} points (ratio {times[1] / t_curve:.1f}x)"  # type: ignore[index]
+            )
+            cpu = ph["cpu"]  # type: ignore[index]
+            print(
+                f"  CPU time of the process (all its threads), second run: pyHarm {cpu[1]:.3f} s, "  # type: ignore[index]
+                f"continuation {cpu_curve:.4f} s (ratio {cpu[1] / cpu_curve:.1f}x; under load the "  # type: ignore[index]
+                "wall ratio swings with the other jobs, this one less)"
             )
             print("  " + curve_summary(om, amp))
     else:

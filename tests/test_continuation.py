@@ -61,6 +61,9 @@ def test_no_solution_at_the_start_is_an_error() -> None:
 def test_settings_are_validated() -> None:
     with pytest.raises(ParameterError, match="min_step <= step <= max_step"):
         ContinuationSettings(step=1.0, max_step=0.1)
+    for bad in (0, 2.5, True):
+        with pytest.raises(ParameterError, match="predictor_degree must be an integer >= 1"):
+            ContinuationSettings(predictor_degree=bad)  # type: ignore[arg-type]
 
 
 def _corner(u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:

@@ -490,6 +490,38 @@ def test_study_curve_goes_on_past_the_grazing_fold_near_104_hz_from_an_orbit_fur
     assert np.min(np.abs(curve.amplitude[on] - rest.amplitude)) < 1e-3 * rest.amplitude
 
 
+def test_compiled_ordinary_step_follows_the_same_branch_as_the_python_one() -> None:
+    # the continuation hands its ordinary step (predictor, corrector, tangent) to the
+    # residual's compiled ``step``; without that hook it predicts and orients in Python:
+    # the two must give the same points, bit for bit (the same arithmetic, compiled)
+    from clearjoint.continuation import ContinuationSettings, continue_branch
+    from clearjoint.periodic import _map_residual
+    from clearjoint.simulate.core import _parameters
+
+    orbit = periodic_orbit(PYHARM, F0, 1.0, damping_ratio=ZETA)
+    p = _parameters(PYHARM, F0, 1.0, ZETA, None, 1.0)
+    residual = _map_residual(p, "omega")
+
+    class WithoutStep:
+        corrector = staticmethod(residual.corrector)
+
+        def __call__(self, u: np.ndarray, lam: float, derivative: bool = True) -> object:
+            return residual(u, lam, derivative)
+
+    settings = ContinuationSettings(
+        step=0.002, min_step=1e-7, max_step=0.023, max_points=60, chord_parameter=True
+    )
+    kw = {"u_scale": np.array([0.2, 0.3]), "lam_scale": 0.8, "settings": settings}
+    fast = continue_branch(residual, np.array(orbit.initial_state), 1.0, 1.8, **kw)  # type: ignore[arg-type]
+    slow = continue_branch(WithoutStep(), np.array(orbit.initial_state), 1.0, 1.8, **kw)  # type: ignore[arg-type]
+    assert fast.lam.size == slow.lam.size == 60
+    assert np.array_equal(fast.u, slow.u)
+    assert np.array_equal(fast.lam, slow.lam)
+    assert np.array_equal(fast.tangent, slow.tangent)
+    assert np.array_equal(fast.iterations, slow.iterations)
+    assert int(np.sum(fast.iterations == 1)) > 10  # the polynomial predictor was used on the way
+
+
 def test_study_unstable_branch_passes_where_the_section_sits_on_an_impact_near_636_hz() -> None:
     # examples/study.toml: the unstable branch coming down from the fold at 704.8 Hz used to
     # stop at 636.04 Hz. There its tension impact passes through forcing phase 0, so the

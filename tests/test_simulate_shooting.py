@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from clearjoint import Friction, Joint
-from clearjoint.simulate import core, steady_state
+from clearjoint.simulate import _shooting as sh
+from clearjoint.simulate import core, steady_state, time_response
 from clearjoint.simulate._shooting import shoot
 from clearjoint.simulate.reference import reference_time_response
 
@@ -66,6 +67,107 @@ def test_monodromy_by_saltation_matches_a_finite_difference_of_the_map(
         exact = shoot(p, z, 1).monodromy
         fd = _finite_difference(p, z)
         assert np.max(np.abs(exact - fd)) <= 1e-5 * np.max(np.abs(fd))
+
+
+def _end_and_sensitivity(
+    p: np.ndarray, z: np.ndarray, parameter: int, lam: float
+) -> tuple[np.ndarray, np.ndarray, float, int]:
+    """P_1(z; lam), the sensitivity dP/dlam shoot_map carries, its exactness flag, events."""
+    q = p.copy()
+    sh._set_parameter(q, parameter, lam)
+    state = np.zeros(4)
+    sh.start_state(q, float(z[0]), float(z[1]), state)
+    out = np.zeros(sh.N_OUT)
+    assert sh.shoot_map(q, state, 1, out, parameter) == 0
+    sens = out[sh.O_DL0 : sh.O_DL1 + 1].copy()
+    return state[:2].copy(), sens, float(out[sh.O_DL_EXACT]), int(out[sh.O_EVENTS])
+
+
+@pytest.mark.parametrize(
+    ("case", "force", "omega", "losses", "z"),
+    [
+        ("free play", 0.03, 0.7, {"damping_ratio": PYHARM_ZETA}, (0.05, 0.01)),
+        ("contact", 0.03, 1.5, {"damping_ratio": PYHARM_ZETA}, (0.3, 0.0)),
+        ("impacts", 0.03, 1.2, {"damping_ratio": PYHARM_ZETA, "restitution": 0.7}, (0.3, 0.1)),
+        (
+            "slip",
+            0.3,
+            1.0,
+            {"damping_ratio": PYHARM_ZETA, "friction": Friction(0.3, 0.2)},
+            (0.1, 0),
+        ),
+        (
+            "sticks",
+            0.3,
+            0.4,
+            {"damping_ratio": PYHARM_ZETA, "friction": Friction(0.3, 0.5)},
+            (0, 0),
+        ),
+        (
+            "sticks, impacts, undamped",
+            0.3,
+            0.4,
+            {"friction": Friction(0.3, 0.5), "restitution": 0.9},
+            (0.2, 0.3),
+        ),
+    ],
+)
+def test_parameter_sensitivity_matches_a_central_difference_of_the_map(
+    case: str, force: float, omega: float, losses: dict[str, object], z: tuple[float, float]
+) -> None:
+    # dP/domega and dP/dF0 carried through the segments and events (saltation) against a
+    # central difference of the exact map (an independent route: two more evaluations)
+    p = core._parameters(
+        PYHARM,
+        force,
+        omega,
+        losses.get("damping_ratio", 0.0),  # type: ignore[arg-type]
+        losses.get("friction"),  # type: ignore[arg-type]
+        losses.get("restitution", 1.0),  # type: ignore[arg-type]
+    )
+    z0 = np.array(z, dtype=float)
+    motion = time_response(PYHARM, force, omega, 2 * math.pi / omega, initial=z, **losses)  # type: ignore[arg-type]
+    if case.startswith("sticks"):
+        assert motion.stick_time > 0.0
+    if case == "free play":
+        assert motion.impact_times.size == 0
+        assert max(abs(motion.x_max), abs(motion.x_min)) < PYHARM.compression_gap
+    if case.startswith(("contact", "impacts")):
+        assert motion.x_max > PYHARM.compression_gap
+    for parameter, lam in ((0, omega), (1, force)):
+        _, sens, exact, events = _end_and_sensitivity(p, z0, parameter, lam)
+        assert exact == 1.0
+        h = 1e-6 * lam
+        up, _, _, events_up = _end_and_sensitivity(p, z0, parameter, lam + h)
+        down, _, _, events_down = _end_and_sensitivity(p, z0, parameter, lam - h)
+        assert events_up == events == events_down  # the same sequence of segments
+        central = (up - down) / (2 * h)
+        assert np.max(np.abs(sens - central)) <= 1e-6 * np.max(np.abs(central))
+
+
+def test_parameter_sensitivity_falls_back_to_a_difference_at_exact_undamped_resonance() -> None:
+    # undamped free play at omega = sqrt(k0 / m) exactly: the secular particular solution is
+    # not carried, so shoot_map says so and map_residual differences the map instead
+    p = core._parameters(PYHARM, 0.001, 1.0, 0.0, None, 1.0)
+    z = np.array([0.01, 0.0])
+    _, _, exact, _ = _end_and_sensitivity(p, z, 0, 1.0)
+    assert exact == 0.0
+    out = np.zeros(sh.N_RES)
+    assert sh.map_residual(p, 0, 0.01, 0.0, 1.0, out, True) == 0
+    assert out[sh.R_EVALS] == 2.0
+    # the forward difference with step 1e-7 lam, as written by hand, and near the central one
+    base, _, _, _ = _end_and_sensitivity(p, z, 0, 1.0)
+    shifted, _, _, _ = _end_and_sensitivity(p, z, 0, 1.0 + 1e-7)
+    forward = (shifted - base) / 1e-7
+    assert np.allclose(out[sh.R_DLAM : sh.R_DLAM + 2], forward, rtol=1e-12, atol=0.0)
+    up, _, _, _ = _end_and_sensitivity(p, z, 0, 1.0 + 1e-6)
+    down, _, _, _ = _end_and_sensitivity(p, z, 0, 1.0 - 1e-6)
+    central = (up - down) / 2e-6
+    assert np.max(np.abs(forward - central)) <= 1e-3 * np.max(np.abs(central))
+    # off resonance the same call evaluates the map once
+    out = np.zeros(sh.N_RES)
+    assert sh.map_residual(p, 0, 0.01, 0.0, 1.1, out, True) == 0
+    assert out[sh.R_EVALS] == 1.0
 
 
 def _closes_after(

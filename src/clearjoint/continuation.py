@@ -6,16 +6,18 @@ y = (u / u_scale, lambda / lambda_scale):
 
 - tangent t: the null vector of [dR/du, dR/dlambda], oriented along the last one;
 - predictor y + h t + (h^2 / 2) dt/ds, the curvature taken from the last step; after
-  three ordinary steps in a row with tangents that turn little (and before any kink),
-  the cubic through the last four points in chord length instead (error ~h^4, so
-  most corrections converge in one iteration);
+  n = ``predictor_degree`` ordinary steps in a row with tangents that turn little (and
+  before any kink), the polynomial of degree n through the last n + 1 points in chord
+  length instead (error ~h^(n + 1), so most corrections converge in one iteration);
 - corrector: Newton on R(y) = 0 together with the arclength condition
   t . (y - y_predicted) = 0, so that it passes folds where dR/du is singular;
 - step control from the corrector's iteration count: grow after an easy
   correction, shrink after a hard one, halve and retry after a failure or a
   turn of the tangent sharper than ``max_turn`` (that is how the corrector is kept
   from jumping to another branch near a fold). At the smallest step a sharp turn
-  is accepted: the branch has a kink there (grazing), which it must cross.
+  is accepted: the branch has a kink there (grazing), which it must cross; with
+  ``differs`` given it is recorded in ``Branch.kinks`` (so that it is reported whether
+  Newton crosses it or fails on it and a parameter jump does).
 - crossing a kink where no arclength step converges (a grazing with impacts, where the
   map has a square-root singularity and Newton fails on it): a natural-parameter step,
   lambda moved by a fixed increment (growing tenfold from ten times the smallest step
@@ -68,10 +70,8 @@ Differs = Callable[[Any, Any], bool]
 Equivalents = Callable[[FloatArray], list[FloatArray]]
 
 
-#: Ordinary steps in a row after which the predictor is the cubic through the last four points.
-_CUBIC_POINTS = 3
 #: ... and while the last tangents turned by less than arccos of this between points.
-_CUBIC_ALIGN = math.cos(0.1)
+_POLY_ALIGN = math.cos(0.1)
 
 #: Scaled distance within which a branch has reached the ``join`` point of another.
 _JOIN_DISTANCE = 1e-3
@@ -115,6 +115,9 @@ class ContinuationSettings:
         keep it (a chord in that one column): the residual is then called as
         ``residual(u, lam, False)`` after the first iteration and may return None
         for dR/dlambda. Worth it when that derivative costs a second evaluation.
+    predictor_degree : int
+        Degree of the polynomial predictor through the last points, used after as
+        many ordinary steps in a row (3: a cubic through four points).
     crawl_points : int
         After this many points in a row reached by steps of at most 100 smallest
         steps (the branch crawls towards a singular point), the natural-parameter
@@ -134,6 +137,7 @@ class ContinuationSettings:
     max_turn: float = 0.3
     max_kink_jump: float = 1e-4
     chord_parameter: bool = False
+    predictor_degree: int = 3
     crawl_points: int = 0
 
     def __post_init__(self) -> None:
@@ -141,6 +145,12 @@ class ContinuationSettings:
             raise ParameterError(
                 "the steps must satisfy 0 < min_step <= step <= max_step, got "
                 f"{self.min_step!r}, {self.step!r}, {self.max_step!r}"
+            )
+        if isinstance(self.predictor_degree, bool) or not (
+            isinstance(self.predictor_degree, int) and self.predictor_degree >= 1
+        ):
+            raise ParameterError(
+                f"predictor_degree must be an integer >= 1, got {self.predictor_degree!r}"
             )
         if self.max_points < 2:
             raise ParameterError(f"max_points must be >= 2, got {self.max_points!r}")
@@ -169,8 +179,10 @@ class Branch:
         led back onto the branch already followed; those points are dropped),
         or "joined" (it reached the ``join`` point).
     kinks : (k,) ndarray of int
-        Indices of the points reached by a natural-parameter jump across a kink
-        (the kink lies between point i - 1 and point i).
+        Indices of the points reached by a natural-parameter jump across a kink,
+        or (with ``differs`` given) by an arclength step at the smallest step that
+        turned sharper than ``max_turn`` (the kink lies between point i - 1 and
+        point i).
     """
 
     u: FloatArray
@@ -330,7 +342,13 @@ def continue_branch(
     Parameters
     ----------
     residual : callable
-        residual(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data).
+        residual(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data). With
+        ``settings.chord_parameter`` it may carry compiled versions of the work:
+        ``corrector`` (see ``_correct``) and ``step(points (k, d + 1), h, t,
+        curvature, scale, settings)``, the ordinary step (the predictor from the
+        last k points, or from the last one with ``t`` and ``curvature`` when k = 1,
+        the correction and the new unit tangent oriented along ``t``), returning
+        ((y, a, data, iterations), tangent) or None, as the Python steps here do.
     u0 : (d,) ndarray
         A solution, or a guess close to one, at ``lam0`` (corrected there first).
     lam0, lam_stop : float
@@ -390,6 +408,8 @@ def continue_branch(
     y, a, data, its = first
     t = _tangent(a, t)
     ys, ts, datas, iters = [y], [t], [data], [its]
+    trail = np.empty((settings.max_points + 1, d + 1))  # ys as rows, for the predictor
+    trail[0] = y
     h = settings.step
     stop = lam_stop / scale[-1]
     reason = "max_points"
@@ -397,30 +417,51 @@ def continue_branch(
     curvature = np.zeros_like(t)  # d(tangent)/ds from the last step: a second-order predictor
     back_steps = 0  # points in a row that run back along the branch's own path
     smooth = 0  # points in a row reached by an ordinary arclength step (no kink, no retry)
+    aligned = 0  # ... of which the last ones whose tangent turned by less than _POLY_ALIGN
     retry = False  # the last attempt failed: predict from the tangent and curvature only
+    # a residual may carry its ordinary step compiled: step(points, h, t, curvature, scale,
+    # settings) -> ((y, a, data, its), tangent) or None, predicting as below from ``points``
+    fast_step = getattr(residual, "step", None) if settings.chord_parameter else None
     crawl = 0  # points in a row reached by steps of at most _CRAWL_STEPS smallest steps
     while len(ys) < settings.max_points:
-        cubic = (
-            smooth >= _CUBIC_POINTS
+        poly = (
+            smooth >= settings.predictor_degree
             and not retry
             and not kinks  # past a kink the pieces lie close: keep the cautious predictor
-            and all(float(a @ b) > _CUBIC_ALIGN for a, b in zip(ts[-4:-1], ts[-3:], strict=True))
+            and aligned
+            >= settings.predictor_degree  # the last tangents turned little between points
         )
-        if cubic:
-            predicted = _extrapolate(np.array(ys[-_CUBIC_POINTS - 1 :]), h)
+        fast_tangent: FloatArray | None = None
+        if fast_step is not None:
+            # predictor, corrector and tangent in one call (the same arithmetic compiled)
+            points = (
+                trail[len(ys) - settings.predictor_degree - 1 : len(ys)] if poly else y[None, :]
+            )
+            stepped = fast_step(points, h, t, curvature, scale, settings)
+            attempt, fast_tangent = (None, None) if stepped is None else stepped
         else:
-            predicted = y + h * t + 0.5 * h * h * curvature
-        attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
-        if cubic and (attempt is None or (differs is not None and differs(datas[-1], attempt[2]))):
-            # near a kink the cubic may reach across it: the same step again, predicted
+            if poly:
+                predicted = _extrapolate(
+                    trail[len(ys) - settings.predictor_degree - 1 : len(ys)], h
+                )
+            else:
+                predicted = y + h * t + 0.5 * h * h * curvature
+            attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
+        if poly and (attempt is None or (differs is not None and differs(datas[-1], attempt[2]))):
+            # near a kink the polynomial may reach across it: the same step again, predicted
             # from the tangent and curvature (the ordinary way, with its step control)
             retry = True
             continue
         if attempt is not None:
             y_new, a_new, data_new, its = attempt
-            t_new = _tangent(a_new, t)
-            turn = math.acos(min(1.0, max(-1.0, float(t_new @ t))))
-            if turn > settings.max_turn and h > settings.min_step:
+            if fast_tangent is not None and math.isfinite(float(fast_tangent[0])):
+                t_new = fast_tangent
+            else:
+                t_new = _tangent(a_new, t)
+            cos_turn = float(t_new @ t)
+            turn = math.acos(min(1.0, max(-1.0, cos_turn)))
+            sharp = turn > settings.max_turn
+            if sharp and h > settings.min_step:
                 attempt = None
         stuck = attempt is None and h <= settings.min_step
         # crawling: the last ``crawl_points`` steps all accepted at tiny steps (towards a
@@ -485,9 +526,10 @@ def continue_branch(
             if not relabelled:
                 kinks.append(len(ys))
             curvature = np.zeros_like(t)
-            smooth, retry = 0, False
+            smooth, aligned, retry = 0, 0, False
             y, t = y_new, t_new
             ys.append(y)
+            trail[len(ys) - 1] = y
             ts.append(t)
             datas.append(data_new)
             iters.append(its)
@@ -528,13 +570,20 @@ def continue_branch(
                 del ys[len(ys) - _BACK_POINTS + 1 :], ts[len(ts) - _BACK_POINTS + 1 :]
                 del datas[len(datas) - _BACK_POINTS + 1 :], iters[len(iters) - _BACK_POINTS + 1 :]
                 break
-        step_length = float(np.linalg.norm(y_new - y))
+        chord = y_new - y
+        step_length = math.sqrt(float(chord @ chord))
         curvature = (t_new - t) / step_length if step_length > 0.0 else np.zeros_like(t)
         smooth = 0 if retry else smooth + 1
+        aligned = aligned + 1 if cos_turn > _POLY_ALIGN else 0
         crawl = crawl + 1 if h <= _CRAWL_STEPS * settings.min_step else 0
         retry = False
         y, t = y_new, t_new
+        if sharp and differs is not None:
+            # the sharp turn accepted at the smallest step: a kink (a corner where a stage
+            # appears or sticking begins), crossed by the arclength step itself
+            kinks.append(len(ys))
         ys.append(y)
+        trail[len(ys) - 1] = y
         ts.append(t)
         datas.append(data_new)
         iters.append(its)
@@ -565,8 +614,9 @@ def _extrapolate(path: FloatArray, h: float) -> FloatArray:
     """The polynomial through the rows of ``path`` (in chord length) at ``h`` past the last.
 
     Lagrange interpolation in the cumulative chord length s (s = 0 at the last
-    row), evaluated at s = h: with the last four points, a cubic predictor whose
-    error falls as h^4, against h^3 for the tangent-and-curvature one.
+    row), evaluated at s = h: through the last n points, a predictor whose error
+    falls as h^n (h^4 for a cubic through four), against h^3 for the
+    tangent-and-curvature one.
     """
     n, m = path.shape
     s = np.zeros(n)

@@ -45,6 +45,7 @@ from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate._shooting import (
     N_RES,
     R_DLAM,
+    R_EVALS,
     R_EVENTS,
     R_JAC,
     R_RES,
@@ -52,6 +53,7 @@ from clearjoint.simulate._shooting import (
     R_XMIN,
     Shot,
     _set_parameter,
+    arclength_step,
     correct_orbit,
     map_residual,
     newton_orbit,
@@ -572,6 +574,8 @@ class _MapResidual:
     def __init__(self, p: FloatArray, parameter: str, free_play_stop: bool = False) -> None:
         self.p = p
         self.code = 0 if parameter == "omega" else 1
+        #: evaluations of the exact map so far (a cost that does not depend on the load)
+        self.evaluations = 0
         #: refuse orbits that never touch an edge (with k0 = 0: a continuum, see _in_gap)
         self.free_play_stop = free_play_stop
         #: the parameters at which such an orbit was refused
@@ -587,6 +591,7 @@ class _MapResidual:
             raise SimulationError(f"the parameter left the positive range ({lam!r})")
         out = np.zeros(N_RES)
         status = map_residual(self.p, self.code, float(u[0]), float(u[1]), lam, out, derivative)
+        self.evaluations += int(out[R_EVALS])
         if status != kn.STATUS_OK:
             raise SimulationError(f"the exact map failed (kernel status {status})")
         if self._refused(out):
@@ -619,12 +624,55 @@ class _MapResidual:
             system,
             out,
         )
+        self.evaluations += int(out[R_EVALS])
         if its < 0:
             return None
         if self._refused(out):
             self.refused_at.append(float(y[-1] * scale[-1]))
             return None
         return y, system[:2].copy(), out, int(its)
+
+    def step(
+        self,
+        points: FloatArray,
+        h: float,
+        tangent: FloatArray,
+        curvature: FloatArray,
+        scale: FloatArray,
+        settings: ContinuationSettings,
+    ) -> tuple[tuple[FloatArray, FloatArray, Any, int], FloatArray] | None:
+        """``continuation``'s ordinary step, compiled (``_shooting.arclength_step``).
+
+        Predicts from ``points`` (the last points, or the last one with the
+        ``tangent`` and ``curvature``), corrects as ``corrector`` does, and returns
+        ((y, [R_u, R_lam], data, its), the new unit tangent), or None.
+        """
+        y = np.empty(3)
+        system = np.empty((3, 3))
+        out = np.zeros(N_RES)
+        t_new = np.empty(3)
+        its = arclength_step(
+            self.p,
+            self.code,
+            points,
+            h,
+            tangent,
+            curvature,
+            scale,
+            settings.tolerance,
+            settings.max_iterations,
+            y,
+            system,
+            out,
+            t_new,
+        )
+        self.evaluations += int(out[R_EVALS])
+        if its < 0:
+            return None
+        if self._refused(out):
+            self.refused_at.append(float(y[-1] * scale[-1]))
+            return None
+        return (y, system[:2].copy(), out, int(its)), t_new
 
 
 def _map_residual(p: FloatArray, parameter: str, free_play_stop: bool = False) -> _MapResidual:
@@ -865,6 +913,7 @@ def frequency_response(
                 max_points=points,
                 tolerance=1e-11,
                 chord_parameter=True,
+                predictor_degree=5,  # pyHarm curve: 72 of 323 points need 2+ iterations, 105 with 3
                 crawl_points=_CRAWL_POINTS,
             ),
             restart=restart,

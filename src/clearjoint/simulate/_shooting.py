@@ -27,13 +27,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint._jit import njit  # numba.njit that survives a read-only install
+from clearjoint.continuation import _extrapolate, _tangent_solve
 from clearjoint.simulate import _kernel as kn
 
 FloatArray = NDArray[np.float64]
 
 # output vector layout of ``shoot_map``
 O_XMAX, O_XMIN, O_EDGE_SPEED, O_EVENTS, O_M00, O_M01, O_M10, O_M11 = range(8)
-N_OUT = 8
+O_DL0, O_DL1, O_DL_EXACT = 8, 9, 10  # dP/dlambda (x, x') and 1.0 when it was computed exactly
+N_OUT = 11
+
+# parameters whose sensitivity ``shoot_map`` can carry
+NO_PARAMETER, PARAMETER_OMEGA, PARAMETER_FORCE = -1, 0, 1
 
 
 @njit(cache=True)
@@ -79,12 +84,68 @@ def _left_multiply(a: np.ndarray, m: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def shoot_map(p: np.ndarray, state: np.ndarray, n_periods: int, out: np.ndarray) -> int:
+def _forced_sensitivity(
+    p: np.ndarray, q: np.ndarray, parameter: int, theta: float
+) -> tuple[float, float, bool]:
+    """d/dlambda at fixed forcing phase ``theta`` of the forced particular solution.
+
+    The particular solution of F0 sin(theta) in the state ``q`` is
+    x_f = a sin(theta) + b cos(theta), x_f' = w (a cos(theta) - b sin(theta)), with
+    a = F0 (k - m w^2) / D, b = -F0 c w / D, D = (k - m w^2)^2 + (c w)^2. Returns
+    (d x_f, d x_f', True), or False when the state is undamped at exact resonance
+    (the secular solution, not carried here).
+    """
+    k = q[kn.Q_K]
+    c = q[kn.Q_C]
+    m = q[kn.Q_M]
+    w = p[kn.P_W]
+    u = k - m * w * w
+    det = u * u + (c * w) ** 2
+    if not det > 0.0:
+        return 0.0, 0.0, False
+    sn = math.sin(theta)
+    cs = math.cos(theta)
+    if parameter == PARAMETER_FORCE:
+        a1 = u / det
+        b1 = -c * w / det
+        return a1 * sn + b1 * cs, w * (a1 * cs - b1 * sn), True
+    f0 = p[kn.P_F0]
+    a = f0 * u / det
+    b = -f0 * c * w / det
+    det_w = -4.0 * m * w * u + 2.0 * c * c * w
+    a_w = f0 * (-2.0 * m * w * det - u * det_w) / (det * det)
+    b_w = -f0 * c * (det - w * det_w) / (det * det)
+    return a_w * sn + b_w * cs, (a * cs - b * sn) + w * (a_w * cs - b_w * sn), True
+
+
+@njit(cache=True)
+def shoot_map(
+    p: np.ndarray, state: np.ndarray, n_periods: int, out: np.ndarray, parameter: int = -1
+) -> int:
     """Advance ``state`` (x, v, region, slip) over ``n_periods`` periods, with the monodromy.
 
     ``out`` receives x_max, x_min over the stretch, the smallest approach speed
     at a gap edge (inf if none), the number of events and the monodromy matrix
-    M = dz(end)/dz(start) row by row. Returns a kernel status code.
+    M = dz(end)/dz(start) row by row. With ``parameter`` 0 (omega) or 1 (F0) it
+    also receives dP/dlambda, the sensitivity of the end point to that parameter
+    at the fixed start z0 (MODEL.md sec. 5.1), and 1.0 in ``O_DL_EXACT`` when it
+    was carried exactly (0.0 when a state was undamped at exact resonance: the
+    caller must then difference the map). Returns a kernel status code.
+
+    The sensitivity sigma = dz/dlambda is taken at fixed forcing *phase*
+    theta = w t, so that the end of the period (theta = 2 pi p) does not move
+    with omega. In a state with homogeneous flow Phi(tau) it obeys
+    sigma' = A sigma - z'/w for omega (sigma' = A sigma + (0, sin(theta)/m) for
+    F0), whose solution over a segment of length tau from phase theta0 to theta1 is
+
+        sigma1 = Phi(tau) (sigma0 - sf(theta0)) + sf(theta1) - (tau / w) (z1' - zf1')
+
+    (the last term for omega only), sf being the derivative of the forced
+    particular solution at fixed phase (``_forced_sensitivity``) and zf' its
+    time derivative. The event surfaces (x at a gap edge, x' = 0) do not depend on
+    the phase or the parameter, so sigma jumps by the same saltation matrix as the
+    monodromy; at the release from stick, whose surface does, the vector field is
+    zero on both sides and the jump is the identity; while sticking sigma stays.
     """
     tf = p[kn.P_TF]
     w = p[kn.P_W]
@@ -101,6 +162,9 @@ def shoot_map(p: np.ndarray, state: np.ndarray, n_periods: int, out: np.ndarray)
     x_min = x
     edge_speed = math.inf
     n_events = 0
+    s0 = 0.0  # sigma = dz/dlambda at fixed phase, from sigma = 0 at the start
+    s1 = 0.0
+    exact = parameter >= 0
     for _period in range(n_periods):
         t_in = 0.0
         events_here = 0
@@ -112,9 +176,28 @@ def shoot_map(p: np.ndarray, state: np.ndarray, n_periods: int, out: np.ndarray)
                 return kn.STATUS_MARCH_FAILED
             if code == kn.EV_PERIOD_END:
                 tau = tf - t_in
-            x, v, _, _ = kn.evaluate(q, slip, tau)
+            x, v, acc, _ = kn.evaluate(q, slip, tau)
             _flow(q, slip, tau, phi_m)
             _left_multiply(phi_m, mono)
+            if exact and slip != 0:
+                f_x, f_v, ok = _forced_sensitivity(p, q, parameter, phase)
+                if not ok:
+                    exact = False
+                else:
+                    d0 = s0 - f_x
+                    d1 = s1 - f_v
+                    s0 = phi_m[0, 0] * d0 + phi_m[0, 1] * d1
+                    s1 = phi_m[1, 0] * d0 + phi_m[1, 1] * d1
+                    theta = phase + w * tau
+                    f_x, f_v, _ = _forced_sensitivity(p, q, parameter, theta)
+                    s0 += f_x
+                    s1 += f_v
+                    if parameter == PARAMETER_OMEGA:
+                        # - (tau / w) times the velocity and acceleration less the forced part's
+                        xf = q[kn.Q_A] * math.sin(theta) + q[kn.Q_B] * math.cos(theta)
+                        vf = w * (q[kn.Q_A] * math.cos(theta) - q[kn.Q_B] * math.sin(theta))
+                        s0 -= (tau / w) * (v - vf)
+                        s1 -= (tau / w) * (acc + w * w * xf)
             x_max = max(x_max, x)
             x_min = min(x_min, x)
             t_in += tau
@@ -148,6 +231,7 @@ def shoot_map(p: np.ndarray, state: np.ndarray, n_periods: int, out: np.ndarray)
             elif code == kn.EV_VELOCITY_ZERO and a_before != 0.0:
                 sal[1, 1] = a_after / a_before
             _left_multiply(sal, mono)
+            s0, s1 = sal[0, 0] * s0 + sal[0, 1] * s1, sal[1, 0] * s0 + sal[1, 1] * s1
             region = new_region
             slip = new_slip
             x_max = max(x_max, x)
@@ -164,6 +248,9 @@ def shoot_map(p: np.ndarray, state: np.ndarray, n_periods: int, out: np.ndarray)
     out[O_M01] = mono[0, 1]
     out[O_M10] = mono[1, 0]
     out[O_M11] = mono[1, 1]
+    out[O_DL0] = s0
+    out[O_DL1] = s1
+    out[O_DL_EXACT] = 1.0 if exact else 0.0
     return kn.STATUS_OK
 
 
@@ -247,7 +334,7 @@ def shoot(p: FloatArray, z0: FloatArray, n_periods: int) -> Shot:
     return Shot(
         end=state[:2].copy(),
         end_state=state,
-        monodromy=out[O_M00:].reshape(2, 2).copy(),
+        monodromy=out[O_M00 : O_M11 + 1].reshape(2, 2).copy(),
         x_max=float(out[O_XMAX]),
         x_min=float(out[O_XMIN]),
         edge_speed=float(out[O_EDGE_SPEED]),
@@ -310,8 +397,8 @@ def newton_orbit(
 
 
 # residual vector layout of ``map_residual``
-R_RES, R_JAC, R_DLAM, R_XMAX, R_XMIN, R_EDGE, R_EVENTS = 0, 2, 6, 8, 9, 10, 11
-N_RES = 12
+R_RES, R_JAC, R_DLAM, R_XMAX, R_XMIN, R_EDGE, R_EVENTS, R_EVALS = 0, 2, 6, 8, 9, 10, 11, 12
+N_RES = 13
 
 
 @njit(cache=True)
@@ -335,31 +422,41 @@ def map_residual(
 ) -> int:
     """R = P_1(z) - z at parameter ``lam`` (0: omega, 1: F0), dR/dz and dR/dlam, in one call.
 
-    ``out`` receives R (2), dR/dz = M - I row by row (4), dR/dlam (2) by a forward
-    difference of the exact map with step 1e-7 lam, then x_max, x_min, the
-    smallest approach speed at an edge and the number of events. Without
-    ``derivative`` dR/dlam is not computed (left as it is in ``out``). Returns a
-    kernel status code.
+    ``out`` receives R (2), dR/dz = M - I row by row (4), dR/dlam (2), then
+    x_max, x_min, the smallest approach speed at an edge and the number of
+    events; ``out[R_EVALS]`` is incremented by the evaluations of the map made
+    (1, or 2 with the difference), so that a caller can count them. dR/dlam =
+    dP/dlam is carried exactly through the segments and events by ``shoot_map``
+    (no second evaluation of the map); only where a state is undamped at exact
+    resonance is it a forward difference of the exact map with step 1e-7 lam.
+    Without ``derivative`` dR/dlam is not computed (left as it is in ``out``).
+    Returns a kernel status code.
     """
     q = p.copy()
     _set_parameter(q, parameter, lam)
     state = np.zeros(4)
     start_state(q, x, v, state)
     o1 = np.zeros(N_OUT)
-    status = shoot_map(q, state, 1, o1)
+    status = shoot_map(q, state, 1, o1, parameter if derivative else NO_PARAMETER)
+    out[R_EVALS] += 1.0
     if status != kn.STATUS_OK:
         return status
     if derivative:
-        delta = 1e-7 * lam
-        _set_parameter(q, parameter, lam + delta)
-        shifted = np.zeros(4)
-        start_state(q, x, v, shifted)
-        o2 = np.zeros(N_OUT)
-        status = shoot_map(q, shifted, 1, o2)
-        if status != kn.STATUS_OK:
-            return status
-        out[R_DLAM] = (shifted[kn.S_X] - state[kn.S_X]) / delta
-        out[R_DLAM + 1] = (shifted[kn.S_V] - state[kn.S_V]) / delta
+        if o1[O_DL_EXACT] == 1.0:
+            out[R_DLAM] = o1[O_DL0]
+            out[R_DLAM + 1] = o1[O_DL1]
+        else:
+            delta = 1e-7 * lam
+            _set_parameter(q, parameter, lam + delta)
+            shifted = np.zeros(4)
+            start_state(q, x, v, shifted)
+            o2 = np.zeros(N_OUT)
+            status = shoot_map(q, shifted, 1, o2)
+            out[R_EVALS] += 1.0
+            if status != kn.STATUS_OK:
+                return status
+            out[R_DLAM] = (shifted[kn.S_X] - state[kn.S_X]) / delta
+            out[R_DLAM + 1] = (shifted[kn.S_V] - state[kn.S_V]) / delta
     out[R_RES] = state[kn.S_X] - x
     out[R_RES + 1] = state[kn.S_V] - v
     out[R_JAC] = o1[O_M00] - 1.0
@@ -424,9 +521,11 @@ def correct_orbit(
 
     Newton in scaled coordinates y = (x, x', lam) / ``scale`` on R(y) = 0 together
     with ``tangent . (y - y0) = 0`` (or lam fixed), exactly as
-    ``continuation._correct`` with a chord in the parameter column (dR/dlam taken
-    at the first iteration only). On success ``y`` holds the solution, ``system``
-    (3, 3) the scaled [dR/du, dR/dlam] in its first two rows, ``out`` the
+    ``continuation._correct`` with a chord in the parameter column (dR/dlam, exact
+    from ``map_residual``, taken at the first iteration only: full Newton steps
+    across the square-root kink of a grazing with impacts, where the chord stops
+    and the continuation finds and reports the kink). On success ``y`` holds the
+    solution, ``system`` (3, 3) the scaled [dR/du, dR/dlam] in its first two rows, ``out`` the
     ``map_residual`` data there, and the iterations are returned; -1 on failure
     (a kernel failure, a parameter <= 0, a value not finite, no convergence).
     """
@@ -484,3 +583,53 @@ def correct_orbit(
         for i in range(3):
             y[i] += dy[i]
     return -1
+
+
+@njit(cache=True)
+def arclength_step(
+    p: np.ndarray,
+    parameter: int,
+    points: np.ndarray,
+    h: float,
+    tangent: np.ndarray,
+    curvature: np.ndarray,
+    scale: np.ndarray,
+    tolerance: float,
+    max_iterations: int,
+    y: np.ndarray,
+    system: np.ndarray,
+    out: np.ndarray,
+    t_new: np.ndarray,
+) -> int:
+    """One ordinary step of the continuation, compiled: predict, correct, new tangent.
+
+    The predictor is ``continuation``'s: the polynomial through the rows of
+    ``points`` (scaled) at chord length ``h`` past the last when it has more than
+    one row, else ``points[0] + h tangent + (h^2 / 2) curvature``. Then
+    ``correct_orbit`` (arclength condition along ``tangent``) and, on success, the
+    unit tangent of the solution in ``t_new``, oriented along ``tangent``
+    (``continuation._tangent``; NaN when that 3x3 solve is singular, for the caller
+    to fall back on its SVD). Returns the corrector's iterations, -1 on failure.
+    """
+    if points.shape[0] > 1:
+        predicted = _extrapolate(points, h)
+    else:
+        predicted = np.empty(3)
+        for i in range(3):
+            predicted[i] = points[0, i] + h * tangent[i] + 0.5 * h * h * curvature[i]
+    its = correct_orbit(
+        p, parameter, predicted, tangent, scale, False, tolerance, max_iterations, y, system, out
+    )
+    if its < 0:
+        return its
+    a = np.empty((2, 3))
+    for i in range(2):
+        for j in range(3):
+            a[i, j] = system[i, j]
+    if not _tangent_solve(a, tangent, t_new):
+        t_new[:] = np.nan
+        return its
+    if t_new[0] * tangent[0] + t_new[1] * tangent[1] + t_new[2] * tangent[2] < 0.0:
+        for i in range(3):
+            t_new[i] = -t_new[i]
+    return its
