@@ -8,6 +8,7 @@ import os
 import subprocess
 import sys
 import textwrap
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -116,3 +117,38 @@ def test_homogeneous_parts_are_the_matrix_exponential(alpha: float, kq: float, t
     flow = expm(np.array([[0.0, 1.0], [-kq, 2.0 * alpha]]) * tau)
     assert e_part - alpha * g_part == pytest.approx(flow[0, 0], rel=1e-9, abs=1e-12)
     assert g_part == pytest.approx(flow[0, 1], rel=1e-9, abs=1e-15)
+
+
+def _first_root(g0: float, g1: float, g2: float, bound: float, h_max: float) -> float:
+    """First h in (0, h_max] where g0 + g1 h + g2 h^2/2 - bound h^3/6 falls to 0, by numpy.roots."""
+    roots = np.roots([-bound / 6.0, 0.5 * g2, g1, g0])
+    real = [r.real for r in roots if abs(r.imag) <= 1e-12 * abs(r) and r.real > 0.0]
+    return min([h_max, *real])
+
+
+def _exact_cubic(g0: float, g1: float, g2: float, bound: float, h: float) -> Fraction:
+    g0_, g1_, g2_, b_, h_ = (Fraction(v) for v in (g0, g1, g2, bound, h))
+    return g0_ + h_ * (g1_ + h_ * (g2_ / 2 - b_ * h_ / 6))
+
+
+def test_certified_step_is_certified_and_tight_on_random_cubics() -> None:
+    # long brackets (a critical point far left of h_max) and both convex and concave pieces
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        g0 = abs(rng.normal()) * 10.0 ** rng.uniform(-6, 1) * (rng.uniform() > 0.2)
+        g1 = rng.normal() * 10.0 ** rng.uniform(-3, 4)
+        g2 = rng.normal() * 10.0 ** rng.uniform(-3, 8)
+        bound = 10.0 ** rng.uniform(0, 12)
+        h_max = 10.0 ** rng.uniform(-5, 1)
+        h = kn.certified_step(g0, g1, g2, bound, h_max)
+        root = _first_root(g0, g1, g2, bound, h_max)
+        if g0 == 0.0 and g1 < 0.0:
+            assert h == 0.0
+            continue
+        # positive up to h (exactly at h, in rational arithmetic), so no root was passed
+        grid = np.linspace(0.0, h, 201)[1:]
+        assert np.all(kn._cubic(g0, g1, g2, bound, grid) > 0.0) or h == 0.0, (g0, g1, g2, h)
+        size = abs(g0) + abs(g1) * h + abs(g2) * h * h / 2 + bound * h**3 / 6
+        assert _exact_cubic(g0, g1, g2, bound, h) >= -1e-15 * size  # the round-off of the bound
+        assert h <= root * (1.0 + 1e-10)  # numpy.roots itself is good to about 1e-13
+        assert h >= root * (1.0 - 2e-9) - 1e-300, (g0, g1, g2, bound, h_max, h, root)
