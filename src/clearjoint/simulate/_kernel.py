@@ -518,6 +518,36 @@ def _moment(z: complex, n: int) -> complex:
 
 
 @njit(cache=True)
+def _moments(z: complex, order: int) -> tuple[complex, complex, complex]:
+    """E_0(z), E_1(z), E_2(z) of ``_moment`` up to ``order`` (the rest 0), sharing one exp(z).
+
+    The same formulas and the same series, term for term, as ``_moment``.
+    """
+    e0 = 0.0j
+    e1 = 0.0j
+    e2 = 0.0j
+    if abs(z) < 1.0:
+        term = 1.0 + 0.0j  # z^k / k!
+        for k in range(30):
+            e0 += term / (k + 1)
+            if order >= 1:
+                e1 += term / (k + 2)
+            if order >= 2:
+                e2 += term / (k + 3)
+            term = term * z / (k + 1)
+            if abs(term) < 1e-18:
+                break
+        return e0, e1, e2
+    ez = cmath.exp(z)
+    e0 = (ez - 1.0) / z
+    if order >= 1:
+        e1 = (ez * (z - 1.0) + 1.0) / (z * z)
+    if order >= 2:
+        e2 = (ez * (z * z - 2.0 * z + 2.0) - 2.0) / (z * z * z)
+    return e0, e1, e2
+
+
+@njit(cache=True)
 def _velocity_terms(
     q: np.ndarray, slip: int, rates: np.ndarray, consts: np.ndarray, slopes: np.ndarray
 ) -> tuple[int, float]:
@@ -619,7 +649,7 @@ def _segment_energy(
 
     x'(tau) is a sum of (a + b tau) exp(s tau) terms (homogeneous, forced and
     constant parts), and so is F0 sin(phi + w tau); every product integrates to
-    tau^n exp(s tau) moments (``_moment``). Near-critical damping, where the
+    tau^n exp(s tau) moments (``_moment``, ``_moments``). Near-critical damping, where the
     exponential terms cancel each other, falls back to quadrature on the state's
     own time scale. ``scratch`` is a (3, 6) complex work array.
     """
@@ -647,18 +677,25 @@ def _segment_energy(
     viscous = 0.0j
     t = duration
     for j in range(n):
+        sloped = slopes[j] != 0.0  # a term without a slope needs E_0 only
         for sign in (1.0, -1.0):
             fk = force_plus if sign > 0.0 else force_plus.conjugate()
             z = (rates[j] + sign * 1j * w) * t
-            work += fk * (consts[j] * t * _moment(z, 0) + slopes[j] * t * t * _moment(z, 1))
+            e0, e1, _ = _moments(z, 1 if sloped else 0)
+            if sloped:
+                work += fk * (consts[j] * t * e0 + slopes[j] * t * t * e1)
+            else:
+                work += fk * (consts[j] * t * e0)
         if p[P_DAMP] == 0.0:
             continue
         for i in range(n):
             z = (rates[i] + rates[j]) * t
+            order = 2 if sloped and slopes[i] != 0.0 else (1 if sloped or slopes[i] != 0.0 else 0)
+            e0, e1, e2 = _moments(z, order)
             viscous += (
-                consts[i] * consts[j] * t * _moment(z, 0)
-                + (consts[i] * slopes[j] + slopes[i] * consts[j]) * t * t * _moment(z, 1)
-                + slopes[i] * slopes[j] * t * t * t * _moment(z, 2)
+                consts[i] * consts[j] * t * e0
+                + (consts[i] * slopes[j] + slopes[i] * consts[j]) * t * t * e1
+                + slopes[i] * slopes[j] * t * t * t * e2
             )
     return work.real, p[P_DAMP] * viscous.real
 
@@ -823,15 +860,19 @@ def sample(
     """Evaluate x, v, a at sorted ``times`` (period index * T + time in period) from segments."""
     tf = p[P_TF]
     i = 0
+    built = -1  # the segment whose closed-form coefficients ``q`` holds
+    q = np.zeros(N_Q)
     for n in range(times.shape[0]):
         t = times[n]
         while i + 1 < n_seg and (segments[i + 1, SEG_PERIOD] * tf + segments[i + 1, SEG_T0] <= t):
             i += 1
         row = segments[i]
         slip = int(row[SEG_SLIP])
-        q = phase_coefficients(
-            p, int(row[SEG_REGION]), slip, row[SEG_X0], row[SEG_V0], row[SEG_PHI]
-        )
+        if built != i:  # the same coefficients serve every sample of a segment
+            q = phase_coefficients(
+                p, int(row[SEG_REGION]), slip, row[SEG_X0], row[SEG_V0], row[SEG_PHI]
+            )
+            built = i
         tau = t - (row[SEG_PERIOD] * tf + row[SEG_T0])
         tau = min(max(tau, 0.0), row[SEG_DT])
         x, v, a, _ = evaluate(q, slip, tau)
