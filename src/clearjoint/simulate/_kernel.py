@@ -457,8 +457,17 @@ def _next_event(
     x = q[Q_XSTICK]
     v = q[Q_V0]
     a = (p[P_F0] * math.sin(q[Q_PHI]) + fc - k * x - c * v) / m
-    if v == 0.0 and abs(a) * m <= 1e-12 * (p[P_F0] + abs(fc) + abs(k * x) + p[P_FF]):
-        a = 0.0  # a slip that starts from stick: the net force is exactly at the friction limit
+    if (
+        v == 0.0
+        and slip * a < 0.0
+        and abs(a) * m <= 1e-12 * (p[P_F0] + abs(fc) + abs(k * x) + p[P_FF])
+    ):
+        # a slip that starts from stick with the net force exactly at the friction limit:
+        # an acceleration against the slip is round-off. One along it is kept, however
+        # small: from rest just off zero (net force -k0 x0 tiny, its rate F0 w not) it
+        # moves the mass that way for a moment; zeroed, the velocity zero came at once,
+        # and decide_slip chose the same direction again, without end
+        a = 0.0
     j = (p[P_F0] * p[P_W] * math.cos(q[Q_PHI]) - k * v - c * a) / m
     for it in range(MAX_MARCH_STEPS):
         if it > 0:
