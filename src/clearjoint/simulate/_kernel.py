@@ -685,28 +685,31 @@ def _segment_energy(
     work = 0.0j
     viscous = 0.0j
     t = duration
+    # The velocity's terms are closed under conjugation (a complex rate comes with its
+    # conjugate, a real one has real coefficients), so the work's terms pair off as
+    # (j, force_plus) with (conj j, conj force_plus): the real part of the sum is twice
+    # that of the force_plus terms alone. The viscous sum is symmetric in (i, j).
     for j in range(n):
         sloped = slopes[j] != 0.0  # a term without a slope needs E_0 only
-        for sign in (1.0, -1.0):
-            fk = force_plus if sign > 0.0 else force_plus.conjugate()
-            z = (rates[j] + sign * 1j * w) * t
-            e0, e1, _ = _moments(z, 1 if sloped else 0)
-            if sloped:
-                work += fk * (consts[j] * t * e0 + slopes[j] * t * t * e1)
-            else:
-                work += fk * (consts[j] * t * e0)
+        z = (rates[j] + 1j * w) * t
+        e0, e1, _ = _moments(z, 1 if sloped else 0)
+        if sloped:
+            work += force_plus * (consts[j] * t * e0 + slopes[j] * t * t * e1)
+        else:
+            work += force_plus * (consts[j] * t * e0)
         if p[P_DAMP] == 0.0:
             continue
-        for i in range(n):
+        for i in range(j + 1):
             z = (rates[i] + rates[j]) * t
             order = 2 if sloped and slopes[i] != 0.0 else (1 if sloped or slopes[i] != 0.0 else 0)
             e0, e1, e2 = _moments(z, order)
-            viscous += (
+            term = (
                 consts[i] * consts[j] * t * e0
                 + (consts[i] * slopes[j] + slopes[i] * consts[j]) * t * t * e1
                 + slopes[i] * slopes[j] * t * t * t * e2
             )
-    return work.real, p[P_DAMP] * viscous.real
+            viscous += term if i == j else 2.0 * term
+    return 2.0 * work.real, p[P_DAMP] * viscous.real
 
 
 @njit(cache=True)
