@@ -440,7 +440,7 @@ def _next_event(
             d2 = -f0 * w * w * math.sin(theta)
             remaining = tau_end - tau
             h_up = certified_step(ff - net, -d1, -d2, bound, remaining)
-            h_dn = certified_step(ff + net, d1, d2, bound, remaining)
+            h_dn = certified_step(ff + net, d1, d2, bound, h_up)  # only: does it come first?
             h = min(h_up, h_dn)
             if h >= remaining:
                 return tau_end, EV_PERIOD_END
@@ -475,26 +475,28 @@ def _next_event(
         remaining = tau_end - tau
         best = remaining
         code = EV_PERIOD_END
+        # each later event function is asked only whether it comes before ``best``: a
+        # bound that stays positive up to there costs no root search
         h = certified_step(slip * v, slip * a, slip * j, b4, remaining)
         if h < best:
             best = h
             code = EV_VELOCITY_ZERO
         if region == FREE:
-            h = certified_step(gc - x, -v, -a, b3, remaining, -j, b4)
+            h = certified_step(gc - x, -v, -a, b3, best, -j, b4)
             if h < best:
                 best = h
                 code = EV_ENTER_COMPRESSION
-            h = certified_step(x + gt, v, a, b3, remaining, j, b4)
+            h = certified_step(x + gt, v, a, b3, best, j, b4)
             if h < best:
                 best = h
                 code = EV_ENTER_TENSION
         elif region == COMPRESSION:
-            h = certified_step(x - gc, v, a, b3, remaining, j, b4)
+            h = certified_step(x - gc, v, a, b3, best, j, b4)
             if h < best:
                 best = h
                 code = EV_LEAVE_COMPRESSION
         else:
-            h = certified_step(-gt - x, -v, -a, b3, remaining, -j, b4)
+            h = certified_step(-gt - x, -v, -a, b3, best, -j, b4)
             if h < best:
                 best = h
                 code = EV_LEAVE_TENSION
