@@ -13,7 +13,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from clearjoint import Joint
+from clearjoint import Friction, Joint
 from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate import core, time_response
 
@@ -168,4 +168,21 @@ def test_a_start_at_rest_just_off_zero_follows_the_closed_form(x0: float) -> Non
     exact = x0 * np.cos(t[free]) + 0.5 * (np.sin(t[free]) - t[free] * np.cos(t[free]))
     np.testing.assert_allclose(motion.displacement[free], exact, rtol=0, atol=1e-14)
     assert motion.events < 200
+    assert motion.energy.balance_error < 1e-9
+
+
+@pytest.mark.parametrize("ulps", [1, 2, 4])
+def test_a_start_just_past_the_friction_limit_sticks_instead_of_looping(ulps: int) -> None:
+    # at rest at x0 = F_f / k0 + a few ulps, phase 0: the net force -k0 x0 is just past the
+    # friction limit, its rate F0 w pulls it back inside. The mass slides down for an
+    # instant, then sticks while |F0 sin t - k0 x0| <= F_f, i.e. until t = pi; before the
+    # fix this looped at t = 0 ("more than 100000 events ... (chattering)")
+    joint = Joint(mass=1.0, clearance=2.0, gap_stiffness=1.0, compression_stiffness=3.0)
+    x0 = 0.5 + ulps * float(np.spacing(0.5))
+    motion = time_response(
+        joint, 1.0, 1.0, 2 * 2 * math.pi, friction=Friction(0.5, 1.0), initial=(x0, 0.0)
+    )
+    stuck = motion.time < math.pi - 1e-6
+    np.testing.assert_allclose(motion.displacement[stuck], x0, rtol=0, atol=1e-12)
+    assert motion.displacement[motion.time > math.pi + 0.5].min() < x0 - 0.01  # then slides
     assert motion.energy.balance_error < 1e-9
