@@ -81,3 +81,23 @@ def test_longdouble_reference_with_impacts_agrees_with_both_solvers(bench: Modul
     assert abs(ivp[1] - v) < 1e-9
     assert abs(exact.final_state[0] - x) < 1e-12
     assert abs(exact.final_state[1] - v) < 1e-12
+
+
+@pytest.mark.parametrize("method", ["RK45", "Radau", "BDF", "LSODA"])
+def test_every_solve_ivp_method_the_benchmark_tries_solves_the_impacting_case(
+    bench: ModuleType, method: str
+) -> None:
+    # the implicit methods get the state's exact Jacobian; one period, 7 impacts, against
+    # the longdouble closed form, to the accuracy each reaches at a loose rtol
+    duration = 2.0 * math.pi
+    x, v, _ = bench.closed_form_reference(STIFF, 1.0, 1.0, duration, 0.8)
+    ivp = bench.per_state_reference(STIFF, 1.0, 1.0, duration, 0.8, rtol=1e-9, method=method)
+    assert abs(ivp[0] - x) < 1e-5
+    assert abs(ivp[1] - v) < 1e-5
+
+
+def test_a_failed_solve_ivp_run_raises_instead_of_returning_its_last_state(
+    bench: ModuleType,
+) -> None:
+    with pytest.raises(RuntimeError, match="BDF at rtol 1e-13 failed"):
+        bench.per_state_reference(STIFF, 1.0, 1.0, 2.0 * math.pi, 0.8, rtol=1e-13, method="BDF")

@@ -8,11 +8,12 @@ import os
 import subprocess
 import sys
 import textwrap
+from fractions import Fraction
 
 import numpy as np
 import pytest
 
-from clearjoint import Joint
+from clearjoint import Friction, Joint
 from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate import core, time_response
 
@@ -116,3 +117,72 @@ def test_homogeneous_parts_are_the_matrix_exponential(alpha: float, kq: float, t
     flow = expm(np.array([[0.0, 1.0], [-kq, 2.0 * alpha]]) * tau)
     assert e_part - alpha * g_part == pytest.approx(flow[0, 0], rel=1e-9, abs=1e-12)
     assert g_part == pytest.approx(flow[0, 1], rel=1e-9, abs=1e-15)
+
+
+def _first_root(g0: float, g1: float, g2: float, bound: float, h_max: float) -> float:
+    """First h in (0, h_max] where g0 + g1 h + g2 h^2/2 - bound h^3/6 falls to 0, by numpy.roots."""
+    roots = np.roots([-bound / 6.0, 0.5 * g2, g1, g0])
+    real = [r.real for r in roots if abs(r.imag) <= 1e-12 * abs(r) and r.real > 0.0]
+    return min([h_max, *real])
+
+
+def _exact_cubic(g0: float, g1: float, g2: float, bound: float, h: float) -> Fraction:
+    g0_, g1_, g2_, b_, h_ = (Fraction(v) for v in (g0, g1, g2, bound, h))
+    return g0_ + h_ * (g1_ + h_ * (g2_ / 2 - b_ * h_ / 6))
+
+
+def test_certified_step_is_certified_and_tight_on_random_cubics() -> None:
+    # long brackets (a critical point far left of h_max) and both convex and concave pieces
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        g0 = abs(rng.normal()) * 10.0 ** rng.uniform(-6, 1) * (rng.uniform() > 0.2)
+        g1 = rng.normal() * 10.0 ** rng.uniform(-3, 4)
+        g2 = rng.normal() * 10.0 ** rng.uniform(-3, 8)
+        bound = 10.0 ** rng.uniform(0, 12)
+        h_max = 10.0 ** rng.uniform(-5, 1)
+        h = kn.certified_step(g0, g1, g2, bound, h_max)
+        root = _first_root(g0, g1, g2, bound, h_max)
+        if g0 == 0.0 and g1 < 0.0:
+            assert h == 0.0
+            continue
+        # positive up to h (exactly at h, in rational arithmetic), so no root was passed
+        grid = np.linspace(0.0, h, 201)[1:]
+        assert np.all(kn._cubic(g0, g1, g2, bound, grid) > 0.0) or h == 0.0, (g0, g1, g2, h)
+        size = abs(g0) + abs(g1) * h + abs(g2) * h * h / 2 + bound * h**3 / 6
+        assert _exact_cubic(g0, g1, g2, bound, h) >= -1e-15 * size  # the round-off of the bound
+        assert h <= root * (1.0 + 1e-10)  # numpy.roots itself is good to about 1e-13
+        assert h >= root * (1.0 - 2e-9) - 1e-300, (g0, g1, g2, bound, h_max, h, root)
+
+
+@pytest.mark.parametrize("x0", [1e-12, -1e-12, 3e-13, 1e-9])
+def test_a_start_at_rest_just_off_zero_follows_the_closed_form(x0: float) -> None:
+    # at rest at x0 > 0, phase 0: the net force -k0 x0 is tiny and negative while its rate
+    # F0 w is positive, so the mass moves down for 2 x0 / (F0 w) s, then turns. The kernel
+    # took the tiny acceleration for round-off, zeroed it, and so met the velocity zero at
+    # once, again and again ("more than 100000 events ... (chattering)")
+    omega = 1.0
+    motion = time_response(STIFF, 1.0, omega, 3 * 2 * math.pi, restitution=0.8, initial=(x0, 0))
+    # free play with k0 = m w^2 (resonant): x = x0 cos t + (sin t - t cos t) / 2 until x = 0.1
+    t = motion.time
+    free = t < 0.9 * motion.impact_times[0]
+    exact = x0 * np.cos(t[free]) + 0.5 * (np.sin(t[free]) - t[free] * np.cos(t[free]))
+    np.testing.assert_allclose(motion.displacement[free], exact, rtol=0, atol=1e-14)
+    assert motion.events < 200
+    assert motion.energy.balance_error < 1e-9
+
+
+@pytest.mark.parametrize("ulps", [1, 2, 4])
+def test_a_start_just_past_the_friction_limit_sticks_instead_of_looping(ulps: int) -> None:
+    # at rest at x0 = F_f / k0 + a few ulps, phase 0: the net force -k0 x0 is just past the
+    # friction limit, its rate F0 w pulls it back inside. The mass slides down for an
+    # instant, then sticks while |F0 sin t - k0 x0| <= F_f, i.e. until t = pi; before the
+    # fix this looped at t = 0 ("more than 100000 events ... (chattering)")
+    joint = Joint(mass=1.0, clearance=2.0, gap_stiffness=1.0, compression_stiffness=3.0)
+    x0 = 0.5 + ulps * float(np.spacing(0.5))
+    motion = time_response(
+        joint, 1.0, 1.0, 2 * 2 * math.pi, friction=Friction(0.5, 1.0), initial=(x0, 0.0)
+    )
+    stuck = motion.time < math.pi - 1e-6
+    np.testing.assert_allclose(motion.displacement[stuck], x0, rtol=0, atol=1e-12)
+    assert motion.displacement[motion.time > math.pi + 0.5].min() < x0 - 0.01  # then slides
+    assert motion.energy.balance_error < 1e-9

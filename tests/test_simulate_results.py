@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 
 from clearjoint import Friction, Joint
 from clearjoint.simulate import Motion, SteadyState, steady_state, time_response
+from clearjoint.simulate.core import STAGE_NAMES, Stage, _stages
 
 JOINT = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, tension_stiffness=5e7)
 LINEAR = Joint(mass=2.0, clearance=0.0, compression_stiffness=8e7)
@@ -110,3 +111,29 @@ def test_plot_without_axes_makes_a_figure(transient: Motion) -> None:
         np.testing.assert_allclose(ax.lines[0].get_ydata(), transient.displacement * 1e6)
     finally:
         plt.close(ax.figure)
+
+
+def _stages_one_by_one(
+    regions: np.ndarray, starts: np.ndarray, ends: np.ndarray
+) -> tuple[Stage, ...]:
+    """The rule written plainly, segment by segment: merge one region's run, skip empty ones."""
+    stages: list[Stage] = []
+    for region, start, end in zip(regions, starts, ends, strict=True):
+        name = STAGE_NAMES[int(region)]
+        if stages and stages[-1].name == name:
+            stages[-1] = Stage(name, stages[-1].start, float(end))
+        elif end > start or not stages:
+            stages.append(Stage(name, float(start), float(end)))
+    return tuple(stages)
+
+
+def test_stages_merge_runs_and_skip_empty_segments_as_the_plain_rule_does() -> None:
+    rng = np.random.default_rng(1)
+    for _ in range(3000):
+        n = int(rng.integers(1, 12))
+        regions = rng.integers(-1, 2, n)
+        lengths = rng.choice([0.0, 1.0, 2.5], n)  # empty segments: events at one instant
+        starts = np.concatenate(([0.0], np.cumsum(lengths)[:-1])) + rng.choice([0.0, 1e-17], n)
+        ends = starts + lengths + rng.choice([0.0, 1e-16], n)  # ends off by round-off
+        expected = _stages_one_by_one(regions, starts, ends)
+        assert _stages(regions.astype(np.int64), starts, ends) == expected

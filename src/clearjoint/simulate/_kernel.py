@@ -309,9 +309,29 @@ def _monotone_root(g0: float, g1: float, g2: float, bound: float, lo: float, hi:
     """A point just below the root of the cubic bound on [lo, hi] (> 0 at lo, <= 0 at hi).
 
     Newton's method safeguarded by the bracket; the value returned always keeps
-    the bound positive, so the step it gives stays certified.
+    the bound positive, so the step it gives stays certified. The bracket is
+    first cut at the inflection point g2 / bound, so that the cubic is convex
+    or concave on it and Newton's iterates approach the root from one side: from
+    ``lo`` on a convex piece; on a concave piece from the root of the quadratic
+    Taylor polynomial at ``lo``, which lies right of the root (the cubic's third
+    derivative is negative). Once a step moves less than 1e-10 of the point, the
+    point 5e-10 of it below the root is returned (or ``lo``, if higher) when the
+    bound is positive there. About five evaluations, where bisection from the far end of a long
+    bracket took thirty or more.
     """
+    inflection = g2 / bound
+    if lo < inflection < hi:
+        if _cubic(g0, g1, g2, bound, inflection) > 0.0:
+            lo = inflection
+        else:
+            hi = inflection
     x = lo
+    if lo >= inflection:  # concave on [lo, hi]: start right of the root
+        value = _cubic(g0, g1, g2, bound, lo)
+        slope = g1 + lo * (g2 - 0.5 * bound * lo)
+        curvature = g2 - bound * lo
+        denominator = -slope + math.sqrt(max(slope * slope - 2.0 * curvature * value, 0.0))
+        x = min(lo + 2.0 * value / denominator, hi) if denominator > 0.0 else hi
     for _ in range(100):
         value = _cubic(g0, g1, g2, bound, x)
         if value > 0.0:
@@ -322,6 +342,10 @@ def _monotone_root(g0: float, g1: float, g2: float, bound: float, lo: float, hi:
             break
         slope = g1 + x * (g2 - 0.5 * bound * x)
         step = x - value / slope if slope < 0.0 else hi
+        if abs(step - x) <= 1e-10 * x:  # Newton has converged on the root: step just below it
+            trial = step - 5e-10 * x  # (below lo the bound is positive already)
+            if trial > 0.0 and (trial <= lo or _cubic(g0, g1, g2, bound, trial) > 0.0):
+                return max(trial, lo)
         x = step if lo < step < hi else 0.5 * (lo + hi)
     return lo
 
@@ -416,7 +440,7 @@ def _next_event(
             d2 = -f0 * w * w * math.sin(theta)
             remaining = tau_end - tau
             h_up = certified_step(ff - net, -d1, -d2, bound, remaining)
-            h_dn = certified_step(ff + net, d1, d2, bound, remaining)
+            h_dn = certified_step(ff + net, d1, d2, bound, h_up)  # only: does it come first?
             h = min(h_up, h_dn)
             if h >= remaining:
                 return tau_end, EV_PERIOD_END
@@ -433,8 +457,17 @@ def _next_event(
     x = q[Q_XSTICK]
     v = q[Q_V0]
     a = (p[P_F0] * math.sin(q[Q_PHI]) + fc - k * x - c * v) / m
-    if v == 0.0 and abs(a) * m <= 1e-12 * (p[P_F0] + abs(fc) + abs(k * x) + p[P_FF]):
-        a = 0.0  # a slip that starts from stick: the net force is exactly at the friction limit
+    if (
+        v == 0.0
+        and slip * a < 0.0
+        and abs(a) * m <= 1e-12 * (p[P_F0] + abs(fc) + abs(k * x) + p[P_FF])
+    ):
+        # a slip that starts from stick with the net force exactly at the friction limit:
+        # an acceleration against the slip is round-off. One along it is kept, however
+        # small: from rest just off zero (net force -k0 x0 tiny, its rate F0 w not) it
+        # moves the mass that way for a moment; zeroed, the velocity zero came at once,
+        # and decide_slip chose the same direction again, without end
+        a = 0.0
     j = (p[P_F0] * p[P_W] * math.cos(q[Q_PHI]) - k * v - c * a) / m
     for it in range(MAX_MARCH_STEPS):
         if it > 0:
@@ -442,26 +475,28 @@ def _next_event(
         remaining = tau_end - tau
         best = remaining
         code = EV_PERIOD_END
+        # each later event function is asked only whether it comes before ``best``: a
+        # bound that stays positive up to there costs no root search
         h = certified_step(slip * v, slip * a, slip * j, b4, remaining)
         if h < best:
             best = h
             code = EV_VELOCITY_ZERO
         if region == FREE:
-            h = certified_step(gc - x, -v, -a, b3, remaining, -j, b4)
+            h = certified_step(gc - x, -v, -a, b3, best, -j, b4)
             if h < best:
                 best = h
                 code = EV_ENTER_COMPRESSION
-            h = certified_step(x + gt, v, a, b3, remaining, j, b4)
+            h = certified_step(x + gt, v, a, b3, best, j, b4)
             if h < best:
                 best = h
                 code = EV_ENTER_TENSION
         elif region == COMPRESSION:
-            h = certified_step(x - gc, v, a, b3, remaining, j, b4)
+            h = certified_step(x - gc, v, a, b3, best, j, b4)
             if h < best:
                 best = h
                 code = EV_LEAVE_COMPRESSION
         else:
-            h = certified_step(-gt - x, -v, -a, b3, remaining, -j, b4)
+            h = certified_step(-gt - x, -v, -a, b3, best, -j, b4)
             if h < best:
                 best = h
                 code = EV_LEAVE_TENSION
@@ -491,6 +526,36 @@ def _moment(z: complex, n: int) -> complex:
     if n == 1:
         return (ez * (z - 1.0) + 1.0) / (z * z)
     return (ez * (z * z - 2.0 * z + 2.0) - 2.0) / (z * z * z)
+
+
+@njit(cache=True)
+def _moments(z: complex, order: int) -> tuple[complex, complex, complex]:
+    """E_0(z), E_1(z), E_2(z) of ``_moment`` up to ``order`` (the rest 0), sharing one exp(z).
+
+    The same formulas and the same series, term for term, as ``_moment``.
+    """
+    e0 = 0.0j
+    e1 = 0.0j
+    e2 = 0.0j
+    if abs(z) < 1.0:
+        term = 1.0 + 0.0j  # z^k / k!
+        for k in range(30):
+            e0 += term / (k + 1)
+            if order >= 1:
+                e1 += term / (k + 2)
+            if order >= 2:
+                e2 += term / (k + 3)
+            term = term * z / (k + 1)
+            if abs(term) < 1e-18:
+                break
+        return e0, e1, e2
+    ez = cmath.exp(z)
+    e0 = (ez - 1.0) / z
+    if order >= 1:
+        e1 = (ez * (z - 1.0) + 1.0) / (z * z)
+    if order >= 2:
+        e2 = (ez * (z * z - 2.0 * z + 2.0) - 2.0) / (z * z * z)
+    return e0, e1, e2
 
 
 @njit(cache=True)
@@ -595,7 +660,7 @@ def _segment_energy(
 
     x'(tau) is a sum of (a + b tau) exp(s tau) terms (homogeneous, forced and
     constant parts), and so is F0 sin(phi + w tau); every product integrates to
-    tau^n exp(s tau) moments (``_moment``). Near-critical damping, where the
+    tau^n exp(s tau) moments (``_moment``, ``_moments``). Near-critical damping, where the
     exponential terms cancel each other, falls back to quadrature on the state's
     own time scale. ``scratch`` is a (3, 6) complex work array.
     """
@@ -622,21 +687,31 @@ def _segment_energy(
     work = 0.0j
     viscous = 0.0j
     t = duration
+    # The velocity's terms are closed under conjugation (a complex rate comes with its
+    # conjugate, a real one has real coefficients), so the work's terms pair off as
+    # (j, force_plus) with (conj j, conj force_plus): the real part of the sum is twice
+    # that of the force_plus terms alone. The viscous sum is symmetric in (i, j).
     for j in range(n):
-        for sign in (1.0, -1.0):
-            fk = force_plus if sign > 0.0 else force_plus.conjugate()
-            z = (rates[j] + sign * 1j * w) * t
-            work += fk * (consts[j] * t * _moment(z, 0) + slopes[j] * t * t * _moment(z, 1))
+        sloped = slopes[j] != 0.0  # a term without a slope needs E_0 only
+        z = (rates[j] + 1j * w) * t
+        e0, e1, _ = _moments(z, 1 if sloped else 0)
+        if sloped:
+            work += force_plus * (consts[j] * t * e0 + slopes[j] * t * t * e1)
+        else:
+            work += force_plus * (consts[j] * t * e0)
         if p[P_DAMP] == 0.0:
             continue
-        for i in range(n):
+        for i in range(j + 1):
             z = (rates[i] + rates[j]) * t
-            viscous += (
-                consts[i] * consts[j] * t * _moment(z, 0)
-                + (consts[i] * slopes[j] + slopes[i] * consts[j]) * t * t * _moment(z, 1)
-                + slopes[i] * slopes[j] * t * t * t * _moment(z, 2)
+            order = 2 if sloped and slopes[i] != 0.0 else (1 if sloped or slopes[i] != 0.0 else 0)
+            e0, e1, e2 = _moments(z, order)
+            term = (
+                consts[i] * consts[j] * t * e0
+                + (consts[i] * slopes[j] + slopes[i] * consts[j]) * t * t * e1
+                + slopes[i] * slopes[j] * t * t * t * e2
             )
-    return work.real, p[P_DAMP] * viscous.real
+            viscous += term if i == j else 2.0 * term
+    return 2.0 * work.real, p[P_DAMP] * viscous.real
 
 
 @njit(cache=True)
@@ -799,15 +874,19 @@ def sample(
     """Evaluate x, v, a at sorted ``times`` (period index * T + time in period) from segments."""
     tf = p[P_TF]
     i = 0
+    built = -1  # the segment whose closed-form coefficients ``q`` holds
+    q = np.zeros(N_Q)
     for n in range(times.shape[0]):
         t = times[n]
         while i + 1 < n_seg and (segments[i + 1, SEG_PERIOD] * tf + segments[i + 1, SEG_T0] <= t):
             i += 1
         row = segments[i]
         slip = int(row[SEG_SLIP])
-        q = phase_coefficients(
-            p, int(row[SEG_REGION]), slip, row[SEG_X0], row[SEG_V0], row[SEG_PHI]
-        )
+        if built != i:  # the same coefficients serve every sample of a segment
+            q = phase_coefficients(
+                p, int(row[SEG_REGION]), slip, row[SEG_X0], row[SEG_V0], row[SEG_PHI]
+            )
+            built = i
         tau = t - (row[SEG_PERIOD] * tf + row[SEG_T0])
         tau = min(max(tau, 0.0), row[SEG_DT])
         x, v, a, _ = evaluate(q, slip, tau)

@@ -482,6 +482,35 @@ def _contact_friction(
     return factor * total
 
 
+def _stages(regions: NDArray[np.int64], starts: FloatArray, ends: FloatArray) -> tuple[Stage, ...]:
+    """Merge consecutive segments of one region into stages; drop empty ones between others.
+
+    A segment of zero length (an event at the very instant another ended) opens no
+    stage of its own unless it is the first; one in the region of the stage before
+    it extends that stage to its end. Vectorised: one Stage per stage, not per segment.
+    """
+    n = regions.size
+    if n == 0:
+        return ()
+    index = np.arange(n)
+    opens = (ends > starts) | (index == 0)
+    # the last segment before each one that had a length (or the first): the stage it is in
+    before = np.maximum.accumulate(np.where(opens, index, 0))
+    before = np.concatenate(([0], before[:-1]))
+    keep = opens | (regions == regions[before])
+    kept_regions = regions[keep]
+    first = np.flatnonzero(np.concatenate(([True], kept_regions[1:] != kept_regions[:-1])))
+    last = np.concatenate((first[1:] - 1, [kept_regions.size - 1]))
+    kept_starts = starts[keep][first].tolist()
+    kept_ends = ends[keep][last].tolist()
+    return tuple(
+        Stage(STAGE_NAMES[region], start, end)
+        for region, start, end in zip(
+            kept_regions[first].tolist(), kept_starts, kept_ends, strict=True
+        )
+    )
+
+
 def _motion_fields(
     p: FloatArray,
     joint: Joint,
@@ -498,13 +527,7 @@ def _motion_fields(
     seg = run.segments
     starts = seg[:, kn.SEG_PERIOD] * tf + seg[:, kn.SEG_T0]
     ends = starts + seg[:, kn.SEG_DT]
-    stages: list[Stage] = []
-    for region, s, e in zip(seg[:, kn.SEG_REGION].astype(int), starts, ends, strict=True):
-        name = STAGE_NAMES[int(region)]
-        if stages and stages[-1].name == name:
-            stages[-1] = Stage(name, stages[-1].start, float(e))
-        elif e > s or not stages:
-            stages.append(Stage(name, float(s), float(e)))
+    stages = _stages(seg[:, kn.SEG_REGION].astype(np.int64), starts, ends)
     # extremes: v never changes sign inside a state, so they sit at state boundaries
     end_state = run.strobe[-1]
     boundary_x = np.concatenate((seg[:, kn.SEG_X0], [end_state[kn.S_X]]))
