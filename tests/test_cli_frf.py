@@ -137,3 +137,19 @@ def test_free_play_orbits_are_flagged_and_said_to_have_no_set_position(
     assert "free_play" in [e["kind"] for e in data["events"]]
     w = 2.0 * math.pi * data["frequency_hz"][-1]
     assert data["amplitude_m"][-1] == pytest.approx(1.0 / (w * math.sqrt(w * w + 4.0)), rel=1e-9)
+
+
+@pytest.mark.parametrize("frequency", ["0Hz", "--frequency=-3Hz", "1e400Hz"])
+def test_a_bad_fixed_frequency_names_the_option(
+    frequency: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the fixed frequency of --parameter force: the message names --frequency, not the
+    # Python argument omega_start in rad/s that the user never wrote
+    option = [frequency] if frequency.startswith("--") else ["--frequency", frequency]
+    args = ["frf", str(EXAMPLE), "--parameter", "force", "--from", "10N", "--to", "20N", *option]
+    code, _, err = run([*args, "--out", str(tmp_path / "x.nc")], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "--frequency must be finite and > 0" in err
+    assert "omega_start" not in err
+    assert not (tmp_path / "x.nc").exists()

@@ -943,6 +943,8 @@ def _run_frf(args: argparse.Namespace) -> int:
             if args.frequency
             else study.omega / (2.0 * math.pi)
         )
+        if not (math.isfinite(frequency) and frequency > 0.0):
+            raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
         curve = frequency_response(
             study.joint,
             start,
