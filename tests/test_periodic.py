@@ -569,3 +569,20 @@ def test_study_unstable_branch_passes_where_the_section_sits_on_an_impact_near_6
             **kw,  # type: ignore[arg-type]
         )
         assert np.max(np.abs(np.array(kicked.final_state) - z) / size) > 1e-3
+
+
+def test_reached_means_the_curve_ends_at_the_end_of_the_range() -> None:
+    # examples/study.toml (k0 = 0, friction, e = 0.8) followed down in force at 400 Hz: near
+    # 100 N the orbits stick (a multiplier exactly 1, a continuum), a step passes 100 N and
+    # no orbit converges at 100 N itself. The curve then ends short of the range, and
+    # stop_reason must say so rather than "reached" (which the CLI prints no warning for).
+    joint, kw = _study_losses()
+    kw.pop("force")
+    fr = frequency_response(
+        joint, 2000.0, 2 * math.pi * 400.0, None, parameter="force", force_stop=100.0, **kw
+    )  # type: ignore[arg-type]
+    if fr.stop_reason == "reached":
+        assert fr.force_amplitude[-1] == pytest.approx(100.0, rel=1e-12)
+    else:
+        assert "100" in fr.stop_reason
+        assert f"{fr.force_amplitude[-1]:.6g}" in fr.stop_reason
