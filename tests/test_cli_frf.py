@@ -153,3 +153,19 @@ def test_a_bad_fixed_frequency_names_the_option(
     assert "--frequency must be finite and > 0" in err
     assert "omega_start" not in err
     assert not (tmp_path / "x.nc").exists()
+
+
+@pytest.mark.parametrize("force", ['"0N"', '"nan N"'])
+def test_a_study_with_a_zero_or_nan_force_names_the_file_and_the_key(
+    force: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    study = tmp_path / "zero.toml"
+    text = EXAMPLE.read_text(encoding="utf-8").replace('"47.37N"', force)
+    study.write_text(text, encoding="utf-8")
+    args = ["frf", str(study), "--from", "10Hz", "--to", "20Hz", "--out", str(tmp_path / "x.nc")]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "zero.toml" in err
+    assert "[excitation] force_amplitude" in err
+    assert not (tmp_path / "x.nc").exists()

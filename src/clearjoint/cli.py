@@ -958,6 +958,11 @@ def _run_frf(args: argparse.Namespace) -> int:
     else:
         if args.frequency:
             raise ParameterError("--frequency goes with --parameter force; drop it or add that")
+        if not (math.isfinite(study.force_amplitude) and study.force_amplitude > 0.0):
+            raise ParameterError(
+                f"{study.source}: [excitation] force_amplitude must be finite and > 0, got "
+                f"{study.force_amplitude!r} N; give the force the curve is followed at, e.g. 100N"
+            )
         curve = frequency_response(
             study.joint,
             study.force_amplitude,
