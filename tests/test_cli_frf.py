@@ -169,3 +169,14 @@ def test_a_study_with_a_zero_or_nan_force_names_the_file_and_the_key(
     assert "zero.toml" in err
     assert "[excitation] force_amplitude" in err
     assert not (tmp_path / "x.nc").exists()
+
+
+@pytest.mark.parametrize("points", ["1", "0", "-3"])
+def test_too_few_max_points_names_the_option(
+    points: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["frf", str(EXAMPLE), "--from", "10Hz", "--to", "20Hz", f"--max-points={points}"]
+    code, _, err = run([*args, "--out", str(tmp_path / "x.nc")], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "--max-points must be >= 2" in err

@@ -918,6 +918,8 @@ def _run_frf(args: argparse.Namespace) -> int:
             f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
             "give two different values"
         )
+    if args.max_points < 2:
+        raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
     if structure_study is not None:
         curve = _frf_of_structure(args, structure_study, start, stop)
         return _finish_frf(args, curve, structure_study.source, plot_path)
