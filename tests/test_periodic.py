@@ -586,3 +586,24 @@ def test_reached_means_the_curve_ends_at_the_end_of_the_range() -> None:
     else:
         assert "100" in fr.stop_reason
         assert f"{fr.force_amplitude[-1]:.6g}" in fr.stop_reason
+
+
+def test_a_period_doubling_at_a_kink_is_not_said_to_pass_minus_1() -> None:
+    # examples/study.toml from 400 down to 300 Hz: the period-1 orbit loses stability through
+    # -1 near 314.4 Hz, regains it at a sticking corner near 310.27 Hz, where its multiplier
+    # jumps from about -1.24 to -0.55 (the Jacobian jumps), and loses it again near 302.1 Hz.
+    # Only where the multipliers on both sides are near -1 does one pass -1 smoothly.
+    joint, kw = _study_losses()
+    force = kw.pop("force")
+    fr = frequency_response(joint, force, 2 * math.pi * 400.0, 2 * math.pi * 300.0, **kw)  # type: ignore[arg-type]
+    doublings = [e for e in fr.events if e.kind == "period_doubling"]
+    assert len(doublings) == 3
+    f = fr.omega / (2 * math.pi)
+    for event in doublings:
+        hz = event.omega / (2 * math.pi)
+        i = int(np.argmin(np.abs(f - hz)))
+        near = fr.multipliers[max(i - 1, 0) : i + 2, 0].real  # the -1-side multiplier around it
+        smooth = bool(np.all(np.abs(near + 1.0) < 0.15))
+        assert ("passes -1" in event.note) == smooth, (hz, near, event.note)
+        assert ("jumps across -1" in event.note) == (not smooth)
+    assert sum("jumps across -1" in e.note for e in doublings) == 1

@@ -1235,7 +1235,15 @@ def _events(
             def at(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
                 return float(a[i] + frac * (a[i + 1] - a[i]))
 
-            events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), note)))
+            said = note
+            if kind == "period_doubling" and kinks is not None and int(i) + 1 in kinks:
+                # across a kink the multiplier jumps over -1 rather than passing it: a
+                # nonsmooth bifurcation, after which no period-2 branch need exist
+                said = (
+                    "a multiplier jumps across -1 at a kink of the branch (a nonsmooth "
+                    "bifurcation): a period-2 branch may or may not be born here (not checked)"
+                )
+            events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), said)))
     for n, k in enumerate(kinks if kinks is not None else []):
         before = int(k) - 1
         if not any(index == before and e.kind == "grazing" for index, e in events):
