@@ -180,3 +180,21 @@ def test_too_few_max_points_names_the_option(
     assert code == 2
     assert len(err.strip().splitlines()) == 1
     assert "--max-points must be >= 2" in err
+
+
+def test_json_says_why_the_curve_stopped(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a curve cut short (here by --max-points) is partial: the JSON itself must say so, not
+    # only the warning line on stderr that a script reading stdout never sees
+    args = ["frf", str(EXAMPLE), "--from", "10Hz", "--to", "360Hz", "--max-points", "5"]
+    code, text, err = run([*args, "--out", str(tmp_path / "x.nc"), "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    assert len(data["frequency_hz"]) == 5
+    assert data["frequency_hz"][-1] < 360.0
+    assert data["stop_reason"] == "max_points"
+    assert "stopped early" in err
+    code, text, err = run([*args[:-2], "--out", str(tmp_path / "y.nc"), "--json"], capsys)
+    assert code == 0, err
+    assert json.loads(text)["stop_reason"] == "reached"

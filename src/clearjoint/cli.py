@@ -1014,6 +1014,7 @@ def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Pa
                         for e in curve.events
                     ],
                     **({"free_play": free.tolist()} if free is not None else {}),
+                    "stop_reason": curve.stop_reason,
                 }
             )
         )
