@@ -607,3 +607,32 @@ def test_a_period_doubling_at_a_kink_is_not_said_to_pass_minus_1() -> None:
         assert ("passes -1" in event.note) == smooth, (hz, near, event.note)
         assert ("jumps across -1" in event.note) == (not smooth)
     assert sum("jumps across -1" in e.note for e in doublings) == 1
+
+
+def test_plot_marks_each_event_at_its_frequency_in_hz_and_dashes_the_middle_branch(
+    curve: FrequencyResponse,
+) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    ax = curve.plot()
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    for kind in ("fold", "grazing"):
+        hz = sorted(e.omega / (2 * math.pi) for e in curve.events if e.kind == kind)
+        assert sorted(lines[kind].get_xdata()) == pytest.approx(hz)
+        assert lines[kind].get_linestyle() == "None"
+    # the dashed pieces lie between the two folds (0.17 to 0.25 Hz), in Hz, in mm
+    folds = sorted(e.omega / (2 * math.pi) for e in curve.events if e.kind == "fold")
+    dashed = [
+        line for line in ax.get_lines() if line.get_linestyle() == "--" and len(line.get_xdata())
+    ]
+    assert dashed
+    for line in dashed:
+        x = np.asarray(line.get_xdata())
+        assert folds[0] - 1e-3 <= x.min()
+        assert x.max() <= folds[1] + 1e-3
+        # in mm: the unstable orbits' X (0.17 to 0.40 m here) times 1e3
+        assert np.max(line.get_ydata()) == pytest.approx(
+            1e3 * curve.amplitude[~curve.stable].max(), rel=1e-12
+        )
+    matplotlib.pyplot.close("all")
