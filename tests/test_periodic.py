@@ -15,7 +15,7 @@ import pytest
 
 from clearjoint import Friction, Joint, ParameterError
 from clearjoint.periodic import FrequencyResponse, frequency_response, periodic_orbit
-from clearjoint.simulate import frequency_sweep, steady_state, time_response
+from clearjoint.simulate import SimulationError, frequency_sweep, steady_state, time_response
 from clearjoint.stiffness import equivalent_linear_response
 
 #: pyHarm's SDOF clearance case: m = 1, c_v = 0.05, k0 = 1, edges at +-0.1745, contact adds 3.
@@ -636,3 +636,14 @@ def test_plot_marks_each_event_at_its_frequency_in_hz_and_dashes_the_middle_bran
             1e3 * curve.amplitude[~curve.stable].max(), rel=1e-12
         )
     matplotlib.pyplot.close("all")
+
+
+def test_an_undamped_start_at_a_whole_fraction_of_the_gap_frequency_gets_the_right_advice() -> None:
+    # no damping (the default) and omega_start = sqrt(k0/m) / 2: the linear orbit inside the
+    # gap has the multipliers exp(+-2 pi i sqrt(k0/m) / omega) = 1, a continuum of orbits
+    # (any free oscillation can be added). gap_stiffness is already > 0 here, so the advice
+    # to give gap_stiffness > 0 would be wrong: it must name the damping.
+    with pytest.raises(SimulationError, match="damping_ratio > 0") as caught:
+        frequency_response(PYHARM, F0, 0.5, 1.8)
+    assert "give gap_stiffness > 0" not in str(caught.value)
+    assert "1.0 rad/s" in str(caught.value)  # sqrt(k0/m), the gap's natural frequency

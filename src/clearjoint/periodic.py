@@ -844,6 +844,17 @@ def frequency_response(
             "continuum of orbits (it stays in the gap with gap_stiffness = 0, or sticks), so "
             "no single curve exists; give gap_stiffness > 0 or start where the joint is in contact"
         )
+        inside = joint.compression_gap > first.x_max and first.x_min > -joint.tension_gap
+        if inside and joint.gap_stiffness > 0.0 and damping_ratio == 0.0 and friction is None:
+            # undamped inside the gap: the linear orbit's multipliers are exp(+-2 pi i w_g / w),
+            # exactly 1 where omega divides w_g, and any free oscillation can be added to it
+            w_g = math.sqrt(joint.gap_stiffness / joint.mass)
+            refusal = SimulationError(
+                f"the orbit at the start ({first!r}) has a multiplier of exactly 1: without "
+                f"damping, omega_start = {w0!r} rad/s divides the gap's natural frequency "
+                f"sqrt(k0/m) = {w_g!r} rad/s, so a free oscillation can be added to the orbit "
+                "(a continuum, no single curve); give damping_ratio > 0 or another omega_start"
+            )
         if parameter != "omega" or joint.gap_stiffness != 0.0:
             raise refusal
         # a free-play orbit at the start: follow the curve from the other end, which ends on
