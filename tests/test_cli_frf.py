@@ -198,3 +198,15 @@ def test_json_says_why_the_curve_stopped(
     code, text, err = run([*args[:-2], "--out", str(tmp_path / "y.nc"), "--json"], capsys)
     assert code == 0, err
     assert json.loads(text)["stop_reason"] == "reached"
+
+
+def test_a_bad_fixed_frequency_of_a_structure_study_names_the_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mast = EXAMPLE.parent / "mast.toml"
+    args = ["frf", str(mast), "--method", "harmonic", "--parameter", "force"]
+    args += ["--from", "10N", "--to", "20N", "--frequency", "0Hz", "--out", str(tmp_path / "m.nc")]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "--frequency must be finite and > 0" in err

@@ -1114,6 +1114,8 @@ def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: 
             if args.frequency
             else study.omega / (2.0 * math.pi)
         )
+        if not (math.isfinite(frequency) and frequency > 0.0):
+            raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
         pattern = study.force * (start / float(np.max(np.abs(study.force))))
         return harmonic.frequency_response(
             study.structure,
