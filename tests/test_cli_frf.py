@@ -137,3 +137,76 @@ def test_free_play_orbits_are_flagged_and_said_to_have_no_set_position(
     assert "free_play" in [e["kind"] for e in data["events"]]
     w = 2.0 * math.pi * data["frequency_hz"][-1]
     assert data["amplitude_m"][-1] == pytest.approx(1.0 / (w * math.sqrt(w * w + 4.0)), rel=1e-9)
+
+
+@pytest.mark.parametrize("frequency", ["0Hz", "--frequency=-3Hz", "1e400Hz"])
+def test_a_bad_fixed_frequency_names_the_option(
+    frequency: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the fixed frequency of --parameter force: the message names --frequency, not the
+    # Python argument omega_start in rad/s that the user never wrote
+    option = [frequency] if frequency.startswith("--") else ["--frequency", frequency]
+    args = ["frf", str(EXAMPLE), "--parameter", "force", "--from", "10N", "--to", "20N", *option]
+    code, _, err = run([*args, "--out", str(tmp_path / "x.nc")], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "--frequency must be finite and > 0" in err
+    assert "omega_start" not in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+@pytest.mark.parametrize("force", ['"0N"', '"nan N"'])
+def test_a_study_with_a_zero_or_nan_force_names_the_file_and_the_key(
+    force: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    study = tmp_path / "zero.toml"
+    text = EXAMPLE.read_text(encoding="utf-8").replace('"47.37N"', force)
+    study.write_text(text, encoding="utf-8")
+    args = ["frf", str(study), "--from", "10Hz", "--to", "20Hz", "--out", str(tmp_path / "x.nc")]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "zero.toml" in err
+    assert "[excitation] force_amplitude" in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+@pytest.mark.parametrize("points", ["1", "0", "-3"])
+def test_too_few_max_points_names_the_option(
+    points: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["frf", str(EXAMPLE), "--from", "10Hz", "--to", "20Hz", f"--max-points={points}"]
+    code, _, err = run([*args, "--out", str(tmp_path / "x.nc")], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "--max-points must be >= 2" in err
+
+
+def test_json_says_why_the_curve_stopped(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a curve cut short (here by --max-points) is partial: the JSON itself must say so, not
+    # only the warning line on stderr that a script reading stdout never sees
+    args = ["frf", str(EXAMPLE), "--from", "10Hz", "--to", "360Hz", "--max-points", "5"]
+    code, text, err = run([*args, "--out", str(tmp_path / "x.nc"), "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    assert len(data["frequency_hz"]) == 5
+    assert data["frequency_hz"][-1] < 360.0
+    assert data["stop_reason"] == "max_points"
+    assert "stopped early" in err
+    code, text, err = run([*args[:-2], "--out", str(tmp_path / "y.nc"), "--json"], capsys)
+    assert code == 0, err
+    assert json.loads(text)["stop_reason"] == "reached"
+
+
+def test_a_bad_fixed_frequency_of_a_structure_study_names_the_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mast = EXAMPLE.parent / "mast.toml"
+    args = ["frf", str(mast), "--method", "harmonic", "--parameter", "force"]
+    args += ["--from", "10N", "--to", "20N", "--frequency", "0Hz", "--out", str(tmp_path / "m.nc")]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert "--frequency must be finite and > 0" in err

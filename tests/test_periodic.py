@@ -15,7 +15,7 @@ import pytest
 
 from clearjoint import Friction, Joint, ParameterError
 from clearjoint.periodic import FrequencyResponse, frequency_response, periodic_orbit
-from clearjoint.simulate import frequency_sweep, steady_state, time_response
+from clearjoint.simulate import SimulationError, frequency_sweep, steady_state, time_response
 from clearjoint.stiffness import equivalent_linear_response
 
 #: pyHarm's SDOF clearance case: m = 1, c_v = 0.05, k0 = 1, edges at +-0.1745, contact adds 3.
@@ -569,3 +569,81 @@ def test_study_unstable_branch_passes_where_the_section_sits_on_an_impact_near_6
             **kw,  # type: ignore[arg-type]
         )
         assert np.max(np.abs(np.array(kicked.final_state) - z) / size) > 1e-3
+
+
+def test_reached_means_the_curve_ends_at_the_end_of_the_range() -> None:
+    # examples/study.toml (k0 = 0, friction, e = 0.8) followed down in force at 400 Hz: near
+    # 100 N the orbits stick (a multiplier exactly 1, a continuum), a step passes 100 N and
+    # no orbit converges at 100 N itself. The curve then ends short of the range, and
+    # stop_reason must say so rather than "reached" (which the CLI prints no warning for).
+    joint, kw = _study_losses()
+    kw.pop("force")
+    fr = frequency_response(
+        joint, 2000.0, 2 * math.pi * 400.0, None, parameter="force", force_stop=100.0, **kw
+    )  # type: ignore[arg-type]
+    if fr.stop_reason == "reached":
+        assert fr.force_amplitude[-1] == pytest.approx(100.0, rel=1e-12)
+    else:
+        assert "100" in fr.stop_reason
+        assert f"{fr.force_amplitude[-1]:.6g}" in fr.stop_reason
+
+
+def test_a_period_doubling_at_a_kink_is_not_said_to_pass_minus_1() -> None:
+    # examples/study.toml from 400 down to 300 Hz: the period-1 orbit loses stability through
+    # -1 near 314.4 Hz, regains it at a sticking corner near 310.27 Hz, where its multiplier
+    # jumps from about -1.24 to -0.55 (the Jacobian jumps), and loses it again near 302.1 Hz.
+    # Only where the multipliers on both sides are near -1 does one pass -1 smoothly.
+    joint, kw = _study_losses()
+    force = kw.pop("force")
+    fr = frequency_response(joint, force, 2 * math.pi * 400.0, 2 * math.pi * 300.0, **kw)  # type: ignore[arg-type]
+    doublings = [e for e in fr.events if e.kind == "period_doubling"]
+    assert len(doublings) == 3
+    f = fr.omega / (2 * math.pi)
+    for event in doublings:
+        hz = event.omega / (2 * math.pi)
+        i = int(np.argmin(np.abs(f - hz)))
+        near = fr.multipliers[max(i - 1, 0) : i + 2, 0].real  # the -1-side multiplier around it
+        smooth = bool(np.all(np.abs(near + 1.0) < 0.15))
+        assert ("passes -1" in event.note) == smooth, (hz, near, event.note)
+        assert ("jumps across -1" in event.note) == (not smooth)
+    assert sum("jumps across -1" in e.note for e in doublings) == 1
+
+
+def test_plot_marks_each_event_at_its_frequency_in_hz_and_dashes_the_middle_branch(
+    curve: FrequencyResponse,
+) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    ax = curve.plot()
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    for kind in ("fold", "grazing"):
+        hz = sorted(e.omega / (2 * math.pi) for e in curve.events if e.kind == kind)
+        assert sorted(lines[kind].get_xdata()) == pytest.approx(hz)
+        assert lines[kind].get_linestyle() == "None"
+    # the dashed pieces lie between the two folds (0.17 to 0.25 Hz), in Hz, in mm
+    folds = sorted(e.omega / (2 * math.pi) for e in curve.events if e.kind == "fold")
+    dashed = [
+        line for line in ax.get_lines() if line.get_linestyle() == "--" and len(line.get_xdata())
+    ]
+    assert dashed
+    for line in dashed:
+        x = np.asarray(line.get_xdata())
+        assert folds[0] - 1e-3 <= x.min()
+        assert x.max() <= folds[1] + 1e-3
+        # in mm: the unstable orbits' X (0.17 to 0.40 m here) times 1e3
+        assert np.max(line.get_ydata()) == pytest.approx(
+            1e3 * curve.amplitude[~curve.stable].max(), rel=1e-12
+        )
+    matplotlib.pyplot.close("all")
+
+
+def test_an_undamped_start_at_a_whole_fraction_of_the_gap_frequency_gets_the_right_advice() -> None:
+    # no damping (the default) and omega_start = sqrt(k0/m) / 2: the linear orbit inside the
+    # gap has the multipliers exp(+-2 pi i sqrt(k0/m) / omega) = 1, a continuum of orbits
+    # (any free oscillation can be added). gap_stiffness is already > 0 here, so the advice
+    # to give gap_stiffness > 0 would be wrong: it must name the damping.
+    with pytest.raises(SimulationError, match="damping_ratio > 0") as caught:
+        frequency_response(PYHARM, F0, 0.5, 1.8)
+    assert "give gap_stiffness > 0" not in str(caught.value)
+    assert "1.0 rad/s" in str(caught.value)  # sqrt(k0/m), the gap's natural frequency

@@ -918,6 +918,8 @@ def _run_frf(args: argparse.Namespace) -> int:
             f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
             "give two different values"
         )
+    if args.max_points < 2:
+        raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
     if structure_study is not None:
         curve = _frf_of_structure(args, structure_study, start, stop)
         return _finish_frf(args, curve, structure_study.source, plot_path)
@@ -943,6 +945,8 @@ def _run_frf(args: argparse.Namespace) -> int:
             if args.frequency
             else study.omega / (2.0 * math.pi)
         )
+        if not (math.isfinite(frequency) and frequency > 0.0):
+            raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
         curve = frequency_response(
             study.joint,
             start,
@@ -956,6 +960,11 @@ def _run_frf(args: argparse.Namespace) -> int:
     else:
         if args.frequency:
             raise ParameterError("--frequency goes with --parameter force; drop it or add that")
+        if not (math.isfinite(study.force_amplitude) and study.force_amplitude > 0.0):
+            raise ParameterError(
+                f"{study.source}: [excitation] force_amplitude must be finite and > 0, got "
+                f"{study.force_amplitude!r} N; give the force the curve is followed at, e.g. 100N"
+            )
         curve = frequency_response(
             study.joint,
             study.force_amplitude,
@@ -1005,6 +1014,7 @@ def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Pa
                         for e in curve.events
                     ],
                     **({"free_play": free.tolist()} if free is not None else {}),
+                    "stop_reason": curve.stop_reason,
                 }
             )
         )
@@ -1104,6 +1114,8 @@ def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: 
             if args.frequency
             else study.omega / (2.0 * math.pi)
         )
+        if not (math.isfinite(frequency) and frequency > 0.0):
+            raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
         pattern = study.force * (start / float(np.max(np.abs(study.force))))
         return harmonic.frequency_response(
             study.structure,

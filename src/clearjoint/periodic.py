@@ -844,6 +844,17 @@ def frequency_response(
             "continuum of orbits (it stays in the gap with gap_stiffness = 0, or sticks), so "
             "no single curve exists; give gap_stiffness > 0 or start where the joint is in contact"
         )
+        inside = joint.compression_gap > first.x_max and first.x_min > -joint.tension_gap
+        if inside and joint.gap_stiffness > 0.0 and damping_ratio == 0.0 and friction is None:
+            # undamped inside the gap: the linear orbit's multipliers are exp(+-2 pi i w_g / w),
+            # exactly 1 where omega divides w_g, and any free oscillation can be added to it
+            w_g = math.sqrt(joint.gap_stiffness / joint.mass)
+            refusal = SimulationError(
+                f"the orbit at the start ({first!r}) has a multiplier of exactly 1: without "
+                f"damping, omega_start = {w0!r} rad/s divides the gap's natural frequency "
+                f"sqrt(k0/m) = {w_g!r} rad/s, so a free oscillation can be added to the orbit "
+                "(a continuum, no single curve); give damping_ratio > 0 or another omega_start"
+            )
         if parameter != "omega" or joint.gap_stiffness != 0.0:
             raise refusal
         # a free-play orbit at the start: follow the curve from the other end, which ends on
@@ -959,6 +970,14 @@ def frequency_response(
         initial_state = np.concatenate((initial_state, tail[:, R_RES : R_RES + 2]))
         free_play = np.concatenate((free_play, np.ones(len(tail), dtype=bool)))
         reason = "reached" if tail[-1, N_RES] == stop else "max_points"
+    if reason == "reached" and abs(lam_all[-1] - stop) > 1e-12 * abs(stop - start):
+        # a step passed the end but no orbit converged at the end itself (e.g. a continuum
+        # of sticking orbits there): the curve is short of the range, so say so
+        unit = "rad/s" if parameter == "omega" else "N"
+        reason = (
+            f"passed the end of the range ({stop:.6g} {unit}) but no orbit converged there; "
+            f"the curve ends at {lam_all[-1]:.6g} {unit}"
+        )
     n = lam_all.size
     omega = lam_all.copy() if parameter == "omega" else np.full(n, w0)
     force = lam_all.copy() if parameter == "force" else np.full(n, f0)
@@ -1227,7 +1246,15 @@ def _events(
             def at(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
                 return float(a[i] + frac * (a[i + 1] - a[i]))
 
-            events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), note)))
+            said = note
+            if kind == "period_doubling" and kinks is not None and int(i) + 1 in kinks:
+                # across a kink the multiplier jumps over -1 rather than passing it: a
+                # nonsmooth bifurcation, after which no period-2 branch need exist
+                said = (
+                    "a multiplier jumps across -1 at a kink of the branch (a nonsmooth "
+                    "bifurcation): a period-2 branch may or may not be born here (not checked)"
+                )
+            events.append((int(i), ResponseEvent(kind, at(omega), at(force), at(amplitude), said)))
     for n, k in enumerate(kinks if kinks is not None else []):
         before = int(k) - 1
         if not any(index == before and e.kind == "grazing" for index, e in events):
