@@ -970,7 +970,8 @@ def frequency_response(
         initial_state = np.concatenate((initial_state, tail[:, R_RES : R_RES + 2]))
         free_play = np.concatenate((free_play, np.ones(len(tail), dtype=bool)))
         reason = "reached" if tail[-1, N_RES] == stop else "max_points"
-    if reason == "reached" and abs(lam_all[-1] - stop) > 1e-12 * abs(stop - start):
+    short = reason.startswith("passed the end")  # continue_branch says so itself
+    if short or (reason == "reached" and abs(lam_all[-1] - stop) > 1e-12 * abs(stop - start)):
         # a step passed the end but no orbit converged at the end itself (e.g. a continuum
         # of sticking orbits there): the curve is short of the range, so say so
         unit = "rad/s" if parameter == "omega" else "N"
