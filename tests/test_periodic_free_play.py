@@ -325,3 +325,24 @@ def test_study_force_curve_from_inside_the_gap_by_time_marching() -> None:
             size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
             assert np.max(np.abs(np.array(one.final_state) - start) / size) < 1e-8
             assert one.amplitude == pytest.approx(curve.amplitude[i], rel=1e-8)
+    # between the fold (220 N) and the junction (680 N) both kinds coexist, by time marching:
+    # near 400 N a free-play start kicked by 1 % in velocity stays in the gap with the
+    # curve's amplitude; from rest the joint settles on the stable contact orbit, which
+    # steady_state confirms
+    free = np.nonzero(curve.free_play)[0]
+    contact = np.nonzero(curve.stable)[0]
+    j = int(free[np.argmin(abs(curve.force_amplitude[free] - 400.0))])
+    k = int(contact[np.argmin(abs(curve.force_amplitude[contact] - 400.0))])
+    period = 2.0 * math.pi / w
+    for i, start, inside in ((j, curve.initial_state[j] * np.array([1.0, 1.01]), True),
+                             (k, np.zeros(2), False)):  # fmt: skip
+        f = float(curve.force_amplitude[i])
+        motion = time_response(study.joint, f, w, 100 * period, initial=start, **kw)  # type: ignore[arg-type]
+        last = time_response(study.joint, f, w, period, initial=motion.final_state, **kw)  # type: ignore[arg-type]
+        assert (last.x_max < gap) == inside
+        if inside:
+            assert last.amplitude == pytest.approx(curve.amplitude[i], rel=1e-8)
+    ss = steady_state(study.joint, f, w, initial=curve.initial_state[k] * (1.0 + 1e-6), **kw)  # type: ignore[arg-type]
+    assert ss.period_multiple == 1
+    assert abs(ss.x_max - curve.x_max[k]) / curve.amplitude[k] < 1e-9
+    assert last.amplitude == pytest.approx(curve.amplitude[k], rel=1e-6)
