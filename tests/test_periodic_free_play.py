@@ -283,6 +283,18 @@ def test_force_curve_followed_down_ends_on_the_free_play_orbits(
     assert np.max(np.abs(down.amplitude[down.free_play] / expected - 1.0)) < 1e-9
     # the curve started on the free-play orbits is this one turned round
     assert np.array_equal(down.force_amplitude, force_curve.force_amplitude[::-1])
+    # both ends only inside the gap (below the fold at 1.24 N): no single curve, said so
+    with pytest.raises(SimulationError, match="multiplier of exactly 1"):
+        frequency_response(
+            FREE,
+            0.5,
+            W_F,
+            None,
+            parameter="force",
+            force_stop=1.0,
+            damping_ratio=ZETA,
+            restitution=0.8,
+        )
 
 
 def test_study_force_curve_from_inside_the_gap_by_time_marching() -> None:
@@ -346,3 +358,23 @@ def test_study_force_curve_from_inside_the_gap_by_time_marching() -> None:
     assert ss.period_multiple == 1
     assert abs(ss.x_max - curve.x_max[k]) / curve.amplitude[k] < 1e-9
     assert last.amplitude == pytest.approx(curve.amplitude[k], rel=1e-6)
+
+
+def test_force_curve_from_the_coexistence_region_goes_round_the_fold_to_the_free_play() -> None:
+    # at 1.5 N (between the fold, 1.24 N, and the junction, 1.79 N) the transient finds the
+    # stable contact orbit; followed down, the curve goes round the fold, up the unstable
+    # branch past the start to the junction (2 X = clearance), then down the free play
+    curve = frequency_response(
+        FREE, 1.5, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA, restitution=0.8
+    )
+    assert curve.stop_reason == "reached"
+    assert curve.free_play is not None
+    assert not curve.free_play[0]
+    assert curve.free_play[-1]
+    assert curve.force_amplitude[-1] == pytest.approx(0.5, rel=1e-12)
+    f_g = 0.1 * W_F * math.sqrt(W_F**2 + C_V**2)
+    assert np.max(curve.force_amplitude) == pytest.approx(f_g, rel=1e-3)
+    assert [e.kind for e in curve.events].count("fold") >= 1
+    fp = curve.free_play
+    expected = curve.force_amplitude[fp] * _free_mass_amplitude(W_F)
+    assert np.max(np.abs(curve.amplitude[fp] / expected - 1.0)) < 1e-9
