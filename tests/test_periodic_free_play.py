@@ -378,3 +378,32 @@ def test_force_curve_from_the_coexistence_region_goes_round_the_fold_to_the_free
     fp = curve.free_play
     expected = curve.force_amplitude[fp] * _free_mass_amplitude(W_F)
     assert np.max(np.abs(curve.amplitude[fp] / expected - 1.0)) < 1e-9
+
+
+def test_without_impact_loss_the_curve_goes_on_along_the_free_play_too() -> None:
+    # restitution 1: past the junction the orbits that reach past an edge by a hair
+    # (members of the continuum pushed against it) used to be followed, 1e-5 N a step,
+    # to max_points; they count as not touching, and the curve goes on as with e < 1
+    f_g = 0.1 * W_F * math.sqrt(W_F**2 + C_V**2)
+    w_g = brentq(lambda w: 2.0 * _free_mass_amplitude(w) - 0.2, 1.0, 10.0)
+    by_force = frequency_response(
+        FREE, 5.0, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA
+    )
+    by_omega = frequency_response(FREE, 1.0, 2.0, 12.0, damping_ratio=ZETA)
+    for curve, junction in ((by_force, f_g), (by_omega, w_g)):
+        assert curve.stop_reason == "reached"
+        fp = curve.free_play
+        assert fp is not None
+        first = int(np.argmax(fp))
+        assert first > 10
+        assert fp[first:].all()
+        lam = curve.force_amplitude if curve.parameter == "force" else curve.omega
+        assert lam[first - 1] == pytest.approx(junction, rel=1e-3)
+        expected = curve.force_amplitude[fp] * _free_mass_amplitude(curve.omega[fp])
+        assert np.max(np.abs(curve.amplitude[fp] / expected - 1.0)) < 1e-9
+        # the last contact orbit closes under one period of time marching
+        i = first - 1
+        f, w, z = float(curve.force_amplitude[i]), float(curve.omega[i]), curve.initial_state[i]
+        one = time_response(FREE, f, w, 2.0 * math.pi / w, initial=z, damping_ratio=ZETA)
+        size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
+        assert np.max(np.abs(np.array(one.final_state) - z) / size) < 1e-8

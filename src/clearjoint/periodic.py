@@ -582,7 +582,7 @@ class _MapResidual:
         self.refused_at: list[float] = []
 
     def _refused(self, out: FloatArray) -> bool:
-        return self.free_play_stop and _in_gap(self.p, out)
+        return self.free_play_stop and _in_gap(self.p, out, _TOUCH)
 
     def __call__(
         self, u: FloatArray, lam: float, derivative: bool = True
@@ -680,13 +680,22 @@ def _map_residual(p: FloatArray, parameter: str, free_play_stop: bool = False) -
     return _MapResidual(p, parameter, free_play_stop)
 
 
-def _in_gap(p: FloatArray, out: FloatArray) -> bool:
+#: An orbit reaching past an edge by less than this fraction of the clearance counts as
+#: not touching it (with restitution 1 such orbits are the continuum's members pushed
+#: against an edge: a family the continuation would otherwise creep along).
+_TOUCH = 1e-7
+
+
+def _in_gap(p: FloatArray, out: FloatArray, slack: float = 0.0) -> bool:
     """With k0 = 0, an orbit that never reaches a gap edge (``out``: a map_residual row).
 
     Inside the gap the force does not depend on x, so the orbit shifted by any
     constant is an orbit too: a continuum, with a Floquet multiplier exactly 1.
     """
-    return bool(p[kn.P_K0] == 0.0 and out[R_XMAX] < p[kn.P_GC] and out[R_XMIN] > -p[kn.P_GT])
+    tol = slack * (p[kn.P_GC] + p[kn.P_GT])
+    return bool(
+        p[kn.P_K0] == 0.0 and out[R_XMAX] < p[kn.P_GC] + tol and out[R_XMIN] > -p[kn.P_GT] - tol
+    )
 
 
 def _free_play_orbit(p: FloatArray, omega: float, code: int = 0) -> FloatArray | None:
