@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 
 from clearjoint import stiffness
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.identify._stats import median
 from clearjoint.identify.cycles import (
     MIN_STEADY,
     IdentificationError,
@@ -591,14 +592,14 @@ def flag_outliers(results: list[Identification]) -> list[Identification]:
             continue
         for i in members:
             others = [results[j].summary["clearance_m"] for j in members if j != i]
-            median = float(np.median(others))
+            middle = median(others)
             c = results[i].summary["clearance_m"]
-            if median > 0 and c > 2.0 * median and results[i].flags["clearance_m"][0] == "ok":
+            if middle > 0 and c > 2.0 * middle and results[i].flags["clearance_m"][0] == "ok":
                 flags = dict(results[i].flags)
                 flags["clearance_m"] = (
                     "doubtful",
                     f"clearance {c * 1e3:.3g} mm is more than twice the median "
-                    f"{median * 1e3:.3g} mm of the other {len(others)} tests of {device}",
+                    f"{middle * 1e3:.3g} mm of the other {len(others)} tests of {device}",
                 )
                 out[i] = replace(results[i], flags=flags)
     return out
