@@ -117,6 +117,17 @@ def _step_fit(s: FloatArray) -> tuple[float, float, float, int]:
     return c, d, top - c, j
 
 
+def _slope(t: FloatArray, y: FloatArray) -> float:
+    """The least-squares straight line's slope through (t, y) (n,), in closed form.
+
+    The centred normal equation, as ``numpy.polyfit(t, y, 1)[0]`` solves it by an SVD, to
+    rounding; 0 when t does not vary.
+    """
+    tc = t - t.mean()
+    spread = float(tc @ tc)
+    return float(tc @ (y - y.mean())) / spread if spread > 0.0 else 0.0
+
+
 def _damper_fit(x: FloatArray, f: FloatArray, parts: tuple[slice, slice]) -> _Fit | None:
     """The damper model on one cycle average: None if the loop has no slip plateaus.
 
@@ -133,8 +144,7 @@ def _damper_fit(x: FloatArray, f: FloatArray, parts: tuple[slice, slice]) -> _Fi
             return None
         levels.append(median(fb[late]))
         # a slip plateau is flat: its straight-line change over its travel is small
-        slope = np.polyfit(travel[late], fb[late], 1)[0]
-        levels_change = abs(slope) * PLATEAU * total
+        levels_change = abs(_slope(travel[late], fb[late])) * PLATEAU * total
         levels.append(levels_change)
     rise, rise_change, fall, fall_change = levels
     delta = rise - fall
