@@ -297,11 +297,19 @@ def _identify_stack(
     x = xs.mean(axis=0)
     f = fs.mean(axis=0)
     noise_x = _noise_floor(xs)
-    v_crude, a_crude = _periodic_derivatives(x, st.step, noise_x)
-    v = st.channels["v"].mean(axis=0) if "v" in st.channels else v_crude
-    a = st.channels["a"].mean(axis=0) if "a" in st.channels else a_crude
     warnings: list[str] = []
     force_control = record.control == "force"
+    # the average's acceleration is used only under force control: with a measured
+    # velocity and no acceleration needed (a displacement-controlled BRFD record) the
+    # spectral derivatives are not taken; a is then the measured one or unused zeros
+    measured = "v" in st.channels and ("a" in st.channels or not force_control)
+    if measured:
+        v = st.channels["v"].mean(axis=0)
+        a = st.channels["a"].mean(axis=0) if "a" in st.channels else np.zeros_like(x)
+    else:
+        v_crude, a_crude = _periodic_derivatives(x, st.step, noise_x)
+        v = st.channels["v"].mean(axis=0) if "v" in st.channels else v_crude
+        a = st.channels["a"].mean(axis=0) if "a" in st.channels else a_crude
     mass: float | None = record.mass if force_control and record.mass else None
     mass_missing = force_control and mass is None
     m_guess = _estimate_mass(x, f, v, a) if mass_missing else (mass or 0.0)
@@ -309,25 +317,25 @@ def _identify_stack(
     parts = _branches_of(m, x)
     if parts is None:
         raise IdentificationError(f"{where}: the steady cycles' average has no rising branch")
-    windows = (
-        _windows(x[parts[0]], r[parts[0]], 3),
-        _windows(x[parts[1]], r[parts[1]], 3),
-    )
-    if _is_joint(windows[0]) != _is_joint(windows[1]):
-        # a stage too short to be found on one branch (e.g. a brief contact at a low
-        # force): the stages are places in x, the same on both branches, so the branch
-        # that shows all three lends them to the other
-        shown = windows[0] if _is_joint(windows[0]) else windows[1]
-        windows = (shown, shown)
     model = "line"
     system = None
     # a displacement-controlled loop whose branches end on slip plateaus is a damper
-    damper = record.control == "displacement" and _damper_fit(x, f, parts) is not None
-    first_fit = (
-        _joint_fit(x, r, v, parts, windows)
-        if not damper and _is_joint(windows[0]) and _is_joint(windows[1])
-        else None
-    )
+    head_damper = _damper_fit(x, f, parts) if record.control == "displacement" else None
+    damper = head_damper is not None
+    first_fit = None
+    if not damper:  # the stages are looked for only where a joint may be
+        windows = (
+            _windows(x[parts[0]], r[parts[0]], 3),
+            _windows(x[parts[1]], r[parts[1]], 3),
+        )
+        if _is_joint(windows[0]) != _is_joint(windows[1]):
+            # a stage too short to be found on one branch (e.g. a brief contact at a low
+            # force): the stages are places in x, the same on both branches, so the branch
+            # that shows all three lends them to the other
+            shown = windows[0] if _is_joint(windows[0]) else windows[1]
+            windows = (shown, shown)
+        if _is_joint(windows[0]) and _is_joint(windows[1]):
+            first_fit = _joint_fit(x, r, v, parts, windows)
     if damper:
         model = "damper"
     elif first_fit is not None:
@@ -379,11 +387,15 @@ def _identify_stack(
     else:
         # every replicate's velocity and restoring force, (G + 1, M), then the fits of all
         # replicates in one batched solve (row by row only if that solve is singular)
-        reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
-        if reps_a is not None:
-            reps_ad = reps_a
-        if "v" in st.channels:
+        if measured:  # as for the average: no spectral derivative is used
+            reps_ad = reps_a if reps_a is not None else np.zeros_like(reps_x)
             reps_v = np.broadcast_to(v, reps_x.shape)
+        else:
+            reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
+            if reps_a is not None:
+                reps_ad = reps_a
+            if "v" in st.channels:
+                reps_v = np.broadcast_to(v, reps_x.shape)
         reps_r = reps_f - m_guess * reps_ad if force_control else reps_f
         fits = []
         if model == "joint":
@@ -396,7 +408,11 @@ def _identify_stack(
                 ]
             fits = [fit or first_fit for fit in batch]
         elif model == "damper":
-            for xr_, fr_, rr_, vr_ in zip(reps_x, reps_f, reps_r, reps_v, strict=True):
+            assert head_damper is not None
+            fits.append(head_damper)  # replicate 0 is the average itself: fitted above
+            for xr_, fr_, rr_, vr_ in zip(
+                reps_x[1:], reps_f[1:], reps_r[1:], reps_v[1:], strict=True
+            ):
                 fits.append(_damper_fit(xr_, fr_, parts) or _line_fit(xr_, rr_, vr_))
         else:
             line_fits = _line_fits(reps_x, reps_r, reps_v)
