@@ -66,7 +66,6 @@ from clearjoint.identify.segments import (
     _line_fits,
     _windows,
 )
-from clearjoint.identify.weak import stage_runs, weak_fit, weak_system
 from clearjoint.joint import Joint
 from clearjoint.records import Record
 
@@ -343,6 +342,9 @@ def _identify_stack(
         margin = EDGE_MARGIN * (edges[1] - edges[0])
         model = "joint"
         if "a" not in st.channels:  # with a measured acceleration: fit the samples
+            # imported here: a damper or a line (the BRFD folder) never needs the weak form
+            from clearjoint.identify.weak import stage_runs, weak_system
+
             system = weak_system(x, v, st.step, stage_runs(x, edges, margin))
         if system is not None and np.bincount(system.stage).min() < MIN_EQUATIONS:
             system = None  # a contact too short for the weak form: fit sample by sample
@@ -362,6 +364,8 @@ def _identify_stack(
     masses: FloatArray
     residual = math.nan
     if model == "joint" and system is not None:
+        from clearjoint.identify.weak import weak_fit
+
         weak = weak_fit(
             system, reps_x, reps_f, mass=mass if force_control else 0.0, acceleration=reps_a
         )
