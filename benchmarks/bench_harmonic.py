@@ -41,6 +41,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -280,6 +281,80 @@ def example_mast_curve(points: int) -> None:
     )
 
 
+def example_mast(bays: int) -> tuple[Any, np.ndarray]:
+    """examples/mast.toml with ``bays`` bays, its force moved to the tip's x (n{2 bays + 1}x)."""
+    from clearjoint.structure.study import load_structure_study
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "mast.toml").read_text()
+    text = text.replace("bays = 10", f"bays = {bays}").replace(
+        'force_dof = "n21x"', f'force_dof = "n{2 * bays + 1}x"'
+    )
+    text = text.replace('dof = "n21x"', f'dof = "n{2 * bays + 1}x"')
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "mast.toml"
+        path.write_text(text)
+        study = load_structure_study(path)
+    assert study.force is not None
+    return study.structure, study.force
+
+
+#: The sizes of --mast-sizes: (bays, H).
+MAST_SIZES = "5:7,10:7,20:7,40:7,10:3,10:15"
+
+
+def mast_sizes(sizes: str, points: int, force_n: float) -> None:
+    """The example mast's cost against bays and H: the frequency response (``points``
+    points from 0.8 times the open first mode, the study's force pattern scaled to
+    ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes), one line each."""
+    from clearjoint.harmonic import nonlinear_modes
+
+    print(
+        f"examples/mast.toml with other bay counts; force {force_n} N at the tip (x); "
+        f"curves of {points} points at most from 0.8 x the open first mode, max_step "
+        f"{MAST_MAX_STEP}; modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
+    )
+    print(f"  load before: {os.getloadavg()[0]:.2f} (1-min average)")
+    for item in sizes.split(","):
+        bays, h = (int(v) for v in item.split(":"))
+        s, pattern = example_mast(bays)
+        force = pattern * (force_n / float(np.max(np.abs(pattern))))
+        f_open = float(s.modes("open").omega[0])
+        f_closed = float(s.modes("closed").omega[0])
+        unknowns = (2 * h + 1) * s.n_dof
+        start = time.perf_counter()
+        fr = frequency_response(
+            s,
+            force,
+            0.8 * f_open,
+            1.2 * f_closed,
+            harmonics=h,
+            max_points=points,
+            max_step=MAST_MAX_STEP,
+        )
+        took = time.perf_counter() - start
+        hz = fr.omega / (2 * math.pi)
+        print(
+            f"  {bays:2d} bays ({s.n_dof} DOF, {unknowns} unknowns), H = {h:2d}: curve "
+            f"{fr.omega.size} points in {took:8.1f} s ({took / fr.omega.size:.3f} s/point), "
+            f"{hz.min():.3f} to {hz.max():.3f} Hz (open {f_open / (2 * math.pi):.3f}, closed "
+            f"{f_closed / (2 * math.pi):.3f}), {int(np.sum(~fr.stable))} unstable, "
+            f"load {os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+        amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
+        start = time.perf_counter()
+        nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
+        took = time.perf_counter() - start
+        f = nm.frequency[nm.converged] / (2 * math.pi)
+        span = f"{f.min():.3f} to {f.max():.3f} Hz" if f.size else "none"
+        print(
+            f"  {bays:2d} bays, H = {h:2d}: mode, 50 amplitudes in {took:8.1f} s, "
+            f"{int(nm.converged.sum())}/50 converged, {span}, load {os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+
+
 def samples_error() -> None:
     """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
     from clearjoint.harmonic import aft, solve, system
@@ -321,7 +396,17 @@ def main() -> None:
         "--mast-curve", action="store_true", help="only the example mast's curve (--mast's last)"
     )
     parser.add_argument("--samples", action="store_true", help="the error against N_t instead")
+    parser.add_argument(
+        "--mast-sizes",
+        nargs="?",
+        const=MAST_SIZES,
+        help=f"the example mast's cost against bays and H, as BAYS:H,... (default {MAST_SIZES})",
+    )
+    parser.add_argument("--mast-force", type=float, default=MAST_FORCE_N, help="N, --mast-sizes")
     args = parser.parse_args()
+    if args.mast_sizes:
+        mast_sizes(args.mast_sizes, args.mast_points, args.mast_force)
+        return
     if args.samples:
         samples_error()
         return
