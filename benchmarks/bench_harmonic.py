@@ -355,6 +355,57 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> None:
         )
 
 
+def mast_decay(bays: int, beta: float, cycles: int) -> None:
+    """The example mast's first nonlinear mode (EPMC, H = 7) against its exact free decay.
+
+    As tests/test_harmonic_structure.py does on 2 bays: released on the closed first
+    mode at 2 mm x (bays / 2)^2 on the tip, ``cycles`` cycles of structure.free_decay read
+    per cycle on closed mode 1 (decay_backbone), against EPMC at the same peak amplitude.
+    """
+    from clearjoint import ClearanceJoint
+    from clearjoint.harmonic import nonlinear_modes
+    from clearjoint.structure import decay_backbone, free_decay, mast
+
+    j = ClearanceJoint(clearance=5e-5, compression_stiffness=5e7, gap_stiffness=1e5)
+    s = mast(bays, joints=j, rayleigh=(0.0, beta))
+    closed = s.modes("closed")
+    phi = closed.shapes[:, 0]
+    ref = int(np.argmax(np.abs(phi)))
+    start_amplitude = 2e-3 * (bays / 2) ** 2
+    period = 2.0 * math.pi / float(closed.omega[0])
+    start = time.perf_counter()
+    motion = free_decay(s, (start_amplitude * phi / phi[ref], np.zeros(s.n_dof)), cycles * period)
+    took_decay = time.perf_counter() - start
+    bb = decay_backbone(motion, ref, mode=1)
+    start = time.perf_counter()
+    a = bb.amplitude
+    nm = nonlinear_modes(s, 1, np.geomspace(0.8 * a.min(), 1.2 * a.max(), 30), harmonics=7)
+    took_mode = time.perf_counter() - start
+    ok = nm.converged
+    peak = 0.5 * (nm.x_max[ok, ref] - nm.x_min[ok, ref])
+    print(
+        f"mast, {bays} bays (50 um joints, k_c 5e7 N/m, k0 1e5 N/m, Rayleigh beta {beta:g} s): "
+        f"closed first mode {closed.omega[0] / (2 * math.pi):.3f} Hz, open "
+        f"{s.modes('open').omega[0] / (2 * math.pi):.3f} Hz; free decay from "
+        f"{1e3 * start_amplitude:.1f} mm on {s.dof_names[ref]}, {cycles} cycles in "
+        f"{took_decay:.1f} s ({motion.events} events); EPMC H = 7, 30 amplitudes in "
+        f"{took_mode:.1f} s, {int(ok.sum())}/30 converged"
+    )
+    print("  cycle  amplitude (mm)  decay (Hz)  EPMC (Hz)  rel. gap   zeta decay  zeta EPMC")
+    inside = (a >= peak.min()) & (a <= peak.max())
+    for k in range(a.size):
+        if not inside[k]:
+            print(f"  {k:5d}  {1e3 * a[k]:14.4f}  {bb.omega[k] / (2 * math.pi):10.4f}  (outside)")
+            continue
+        w_e = float(np.interp(a[k], peak, nm.frequency[ok]))
+        z_e = float(np.interp(a[k], peak, nm.damping_ratio[ok]))
+        print(
+            f"  {k:5d}  {1e3 * a[k]:14.4f}  {bb.omega[k] / (2 * math.pi):10.4f}  "
+            f"{w_e / (2 * math.pi):9.4f}  {bb.omega[k] / w_e - 1:+9.2e}  "
+            f"{bb.damping_ratio[k]:10.3e}  {z_e:9.3e}"
+        )
+
+
 def samples_error() -> None:
     """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
     from clearjoint.harmonic import aft, solve, system
@@ -403,7 +454,16 @@ def main() -> None:
         help=f"the example mast's cost against bays and H, as BAYS:H,... (default {MAST_SIZES})",
     )
     parser.add_argument("--mast-force", type=float, default=MAST_FORCE_N, help="N, --mast-sizes")
+    parser.add_argument(
+        "--mast-decay",
+        type=int,
+        metavar="BAYS",
+        help="a BAYS-bay mast's first nonlinear mode against its free decay instead",
+    )
     args = parser.parse_args()
+    if args.mast_decay:
+        mast_decay(args.mast_decay, 2e-5, 12)
+        return
     if args.mast_sizes:
         mast_sizes(args.mast_sizes, args.mast_points, args.mast_force)
         return
