@@ -406,6 +406,140 @@ def mast_decay(bays: int, beta: float, cycles: int) -> None:
         )
 
 
+def _example_at(force_n: float) -> tuple[Any, np.ndarray, int]:
+    s, pattern = example_mast(10)
+    force = pattern * (force_n / float(np.max(np.abs(pattern))))
+    return s, force, int(np.argmax(np.abs(force)))
+
+
+def mast_check(force_n: float, points: int, checks: int) -> None:
+    """The example mast's H = 7 curve at ``force_n`` with ``checks`` points run through one
+    exact period (clearjoint.harmonic.check): residual, exact events, orbit crossings."""
+    s, force, dof = _example_at(force_n)
+    start = time.perf_counter()
+    fr = frequency_response(
+        s,
+        force,
+        2 * math.pi * MAST_FROM_HZ,
+        2 * math.pi * MAST_TO_HZ,
+        harmonics=7,
+        max_points=points,
+        max_step=MAST_MAX_STEP,
+        check_points=checks,
+    )
+    hz = fr.omega / (2 * math.pi)
+    print(
+        f"examples/mast.toml at {force_n} N, H = 7: {fr.omega.size} points in "
+        f"{time.perf_counter() - start:.1f} s, {hz.min():.3f} to {hz.max():.3f} Hz, "
+        f"{int(np.sum(~fr.stable))} unstable; {fr.settings['orbit_check']!r}"
+    )
+    found = fr.settings["orbit_check"]
+    print("  point  f (Hz)   tip x_max (mm)  max|mu|    residual  exact events  HB crossings")
+    for m, i in enumerate(found.index):
+        print(
+            f"  {i:5d}  {hz[i]:.4f}  {1e3 * fr.x_max[i, dof]:14.4f}  "
+            f"{np.max(np.abs(fr.multipliers[i])):9.4g}  {found.residual[m]:8.2e}  "
+            f"{found.exact_events[m]:12d}  {found.orbit_crossings[m]:12d}"
+        )
+
+
+def mast_orders(force_n: float, freqs: list[float]) -> None:
+    """The example mast's HB orbit at H = 7, 15, 31 (each Newton from the one before,
+    padded with zeros): tip maximum, largest multiplier, one-period residual."""
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.response import _start
+    from clearjoint.harmonic.solve import newton
+    from clearjoint.harmonic.system import build
+
+    s, force, dof = _example_at(force_n)
+    model = build(s, 0.0, None, 1.0)
+    n, k_ref = s.n_dof, model.reference_stiffness
+    for f in freqs:
+        w = 2 * math.pi * f
+        prev = None
+        for h in (7, 15, 31):
+            basis = aft.Basis.make(h, 1 << math.ceil(math.log2(32 * (2 * h + 1))))
+
+            def function(
+                q: np.ndarray, basis: aft.Basis = basis, w: float = w
+            ) -> tuple[np.ndarray, np.ndarray]:
+                ev = aft.evaluate(model, basis, q, w, force)
+                return ev.residual / k_ref, ev.jacobian / k_ref
+
+            if prev is None:
+                q = _start(model, basis, w, force, k_ref)
+            else:
+                q0 = np.zeros((2 * h + 1, n))
+                q0[: prev.shape[0]] = prev
+                found = newton(function, q0.ravel(), float(np.max(np.abs(q0))))
+                if found is None:
+                    print(f"  {force_n} N, {f} Hz, H = {h}: no orbit (Newton from H's before)")
+                    break
+                q = found[0]
+            coef = q.reshape(2 * h + 1, n)
+            prev = coef
+            fr_like = _one_point(s, force, w, h, basis, coef)
+            mu = monodromy.multipliers(model, basis, coef, w)
+            top, _ = basis.extremes(coef)
+            print(
+                f"  {force_n} N, {f} Hz, H = {h:2d}: tip x_max {1e3 * top[dof]:.4f} mm, "
+                f"max|mu| {np.max(np.abs(mu)):.4g}, residual {fr_like[0]:.2e}, exact events "
+                f"{fr_like[1]}, HB crossings {monodromy.crossings(model, basis, coef).size}",
+                flush=True,
+            )
+
+
+def _one_point(
+    s: Any, force: np.ndarray, w: float, h: int, basis: Any, coef: np.ndarray
+) -> tuple[float, int]:
+    """One period of exact motion from an HB orbit's state: (residual, events)."""
+    from clearjoint.structure import time_response
+
+    n = s.n_dof
+    row = np.zeros(2 * h + 1)
+    row[2::2] = np.arange(1, h + 1)
+    x = np.concatenate((coef[0] + coef[1::2].sum(axis=0), w * (row @ coef)))
+    m = time_response(s, force, w, 2 * math.pi / w, initial=(x[:n], x[n:]), samples_per_period=8)
+    scale = np.concatenate((np.ones(n), np.full(n, 1 / w)))
+    r = np.linalg.norm(scale * (np.concatenate(m.final_state) - x)) / np.linalg.norm(scale * x)
+    return float(r), int(m.events)
+
+
+def mast_shoot(force_n: float, f: float, iterations: int) -> None:
+    """Look for the exact periodic orbit near the H = 7 one: x <- x - (Phi_HB - I)^-1 (P(x) - x),
+    P one period of exact motion, Phi_HB the HB orbit's monodromy (a fixed Jacobian)."""
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.response import _start
+    from clearjoint.harmonic.system import build
+    from clearjoint.structure import time_response
+
+    s, force, dof = _example_at(force_n)
+    model = build(s, 0.0, None, 1.0)
+    n, w = s.n_dof, 2 * math.pi * f
+    basis = aft.Basis.make(7, 512)
+    coef = _start(model, basis, w, force, model.reference_stiffness).reshape(15, n)
+    jac = monodromy.monodromy(model, basis, coef, w) - np.eye(2 * n)
+    row = np.zeros(15)
+    row[2::2] = np.arange(1, 8)
+    x = np.concatenate((coef[0] + coef[1::2].sum(axis=0), w * (row @ coef)))
+    x_hb = x.copy()
+    scale = np.concatenate((np.ones(n), np.full(n, 1 / w)))
+    top, _ = basis.extremes(coef)
+    print(f"  {force_n} N, {f} Hz: HB (H = 7) tip x_max {1e3 * top[dof]:.4f} mm")
+    for k in range(iterations):
+        m = time_response(s, force, w, 2 * math.pi / w, initial=(x[:n], x[n:]))
+        miss = np.concatenate(m.final_state) - x
+        r = np.linalg.norm(scale * miss) / np.linalg.norm(scale * x)
+        d = np.linalg.norm(scale * (x - x_hb)) / np.linalg.norm(scale * x_hb)
+        print(
+            f"    iteration {k}: residual {r:.2e}, tip max over the period "
+            f"{1e3 * m.u[:, dof].max():.4f} mm, {m.events} events, distance from the HB state "
+            f"{d:.2e}",
+            flush=True,
+        )
+        x = x - np.linalg.solve(jac, miss)
+
+
 def samples_error() -> None:
     """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
     from clearjoint.harmonic import aft, solve, system
@@ -460,7 +594,22 @@ def main() -> None:
         metavar="BAYS",
         help="a BAYS-bay mast's first nonlinear mode against its free decay instead",
     )
+    parser.add_argument("--mast-check", type=float, metavar="N", help="the check at N newtons")
+    parser.add_argument("--mast-orders", type=float, metavar="N", help="H = 7, 15, 31 at N")
+    parser.add_argument("--mast-shoot", type=float, metavar="N", help="exact orbit near HB at N")
+    parser.add_argument("--at", default="0.9,1.28", help="Hz list for --mast-orders/--mast-shoot")
     args = parser.parse_args()
+    freqs = [float(v) for v in args.at.split(",")]
+    if args.mast_check:
+        mast_check(args.mast_check, args.mast_points, 25)
+        return
+    if args.mast_orders:
+        mast_orders(args.mast_orders, freqs)
+        return
+    if args.mast_shoot:
+        for f in freqs:
+            mast_shoot(args.mast_shoot, f, 6)
+        return
     if args.mast_decay:
         mast_decay(args.mast_decay, 2e-5, 12)
         return
