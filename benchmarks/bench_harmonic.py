@@ -594,6 +594,7 @@ def main() -> None:
         metavar="BAYS",
         help="a BAYS-bay mast's first nonlinear mode against its free decay instead",
     )
+    parser.add_argument("--decay-cycles", type=int, default=12, help="cycles, --mast-decay")
     parser.add_argument("--mast-check", type=float, metavar="N", help="the check at N newtons")
     parser.add_argument("--mast-orders", type=float, metavar="N", help="H = 7, 15, 31 at N")
     parser.add_argument("--mast-shoot", type=float, metavar="N", help="exact orbit near HB at N")
@@ -611,7 +612,7 @@ def main() -> None:
             mast_shoot(args.mast_shoot, f, 6)
         return
     if args.mast_decay:
-        mast_decay(args.mast_decay, 2e-5, 12)
+        mast_decay(args.mast_decay, 2e-5, args.decay_cycles)
         return
     if args.mast_sizes:
         mast_sizes(args.mast_sizes, args.mast_points, args.mast_force)
