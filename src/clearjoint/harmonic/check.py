@@ -34,6 +34,8 @@ if TYPE_CHECKING:
 
     from clearjoint.periodic import FrequencyResponse
 
+__all__ = ["RESIDUAL_TOLERANCE", "OrbitCheck", "check_orbits", "spread", "untrusted_events"]
+
 FloatArray = NDArray[np.float64]
 
 #: Largest one-period residual r of an orbit whose stability verdict is trusted. The
