@@ -5,7 +5,7 @@ from the orbit's state x = (u(0), u'(0)), the exact event-driven motion of
 :func:`clearjoint.structure.time_response` (MODEL.md 5.2) over one period T = 2 pi / w
 returns to x exactly when the orbit is the exact one. The relative miss
 
-    r = |S (Phi_T(x) - x)| / |S x|,   S = diag(1, ..., 1, 1/w, ..., 1/w),
+    r = norm(S (Phi_T(x) - x)) / norm(S x),   S = diag(1, ..., 1, 1/w, ..., 1/w),
 
 (velocities divided by w, so both halves are lengths) is the orbit's residual in
 the time domain: a few 1e-3 where the truncation is mild, of order 1 where the
