@@ -540,6 +540,65 @@ def mast_shoot(force_n: float, f: float, iterations: int) -> None:
         x = x - np.linalg.solve(jac, miss)
 
 
+def hill_sorting() -> None:
+    """Hill's exponents picked by the centred eigenvector against the exact monodromy.
+
+    The 3-link chain of tests/test_harmonic_structure.py. Of Hill's 2N (2H + 1)
+    eigenvalues, keep the 2N whose eigenvector's mean complex harmonic index
+    sum m abs(c_m)^2 / sum abs(c_m)^2 (c_(+-h) = (a_h -+ i b_h) / 2) is closest to 0
+    (each family lambda + i k w shifts that index by k), and also the 2N with the
+    smallest abs(Im lambda) (the strip); compare the largest multiplier with the
+    monodromy's.
+    """
+    import scipy.linalg
+
+    from clearjoint import ClearanceJoint
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.system import build
+    from clearjoint.structure import chain
+
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    s = chain([1.0] * 3, [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+    force = np.array([0.0, 0.0, 40.0])
+    model = build(s, 0.0, None, 1.0)
+    n = s.n_dof
+    print("3-link chain, largest multiplier: monodromy / strip / centred eigenvector")
+    for h in (7, 15):
+        for w in (200.0, 300.0, 400.0, 600.0, 800.0):
+            fr = frequency_response(
+                s, force, w, 1.001 * w, harmonics=h, max_points=2, check_points=0
+            )
+            basis = aft.Basis.make(h, int(fr.settings["samples"]))
+            assert fr.coefficients is not None
+            q = fr.coefficients[0]
+            ev = aft.evaluate(model, basis, q.ravel(), w, force)
+            n_c = 2 * h + 1
+            size = n_c * n
+            scale = np.tile(1.0 / np.diag(model.mass), n_c)[:, None]
+            a = np.zeros((2 * size, 2 * size))
+            a[:size, size:] = np.eye(size)
+            a[size:, :size] = -scale * ev.jacobian
+            a[size:, size:] = -scale * aft._damping_operator(model, basis, w)
+            lam, vec = scipy.linalg.eig(a)
+            v = vec[:size].reshape(n_c, n, -1)
+            power = np.sum(np.abs(v[0]) ** 2, axis=0)
+            moment = np.zeros(lam.size)
+            for k in range(1, h + 1):
+                up = np.sum(np.abs(0.5 * (v[2 * k - 1] - 1j * v[2 * k])) ** 2, axis=0)
+                down = np.sum(np.abs(0.5 * (v[2 * k - 1] + 1j * v[2 * k])) ** 2, axis=0)
+                power = power + up + down
+                moment = moment + k * (up - down)
+            centred = np.argsort(np.abs(moment / power))[: 2 * n]
+            strip = np.argsort(np.abs(lam.imag))[: 2 * n]
+            period = 2 * math.pi / w
+            exact = np.max(np.abs(monodromy.multipliers(model, basis, q, w)))
+            print(
+                f"  H = {h:2d}, {w:5.0f} rad/s: {exact:.4f} / "
+                f"{np.max(np.abs(np.exp(lam[strip] * period))):.4f} / "
+                f"{np.max(np.abs(np.exp(lam[centred] * period))):.4f}"
+            )
+
+
 def samples_error() -> None:
     """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
     from clearjoint.harmonic import aft, solve, system
@@ -599,7 +658,11 @@ def main() -> None:
     parser.add_argument("--mast-orders", type=float, metavar="N", help="H = 7, 15, 31 at N")
     parser.add_argument("--mast-shoot", type=float, metavar="N", help="exact orbit near HB at N")
     parser.add_argument("--at", default="0.9,1.28", help="Hz list for --mast-orders/--mast-shoot")
+    parser.add_argument("--hill-sorting", action="store_true", help="Hill's exponent picks")
     args = parser.parse_args()
+    if args.hill_sorting:
+        hill_sorting()
+        return
     freqs = [float(v) for v in args.at.split(",")]
     if args.mast_check:
         mast_check(args.mast_check, args.mast_points, 25)
