@@ -161,9 +161,13 @@ def frequency_response(
     q0 = _start(model, basis, w0, pattern, k_ref)
     x_scale = max(0.5 * scale_length(model), float(np.max(np.abs(q0))))
 
+    # a structure's stability comes from the monodromy, not from the evaluation: do not
+    # keep one per point (each holds a dense Jacobian: 46 MB at 40 bays, H = 7)
+    keep = model.is_joint or model.friction_force is not None
+
     def residual(
         u: FloatArray, lam: float
-    ) -> tuple[FloatArray, FloatArray, FloatArray, aft.Evaluation]:
+    ) -> tuple[FloatArray, FloatArray, FloatArray, aft.Evaluation | None]:
         if not lam > 0.0:
             raise HarmonicError(f"the parameter left the positive range ({lam!r})")
         w, f = at(lam)
@@ -173,7 +177,7 @@ def frequency_response(
         else:
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
-        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev
+        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev if keep else None
 
     # a large structure: the corrector's bordered solves by sparse LU (continuation hands
     # them to the residual's own corrector when chord_parameter is set)
