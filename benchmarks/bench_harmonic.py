@@ -41,6 +41,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -280,6 +281,324 @@ def example_mast_curve(points: int) -> None:
     )
 
 
+def example_mast(bays: int) -> tuple[Any, np.ndarray]:
+    """examples/mast.toml with ``bays`` bays, its force moved to the tip's x (n{2 bays + 1}x)."""
+    from clearjoint.structure.study import load_structure_study
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "mast.toml").read_text()
+    text = text.replace("bays = 10", f"bays = {bays}").replace(
+        'force_dof = "n21x"', f'force_dof = "n{2 * bays + 1}x"'
+    )
+    text = text.replace('dof = "n21x"', f'dof = "n{2 * bays + 1}x"')
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "mast.toml"
+        path.write_text(text)
+        study = load_structure_study(path)
+    assert study.force is not None
+    return study.structure, study.force
+
+
+#: The sizes of --mast-sizes: (bays, H).
+MAST_SIZES = "5:7,10:7,20:7,40:7,10:3,10:15"
+
+
+def mast_sizes(sizes: str, points: int, force_n: float) -> None:
+    """The example mast's cost against bays and H: the frequency response (``points``
+    points from 0.8 times the open first mode, the study's force pattern scaled to
+    ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes), one line each."""
+    from clearjoint.harmonic import nonlinear_modes
+
+    print(
+        f"examples/mast.toml with other bay counts; force {force_n} N at the tip (x); "
+        f"curves of {points} points at most from 0.8 x the open first mode, max_step "
+        f"{MAST_MAX_STEP}; modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
+    )
+    print(f"  load before: {os.getloadavg()[0]:.2f} (1-min average)")
+    for item in sizes.split(","):
+        bays, h = (int(v) for v in item.split(":"))
+        s, pattern = example_mast(bays)
+        force = pattern * (force_n / float(np.max(np.abs(pattern))))
+        f_open = float(s.modes("open").omega[0])
+        f_closed = float(s.modes("closed").omega[0])
+        unknowns = (2 * h + 1) * s.n_dof
+        start = time.perf_counter()
+        fr = frequency_response(
+            s,
+            force,
+            0.8 * f_open,
+            1.2 * f_closed,
+            harmonics=h,
+            max_points=points,
+            max_step=MAST_MAX_STEP,
+        )
+        took = time.perf_counter() - start
+        hz = fr.omega / (2 * math.pi)
+        print(
+            f"  {bays:2d} bays ({s.n_dof} DOF, {unknowns} unknowns), H = {h:2d}: curve "
+            f"{fr.omega.size} points in {took:8.1f} s ({took / fr.omega.size:.3f} s/point), "
+            f"{hz.min():.3f} to {hz.max():.3f} Hz (open {f_open / (2 * math.pi):.3f}, closed "
+            f"{f_closed / (2 * math.pi):.3f}), {int(np.sum(~fr.stable))} unstable, "
+            f"load {os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+        amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
+        start = time.perf_counter()
+        nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
+        took = time.perf_counter() - start
+        f = nm.frequency[nm.converged] / (2 * math.pi)
+        span = f"{f.min():.3f} to {f.max():.3f} Hz" if f.size else "none"
+        print(
+            f"  {bays:2d} bays, H = {h:2d}: mode, 50 amplitudes in {took:8.1f} s, "
+            f"{int(nm.converged.sum())}/50 converged, {span}, load {os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+
+
+def mast_decay(bays: int, beta: float, cycles: int) -> None:
+    """The example mast's first nonlinear mode (EPMC, H = 7) against its exact free decay.
+
+    As tests/test_harmonic_structure.py does on 2 bays: released on the closed first
+    mode at 2 mm x (bays / 2)^2 on the tip, ``cycles`` cycles of structure.free_decay read
+    per cycle on closed mode 1 (decay_backbone), against EPMC at the same peak amplitude.
+    """
+    from clearjoint import ClearanceJoint
+    from clearjoint.harmonic import nonlinear_modes
+    from clearjoint.structure import decay_backbone, free_decay, mast
+
+    j = ClearanceJoint(clearance=5e-5, compression_stiffness=5e7, gap_stiffness=1e5)
+    s = mast(bays, joints=j, rayleigh=(0.0, beta))
+    closed = s.modes("closed")
+    phi = closed.shapes[:, 0]
+    ref = int(np.argmax(np.abs(phi)))
+    start_amplitude = 2e-3 * (bays / 2) ** 2
+    period = 2.0 * math.pi / float(closed.omega[0])
+    start = time.perf_counter()
+    motion = free_decay(s, (start_amplitude * phi / phi[ref], np.zeros(s.n_dof)), cycles * period)
+    took_decay = time.perf_counter() - start
+    bb = decay_backbone(motion, ref, mode=1)
+    start = time.perf_counter()
+    a = bb.amplitude
+    nm = nonlinear_modes(s, 1, np.geomspace(0.8 * a.min(), 1.2 * a.max(), 30), harmonics=7)
+    took_mode = time.perf_counter() - start
+    ok = nm.converged
+    peak = 0.5 * (nm.x_max[ok, ref] - nm.x_min[ok, ref])
+    print(
+        f"mast, {bays} bays (50 um joints, k_c 5e7 N/m, k0 1e5 N/m, Rayleigh beta {beta:g} s): "
+        f"closed first mode {closed.omega[0] / (2 * math.pi):.3f} Hz, open "
+        f"{s.modes('open').omega[0] / (2 * math.pi):.3f} Hz; free decay from "
+        f"{1e3 * start_amplitude:.1f} mm on {s.dof_names[ref]}, {cycles} cycles in "
+        f"{took_decay:.1f} s ({motion.events} events); EPMC H = 7, 30 amplitudes in "
+        f"{took_mode:.1f} s, {int(ok.sum())}/30 converged"
+    )
+    print("  cycle  amplitude (mm)  decay (Hz)  EPMC (Hz)  rel. gap   zeta decay  zeta EPMC")
+    inside = (a >= peak.min()) & (a <= peak.max())
+    for k in range(a.size):
+        if not inside[k]:
+            print(f"  {k:5d}  {1e3 * a[k]:14.4f}  {bb.omega[k] / (2 * math.pi):10.4f}  (outside)")
+            continue
+        w_e = float(np.interp(a[k], peak, nm.frequency[ok]))
+        z_e = float(np.interp(a[k], peak, nm.damping_ratio[ok]))
+        print(
+            f"  {k:5d}  {1e3 * a[k]:14.4f}  {bb.omega[k] / (2 * math.pi):10.4f}  "
+            f"{w_e / (2 * math.pi):9.4f}  {bb.omega[k] / w_e - 1:+9.2e}  "
+            f"{bb.damping_ratio[k]:10.3e}  {z_e:9.3e}"
+        )
+
+
+def _example_at(force_n: float) -> tuple[Any, np.ndarray, int]:
+    s, pattern = example_mast(10)
+    force = pattern * (force_n / float(np.max(np.abs(pattern))))
+    return s, force, int(np.argmax(np.abs(force)))
+
+
+def mast_check(force_n: float, points: int, checks: int) -> None:
+    """The example mast's H = 7 curve at ``force_n`` with ``checks`` points run through one
+    exact period (clearjoint.harmonic.check): residual, exact events, orbit crossings."""
+    s, force, dof = _example_at(force_n)
+    start = time.perf_counter()
+    fr = frequency_response(
+        s,
+        force,
+        2 * math.pi * MAST_FROM_HZ,
+        2 * math.pi * MAST_TO_HZ,
+        harmonics=7,
+        max_points=points,
+        max_step=MAST_MAX_STEP,
+        check_points=checks,
+    )
+    hz = fr.omega / (2 * math.pi)
+    print(
+        f"examples/mast.toml at {force_n} N, H = 7: {fr.omega.size} points in "
+        f"{time.perf_counter() - start:.1f} s, {hz.min():.3f} to {hz.max():.3f} Hz, "
+        f"{int(np.sum(~fr.stable))} unstable; {fr.settings['orbit_check']!r}"
+    )
+    found = fr.settings["orbit_check"]
+    print("  point  f (Hz)   tip x_max (mm)  max|mu|    residual  exact events  HB crossings")
+    for m, i in enumerate(found.index):
+        print(
+            f"  {i:5d}  {hz[i]:.4f}  {1e3 * fr.x_max[i, dof]:14.4f}  "
+            f"{np.max(np.abs(fr.multipliers[i])):9.4g}  {found.residual[m]:8.2e}  "
+            f"{found.exact_events[m]:12d}  {found.orbit_crossings[m]:12d}"
+        )
+
+
+def mast_orders(force_n: float, freqs: list[float]) -> None:
+    """The example mast's HB orbit at H = 7, 15, 31 (each Newton from the one before,
+    padded with zeros): tip maximum, largest multiplier, one-period residual."""
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.response import _start
+    from clearjoint.harmonic.solve import newton
+    from clearjoint.harmonic.system import build
+
+    s, force, dof = _example_at(force_n)
+    model = build(s, 0.0, None, 1.0)
+    n, k_ref = s.n_dof, model.reference_stiffness
+    for f in freqs:
+        w = 2 * math.pi * f
+        prev = None
+        for h in (7, 15, 31):
+            basis = aft.Basis.make(h, 1 << math.ceil(math.log2(32 * (2 * h + 1))))
+
+            def function(
+                q: np.ndarray, basis: aft.Basis = basis, w: float = w
+            ) -> tuple[np.ndarray, np.ndarray]:
+                ev = aft.evaluate(model, basis, q, w, force)
+                return ev.residual / k_ref, ev.jacobian / k_ref
+
+            if prev is None:
+                q = _start(model, basis, w, force, k_ref)
+            else:
+                q0 = np.zeros((2 * h + 1, n))
+                q0[: prev.shape[0]] = prev
+                found = newton(function, q0.ravel(), float(np.max(np.abs(q0))))
+                if found is None:
+                    print(f"  {force_n} N, {f} Hz, H = {h}: no orbit (Newton from H's before)")
+                    break
+                q = found[0]
+            coef = q.reshape(2 * h + 1, n)
+            prev = coef
+            fr_like = _one_point(s, force, w, h, basis, coef)
+            mu = monodromy.multipliers(model, basis, coef, w)
+            top, _ = basis.extremes(coef)
+            print(
+                f"  {force_n} N, {f} Hz, H = {h:2d}: tip x_max {1e3 * top[dof]:.4f} mm, "
+                f"max|mu| {np.max(np.abs(mu)):.4g}, residual {fr_like[0]:.2e}, exact events "
+                f"{fr_like[1]}, HB crossings {monodromy.crossings(model, basis, coef).size}",
+                flush=True,
+            )
+
+
+def _one_point(
+    s: Any, force: np.ndarray, w: float, h: int, basis: Any, coef: np.ndarray
+) -> tuple[float, int]:
+    """One period of exact motion from an HB orbit's state: (residual, events)."""
+    from clearjoint.structure import time_response
+
+    n = s.n_dof
+    row = np.zeros(2 * h + 1)
+    row[2::2] = np.arange(1, h + 1)
+    x = np.concatenate((coef[0] + coef[1::2].sum(axis=0), w * (row @ coef)))
+    m = time_response(s, force, w, 2 * math.pi / w, initial=(x[:n], x[n:]), samples_per_period=8)
+    scale = np.concatenate((np.ones(n), np.full(n, 1 / w)))
+    r = np.linalg.norm(scale * (np.concatenate(m.final_state) - x)) / np.linalg.norm(scale * x)
+    return float(r), int(m.events)
+
+
+def mast_shoot(force_n: float, f: float, iterations: int) -> None:
+    """Look for the exact periodic orbit near the H = 7 one: x <- x - (Phi_HB - I)^-1 (P(x) - x),
+    P one period of exact motion, Phi_HB the HB orbit's monodromy (a fixed Jacobian)."""
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.response import _start
+    from clearjoint.harmonic.system import build
+    from clearjoint.structure import time_response
+
+    s, force, dof = _example_at(force_n)
+    model = build(s, 0.0, None, 1.0)
+    n, w = s.n_dof, 2 * math.pi * f
+    basis = aft.Basis.make(7, 512)
+    coef = _start(model, basis, w, force, model.reference_stiffness).reshape(15, n)
+    jac = monodromy.monodromy(model, basis, coef, w) - np.eye(2 * n)
+    row = np.zeros(15)
+    row[2::2] = np.arange(1, 8)
+    x = np.concatenate((coef[0] + coef[1::2].sum(axis=0), w * (row @ coef)))
+    x_hb = x.copy()
+    scale = np.concatenate((np.ones(n), np.full(n, 1 / w)))
+    top, _ = basis.extremes(coef)
+    print(f"  {force_n} N, {f} Hz: HB (H = 7) tip x_max {1e3 * top[dof]:.4f} mm")
+    for k in range(iterations):
+        m = time_response(s, force, w, 2 * math.pi / w, initial=(x[:n], x[n:]))
+        miss = np.concatenate(m.final_state) - x
+        r = np.linalg.norm(scale * miss) / np.linalg.norm(scale * x)
+        d = np.linalg.norm(scale * (x - x_hb)) / np.linalg.norm(scale * x_hb)
+        print(
+            f"    iteration {k}: residual {r:.2e}, tip max over the period "
+            f"{1e3 * m.u[:, dof].max():.4f} mm, {m.events} events, distance from the HB state "
+            f"{d:.2e}",
+            flush=True,
+        )
+        x = x - np.linalg.solve(jac, miss)
+
+
+def hill_sorting() -> None:
+    """Hill's exponents picked by the centred eigenvector against the exact monodromy.
+
+    The 3-link chain of tests/test_harmonic_structure.py. Of Hill's 2N (2H + 1)
+    eigenvalues, keep the 2N whose eigenvector's mean complex harmonic index
+    sum m abs(c_m)^2 / sum abs(c_m)^2 (c_(+-h) = (a_h -+ i b_h) / 2) is closest to 0
+    (each family lambda + i k w shifts that index by k), and also the 2N with the
+    smallest abs(Im lambda) (the strip); compare the largest multiplier with the
+    monodromy's.
+    """
+    import scipy.linalg
+
+    from clearjoint import ClearanceJoint
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.system import build
+    from clearjoint.structure import chain
+
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    s = chain([1.0] * 3, [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+    force = np.array([0.0, 0.0, 40.0])
+    model = build(s, 0.0, None, 1.0)
+    n = s.n_dof
+    print("3-link chain, largest multiplier: monodromy / strip / centred eigenvector")
+    for h in (7, 15):
+        for w in (200.0, 300.0, 400.0, 600.0, 800.0):
+            fr = frequency_response(
+                s, force, w, 1.001 * w, harmonics=h, max_points=2, check_points=0
+            )
+            basis = aft.Basis.make(h, int(fr.settings["samples"]))
+            assert fr.coefficients is not None
+            q = fr.coefficients[0]
+            ev = aft.evaluate(model, basis, q.ravel(), w, force)
+            n_c = 2 * h + 1
+            size = n_c * n
+            scale = np.tile(1.0 / np.diag(model.mass), n_c)[:, None]
+            a = np.zeros((2 * size, 2 * size))
+            a[:size, size:] = np.eye(size)
+            a[size:, :size] = -scale * ev.jacobian
+            a[size:, size:] = -scale * aft._damping_operator(model, basis, w)
+            lam, vec = scipy.linalg.eig(a)
+            v = vec[:size].reshape(n_c, n, -1)
+            power = np.sum(np.abs(v[0]) ** 2, axis=0)
+            moment = np.zeros(lam.size)
+            for k in range(1, h + 1):
+                up = np.sum(np.abs(0.5 * (v[2 * k - 1] - 1j * v[2 * k])) ** 2, axis=0)
+                down = np.sum(np.abs(0.5 * (v[2 * k - 1] + 1j * v[2 * k])) ** 2, axis=0)
+                power = power + up + down
+                moment = moment + k * (up - down)
+            centred = np.argsort(np.abs(moment / power))[: 2 * n]
+            strip = np.argsort(np.abs(lam.imag))[: 2 * n]
+            period = 2 * math.pi / w
+            exact = np.max(np.abs(monodromy.multipliers(model, basis, q, w)))
+            print(
+                f"  H = {h:2d}, {w:5.0f} rad/s: {exact:.4f} / "
+                f"{np.max(np.abs(np.exp(lam[strip] * period))):.4f} / "
+                f"{np.max(np.abs(np.exp(lam[centred] * period))):.4f}"
+            )
+
+
 def samples_error() -> None:
     """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
     from clearjoint.harmonic import aft, solve, system
@@ -321,7 +640,46 @@ def main() -> None:
         "--mast-curve", action="store_true", help="only the example mast's curve (--mast's last)"
     )
     parser.add_argument("--samples", action="store_true", help="the error against N_t instead")
+    parser.add_argument(
+        "--mast-sizes",
+        nargs="?",
+        const=MAST_SIZES,
+        help=f"the example mast's cost against bays and H, as BAYS:H,... (default {MAST_SIZES})",
+    )
+    parser.add_argument("--mast-force", type=float, default=MAST_FORCE_N, help="N, --mast-sizes")
+    parser.add_argument(
+        "--mast-decay",
+        type=int,
+        metavar="BAYS",
+        help="a BAYS-bay mast's first nonlinear mode against its free decay instead",
+    )
+    parser.add_argument("--decay-cycles", type=int, default=12, help="cycles, --mast-decay")
+    parser.add_argument("--mast-check", type=float, metavar="N", help="the check at N newtons")
+    parser.add_argument("--mast-orders", type=float, metavar="N", help="H = 7, 15, 31 at N")
+    parser.add_argument("--mast-shoot", type=float, metavar="N", help="exact orbit near HB at N")
+    parser.add_argument("--at", default="0.9,1.28", help="Hz list for --mast-orders/--mast-shoot")
+    parser.add_argument("--hill-sorting", action="store_true", help="Hill's exponent picks")
     args = parser.parse_args()
+    if args.hill_sorting:
+        hill_sorting()
+        return
+    freqs = [float(v) for v in args.at.split(",")]
+    if args.mast_check:
+        mast_check(args.mast_check, args.mast_points, 25)
+        return
+    if args.mast_orders:
+        mast_orders(args.mast_orders, freqs)
+        return
+    if args.mast_shoot:
+        for f in freqs:
+            mast_shoot(args.mast_shoot, f, 6)
+        return
+    if args.mast_decay:
+        mast_decay(args.mast_decay, 2e-5, args.decay_cycles)
+        return
+    if args.mast_sizes:
+        mast_sizes(args.mast_sizes, args.mast_points, args.mast_force)
+        return
     if args.samples:
         samples_error()
         return

@@ -219,3 +219,18 @@ def test_structure_study_with_impacts_is_refused_in_cli_terms(
         assert "set restitution = 1" in err
         assert "respond" in err
         assert len(err.strip().splitlines()) == 1
+
+
+def test_frf_warns_where_the_orbit_is_not_the_exact_motion(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """At 200 rad/s one harmonic misses the chain's exact motion by about 0.24 of its
+    state over a period (at 300 rad/s seven harmonics miss by 2.5e-3,
+    tests/test_harmonic_check.py)."""
+    study, out = _chain_study(tmp_path), tmp_path / "frf.nc"
+    args = ["frf", str(study), "--from", "31.83Hz", "--to", "31.835Hz", "--out", str(out)]
+    code, text, err = run([*args, "--method", "harmonic", "--harmonics", "1"], capsys)
+    assert code == 0, err
+    assert "untrusted:" in text
+    (line,) = err.strip().splitlines()
+    assert "not to be trusted; raise --harmonics" in line

@@ -68,6 +68,8 @@ def test_shipped_example_study_loads_and_its_pin_takes_the_clearance() -> None:
         (MINIMAL.replace('"0.106mm"', '"-0.1mm"'), "clearance must be >= 0"),
         (MINIMAL.replace('"400Hz"', '"400N"'), "is not a frequency"),
         (MINIMAL.replace('"400Hz"', '"0Hz"'), "frequency must be > 0"),
+        (MINIMAL.replace('"1kN"', '"nan N"'), "force_amplitude must be a finite force"),
+        (MINIMAL.replace('"1kN"', '"-5N"'), "force_amplitude must be a finite force >= 0"),
         (MINIMAL + 'restitution = "high"\n', "cannot read 'high'"),
         ("this is not = = toml", "not valid TOML"),
     ],

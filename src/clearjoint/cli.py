@@ -995,6 +995,15 @@ def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Pa
             file=sys.stderr,
         )
     free = getattr(curve, "free_play", None)
+    untrusted = [e for e in curve.events if e.kind == "untrusted"]
+    if untrusted:  # harmonic balance of a structure: orbits the exact motion does not follow
+        where = ", ".join(f"{e.omega / (2 * math.pi):.4g}" for e in untrusted)
+        print(
+            f"clearjoint frf: warning: at {where} Hz the harmonic-balance orbit misses one "
+            "period of the exact motion, so its stability is not to be trusted; raise "
+            "--harmonics or lower the force (docs/harmonic.md)",
+            file=sys.stderr,
+        )
     source_system = curve.settings.get("system")
     per_dof = curve.x_max.ndim == 2 and hasattr(source_system, "dof_names")
     if args.json:

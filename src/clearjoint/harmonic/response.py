@@ -17,6 +17,7 @@ edge.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any, Literal
 
@@ -26,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.continuation import ContinuationSettings, continue_branch
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.harmonic import aft, monodromy, solve
+from clearjoint.harmonic import aft, check, monodromy, solve
 from clearjoint.harmonic.solve import (
     TOLERANCE,
     SparseResidual,
@@ -63,6 +64,7 @@ def frequency_response(
     max_points: int = 2000,
     max_step: float = 0.02,
     friction_regularization: float | None = None,
+    check_points: int = 5,
 ) -> FrequencyResponse:
     """Return the frequency-response curve by harmonic balance and continuation (MODEL.md 5.3).
 
@@ -105,6 +107,13 @@ def frequency_response(
         Largest arclength step in scaled coordinates (smaller: more points).
     friction_regularization : float, optional
         v_eps in m/s; default 1e-3 * omega_start * c (c the joint's clearance).
+    check_points : int
+        Structures only: this many points, spread evenly along the curve, are run
+        through one period of the exact motion
+        (:func:`clearjoint.harmonic.check.check_orbits`); each whose orbit misses by
+        more than the tolerance gets an ``"untrusted"`` event (its stability verdict
+        is not to be trusted), and the whole check is in ``settings["orbit_check"]``.
+        0 skips the check.
 
     Returns
     -------
@@ -139,6 +148,8 @@ def frequency_response(
     unit_force = pattern / peak
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
+    if isinstance(check_points, bool) or not isinstance(check_points, int) or check_points < 0:
+        raise ParameterError(f"check_points must be an integer >= 0, got {check_points!r}")
     basis = aft.Basis.make(h, n_t)
     k_ref = model.reference_stiffness
 
@@ -150,9 +161,13 @@ def frequency_response(
     q0 = _start(model, basis, w0, pattern, k_ref)
     x_scale = max(0.5 * scale_length(model), float(np.max(np.abs(q0))))
 
+    # a structure's stability comes from the monodromy, not from the evaluation: do not
+    # keep one per point (each holds a dense Jacobian: 46 MB at 40 bays, H = 7)
+    keep = model.is_joint or model.friction_force is not None
+
     def residual(
         u: FloatArray, lam: float
-    ) -> tuple[FloatArray, FloatArray, FloatArray, aft.Evaluation]:
+    ) -> tuple[FloatArray, FloatArray, FloatArray, aft.Evaluation | None]:
         if not lam > 0.0:
             raise HarmonicError(f"the parameter left the positive range ({lam!r})")
         w, f = at(lam)
@@ -162,7 +177,7 @@ def frequency_response(
         else:
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
-        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev
+        return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev if keep else None
 
     # a large structure: the corrector's bordered solves by sparse LU (continuation hands
     # them to the residual's own corrector when chord_parameter is set)
@@ -195,7 +210,14 @@ def frequency_response(
             chord_parameter=sparse or compiled,
         ),
     )
-    return _response(
+    settings = {
+        "system": system,
+        "harmonics": h,
+        "samples": n_t,
+        "damping_ratio": damping_ratio,
+        "force_pattern": unit_force,
+    }
+    response = _response(
         model,
         basis,
         branch.u,
@@ -206,7 +228,14 @@ def frequency_response(
         pattern,
         unit_force,
         branch.reason,
-        {"system": system, "harmonics": h, "samples": n_t, "damping_ratio": damping_ratio},
+        settings,
+    )
+    if model.is_joint or check_points == 0:
+        return response
+    found = check.check_orbits(response, check.spread(response.omega.size, check_points))
+    settings["orbit_check"] = found
+    return dataclasses.replace(
+        response, events=response.events + check.untrusted_events(response, found)
     )
 
 

@@ -155,6 +155,25 @@ def _refuse_losses(
         )
 
 
+def _refuse_structure_losses(law: ClearanceJoint, index: int) -> None:
+    """Refuse a structure joint's friction or impacts, saying what is supported instead."""
+    if law.friction is not None and law.friction.force > 0.0:
+        raise HarmonicError(
+            f"Coulomb friction in the joint of member {index} is not carried for a structure: "
+            "neither clearjoint.harmonic nor the exact clearjoint.structure motion models "
+            "joints that stick (friction is supported for a single Joint only: "
+            "clearjoint.harmonic.frequency_response regularised, clearjoint.periodic exact "
+            "stick-slip); set friction=None on the structure's joints (its loss may be "
+            "approximated by damping, e.g. rayleigh=), or study that joint alone as a Joint"
+        )
+    if law.restitution != 1.0:
+        raise HarmonicError(
+            f"restitution {law.restitution!r} (joint of member {index}) is an impact event "
+            "that harmonic balance cannot carry; use clearjoint.structure.time_response for "
+            "the exact motion with impacts, or set restitution=1"
+        )
+
+
 def from_joint(
     joint: Joint,
     damping_ratio: float,
@@ -199,7 +218,7 @@ def from_structure(structure: Any) -> LinearSystem:
 
     laws: tuple[ClearanceJoint, ...] = structure.joint_laws
     for index, law in zip(structure.joint_members, laws, strict=True):
-        _refuse_losses(law.friction, law.restitution, f"joint of member {index}")
+        _refuse_structure_losses(law, index)
     n_j = len(laws)
     k_lin, _ = structure.pattern_stiffness(np.full(n_j, OPEN, dtype=np.int64))
     # pattern_stiffness("open") holds each joint's k0; the laws carry k0 themselves.

@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 
 from clearjoint import stiffness
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.identify._stats import median
 from clearjoint.identify.cycles import (
     MIN_STEADY,
     IdentificationError,
@@ -65,7 +66,6 @@ from clearjoint.identify.segments import (
     _line_fits,
     _windows,
 )
-from clearjoint.identify.weak import stage_runs, weak_fit, weak_system
 from clearjoint.joint import Joint
 from clearjoint.records import Record
 
@@ -296,11 +296,19 @@ def _identify_stack(
     x = xs.mean(axis=0)
     f = fs.mean(axis=0)
     noise_x = _noise_floor(xs)
-    v_crude, a_crude = _periodic_derivatives(x, st.step, noise_x)
-    v = st.channels["v"].mean(axis=0) if "v" in st.channels else v_crude
-    a = st.channels["a"].mean(axis=0) if "a" in st.channels else a_crude
     warnings: list[str] = []
     force_control = record.control == "force"
+    # the average's acceleration is used only under force control: with a measured
+    # velocity and no acceleration needed (a displacement-controlled BRFD record) the
+    # spectral derivatives are not taken; a is then the measured one or unused zeros
+    measured = "v" in st.channels and ("a" in st.channels or not force_control)
+    if measured:
+        v = st.channels["v"].mean(axis=0)
+        a = st.channels["a"].mean(axis=0) if "a" in st.channels else np.zeros_like(x)
+    else:
+        v_crude, a_crude = _periodic_derivatives(x, st.step, noise_x)
+        v = st.channels["v"].mean(axis=0) if "v" in st.channels else v_crude
+        a = st.channels["a"].mean(axis=0) if "a" in st.channels else a_crude
     mass: float | None = record.mass if force_control and record.mass else None
     mass_missing = force_control and mass is None
     m_guess = _estimate_mass(x, f, v, a) if mass_missing else (mass or 0.0)
@@ -308,25 +316,25 @@ def _identify_stack(
     parts = _branches_of(m, x)
     if parts is None:
         raise IdentificationError(f"{where}: the steady cycles' average has no rising branch")
-    windows = (
-        _windows(x[parts[0]], r[parts[0]], 3),
-        _windows(x[parts[1]], r[parts[1]], 3),
-    )
-    if _is_joint(windows[0]) != _is_joint(windows[1]):
-        # a stage too short to be found on one branch (e.g. a brief contact at a low
-        # force): the stages are places in x, the same on both branches, so the branch
-        # that shows all three lends them to the other
-        shown = windows[0] if _is_joint(windows[0]) else windows[1]
-        windows = (shown, shown)
     model = "line"
     system = None
     # a displacement-controlled loop whose branches end on slip plateaus is a damper
-    damper = record.control == "displacement" and _damper_fit(x, f, parts) is not None
-    first_fit = (
-        _joint_fit(x, r, v, parts, windows)
-        if not damper and _is_joint(windows[0]) and _is_joint(windows[1])
-        else None
-    )
+    head_damper = _damper_fit(x, f, parts) if record.control == "displacement" else None
+    damper = head_damper is not None
+    first_fit = None
+    if not damper:  # the stages are looked for only where a joint may be
+        windows = (
+            _windows(x[parts[0]], r[parts[0]], 3),
+            _windows(x[parts[1]], r[parts[1]], 3),
+        )
+        if _is_joint(windows[0]) != _is_joint(windows[1]):
+            # a stage too short to be found on one branch (e.g. a brief contact at a low
+            # force): the stages are places in x, the same on both branches, so the branch
+            # that shows all three lends them to the other
+            shown = windows[0] if _is_joint(windows[0]) else windows[1]
+            windows = (shown, shown)
+        if _is_joint(windows[0]) and _is_joint(windows[1]):
+            first_fit = _joint_fit(x, r, v, parts, windows)
     if damper:
         model = "damper"
     elif first_fit is not None:
@@ -334,6 +342,9 @@ def _identify_stack(
         margin = EDGE_MARGIN * (edges[1] - edges[0])
         model = "joint"
         if "a" not in st.channels:  # with a measured acceleration: fit the samples
+            # imported here: a damper or a line (the BRFD folder) never needs the weak form
+            from clearjoint.identify.weak import stage_runs, weak_system
+
             system = weak_system(x, v, st.step, stage_runs(x, edges, margin))
         if system is not None and np.bincount(system.stage).min() < MIN_EQUATIONS:
             system = None  # a contact too short for the weak form: fit sample by sample
@@ -353,6 +364,8 @@ def _identify_stack(
     masses: FloatArray
     residual = math.nan
     if model == "joint" and system is not None:
+        from clearjoint.identify.weak import weak_fit
+
         weak = weak_fit(
             system, reps_x, reps_f, mass=mass if force_control else 0.0, acceleration=reps_a
         )
@@ -378,11 +391,15 @@ def _identify_stack(
     else:
         # every replicate's velocity and restoring force, (G + 1, M), then the fits of all
         # replicates in one batched solve (row by row only if that solve is singular)
-        reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
-        if reps_a is not None:
-            reps_ad = reps_a
-        if "v" in st.channels:
+        if measured:  # as for the average: no spectral derivative is used
+            reps_ad = reps_a if reps_a is not None else np.zeros_like(reps_x)
             reps_v = np.broadcast_to(v, reps_x.shape)
+        else:
+            reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
+            if reps_a is not None:
+                reps_ad = reps_a
+            if "v" in st.channels:
+                reps_v = np.broadcast_to(v, reps_x.shape)
         reps_r = reps_f - m_guess * reps_ad if force_control else reps_f
         fits = []
         if model == "joint":
@@ -395,7 +412,11 @@ def _identify_stack(
                 ]
             fits = [fit or first_fit for fit in batch]
         elif model == "damper":
-            for xr_, fr_, rr_, vr_ in zip(reps_x, reps_f, reps_r, reps_v, strict=True):
+            assert head_damper is not None
+            fits.append(head_damper)  # replicate 0 is the average itself: fitted above
+            for xr_, fr_, rr_, vr_ in zip(
+                reps_x[1:], reps_f[1:], reps_r[1:], reps_v[1:], strict=True
+            ):
                 fits.append(_damper_fit(xr_, fr_, parts) or _line_fit(xr_, rr_, vr_))
         else:
             line_fits = _line_fits(reps_x, reps_r, reps_v)
@@ -591,14 +612,14 @@ def flag_outliers(results: list[Identification]) -> list[Identification]:
             continue
         for i in members:
             others = [results[j].summary["clearance_m"] for j in members if j != i]
-            median = float(np.median(others))
+            middle = median(others)
             c = results[i].summary["clearance_m"]
-            if median > 0 and c > 2.0 * median and results[i].flags["clearance_m"][0] == "ok":
+            if middle > 0 and c > 2.0 * middle and results[i].flags["clearance_m"][0] == "ok":
                 flags = dict(results[i].flags)
                 flags["clearance_m"] = (
                     "doubtful",
                     f"clearance {c * 1e3:.3g} mm is more than twice the median "
-                    f"{median * 1e3:.3g} mm of the other {len(others)} tests of {device}",
+                    f"{middle * 1e3:.3g} mm of the other {len(others)} tests of {device}",
                 )
                 out[i] = replace(results[i], flags=flags)
     return out

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.errors import ClearjointError
+from clearjoint.identify._stats import median
 from clearjoint.records import Record
 
 FloatArray = NDArray[np.float64]
@@ -115,8 +116,8 @@ def steady(x: FloatArray, bounds: list[tuple[int, int]], tolerance: float) -> li
     amp = 0.5 * (high - low)
     mid = 0.5 * (high + low)
     top = amp >= 0.9 * amp.max()
-    reference = float(np.median(amp[top]))
-    centre = float(np.median(mid[top]))
+    reference = median(amp[top])
+    centre = median(mid[top])
     closure = np.abs(x[starts] - x[stops - 1])
     keep = (
         (np.abs(amp - reference) <= tolerance * reference)

@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from clearjoint.identify._stats import median
 from clearjoint.identify.segments import _Fit
 
 FloatArray = NDArray[np.float64]
@@ -107,13 +108,24 @@ def _step_fit(s: FloatArray) -> tuple[float, float, float, int]:
     step at a place is a pair of medians (of s - d alpha before and from the place), every
     place is tried at once and the one of least absolute deviation is kept.
     """
-    d = float(np.median(np.diff(s))) * N_CROSSINGS
+    d = median(np.diff(s)) * N_CROSSINGS
     if not d > 0.0:
         return 0.0, 0.0, 0.0, int(_PLACES[0])
     r = s - d * ALPHAS
     j = int(_PLACES[_best_place(r)])
-    c, top = float(np.median(r[:j])), float(np.median(r[j:]))
+    c, top = median(r[:j]), median(r[j:])
     return c, d, top - c, j
+
+
+def _slope(t: FloatArray, y: FloatArray) -> float:
+    """The least-squares straight line's slope through (t, y) (n,), in closed form.
+
+    The centred normal equation, as ``numpy.polyfit(t, y, 1)[0]`` solves it by an SVD, to
+    rounding; 0 when t does not vary.
+    """
+    tc = t - t.mean()
+    spread = float(tc @ tc)
+    return float(tc @ (y - y.mean())) / spread if spread > 0.0 else 0.0
 
 
 def _damper_fit(x: FloatArray, f: FloatArray, parts: tuple[slice, slice]) -> _Fit | None:
@@ -130,10 +142,9 @@ def _damper_fit(x: FloatArray, f: FloatArray, parts: tuple[slice, slice]) -> _Fi
         late = travel >= (1.0 - PLATEAU) * total
         if total <= 0.0 or late.sum() < 4:
             return None
-        levels.append(float(np.median(fb[late])))
+        levels.append(median(fb[late]))
         # a slip plateau is flat: its straight-line change over its travel is small
-        slope = np.polyfit(travel[late], fb[late], 1)[0]
-        levels_change = abs(slope) * PLATEAU * total
+        levels_change = abs(_slope(travel[late], fb[late])) * PLATEAU * total
         levels.append(levels_change)
     rise, rise_change, fall, fall_change = levels
     delta = rise - fall

@@ -26,10 +26,13 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.polynomial import Legendre, Polynomial
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from numpy.polynomial import Polynomial
 
 FloatArray = NDArray[np.float64]
 
@@ -42,8 +45,15 @@ ORDERS = 2
 MIN_STAGE_SAMPLES = 8
 
 
+@functools.cache
 def _bases(order: int) -> list[tuple[Polynomial, Polynomial, Polynomial]]:
-    """phi_q(tau) = tau^2 (1 - tau)^2 P_q(2 tau - 1) and its two derivatives, q < order."""
+    """phi_q(tau) = tau^2 (1 - tau)^2 P_q(2 tau - 1) and its two derivatives, q < order.
+
+    Built on first use: records that never reach the weak form (the BRFD damper loops)
+    do not import numpy.polynomial.
+    """
+    from numpy.polynomial import Legendre, Polynomial
+
     bump = Polynomial([0.0, 0.0, 1.0, -2.0, 1.0])
     out = []
     for q in range(order):
@@ -51,9 +61,6 @@ def _bases(order: int) -> list[tuple[Polynomial, Polynomial, Polynomial]]:
         phi = bump * legendre
         out.append((phi, phi.deriv(), phi.deriv(2)))
     return out
-
-
-_BASES = _bases(ORDERS)
 
 
 @dataclass(frozen=True)
@@ -106,7 +113,7 @@ def _shapes(width: int, step: float) -> FloatArray:
     return np.array(
         [
             [weight * phi(tau), weight * dphi(tau) / length, weight * ddphi(tau) / length**2]
-            for phi, dphi, ddphi in _BASES[:ORDERS]
+            for phi, dphi, ddphi in _bases(ORDERS)
         ]
     )
 

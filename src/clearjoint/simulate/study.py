@@ -191,6 +191,11 @@ def _build(
     if not frequency > 0.0:
         raise StudyError(f"{where}: [excitation] frequency must be > 0 Hz, got {frequency!r}")
     omega = 2.0 * math.pi * frequency
+    force = ex["force_amplitude"]
+    if not (math.isfinite(force) and force >= 0.0):
+        raise StudyError(
+            f"{where}: [excitation] force_amplitude must be a finite force >= 0 N, got {force!r}"
+        )
     mode = ex["mode"]
     if mode not in ("steady", "transient"):
         raise StudyError(
