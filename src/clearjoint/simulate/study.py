@@ -191,8 +191,8 @@ def _build(
     if not frequency > 0.0:
         raise StudyError(f"{where}: [excitation] frequency must be > 0 Hz, got {frequency!r}")
     omega = 2.0 * math.pi * frequency
-    force = ex["force_amplitude"]
-    if not (math.isfinite(force) and force >= 0.0):
+    force = ex["force_amplitude"]  # NaN when left out as optional (load_study)
+    if "excitation.force_amplitude" in stated and not (math.isfinite(force) and force >= 0.0):
         raise StudyError(
             f"{where}: [excitation] force_amplitude must be a finite force >= 0 N, got {force!r}"
         )
