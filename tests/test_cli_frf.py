@@ -210,3 +210,45 @@ def test_a_bad_fixed_frequency_of_a_structure_study_names_the_option(
     assert code == 2
     assert len(err.strip().splitlines()) == 1
     assert "--frequency must be finite and > 0" in err
+
+
+def test_the_issues_force_example_starts_on_free_play_orbits(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the issue's own example: at 100 N and 400 Hz the study's joint (k0 = 0) stays inside
+    # the gap (a continuum of orbits); the curve follows the centred one, then contact
+    study = EXAMPLE.parent / "study.toml"
+    args = ["frf", str(study), "--parameter", "force", "--from", "100N", "--to", "2kN"]
+    args += ["--frequency", "400Hz", "--out", str(tmp_path / "x.nc")]
+    code, text, err = run(args, capsys)
+    assert code == 0, err
+    assert err == ""
+    assert "free play from 100 to 680" in text  # the widest in-gap orbit near 680 N
+    assert "N at 400 Hz" in text
+    assert "its position is not" in text
+    code, text, err = run([*args, "--json", "--force"], capsys)
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["stop_reason"] == "reached"
+    assert data["force_n"][0] == pytest.approx(100.0)
+    assert data["force_n"][-1] == pytest.approx(2000.0)
+    free = data["free_play"]
+    assert free[0]
+    assert not free[-1]
+    assert sum(free) > 20
+    assert not any(f for f, s in zip(free, data["stable"], strict=True) if s)
+    assert "free_play" in [e["kind"] for e in data["events"]]
+    # a force curve does not need the study's force: the same curve without it
+    bare = tmp_path / "bare.toml"
+    text_toml = study.read_text(encoding="utf-8").replace('force_amplitude = "1000N"', "")
+    bare.write_text(text_toml, encoding="utf-8")
+    args_bare = [str(bare) if a == str(study) else a for a in args]
+    args_bare[args_bare.index(str(tmp_path / "x.nc"))] = str(tmp_path / "y.nc")
+    code, text, err = run([*args_bare, "--json"], capsys)
+    assert code == 0, err
+    assert json.loads(text)["amplitude_m"] == data["amplitude_m"]
+    # a frequency curve still does
+    code, _, err = run(["frf", str(bare), "--from", "300Hz", "--to", "400Hz", "--out",
+                        str(tmp_path / "z.nc")], capsys)  # fmt: skip
+    assert code == 2
+    assert "force_amplitude" in err

@@ -12,7 +12,7 @@ from clearjoint.continuation import (
     ContinuationSettings,
     continue_branch,
 )
-from clearjoint.errors import ParameterError
+from clearjoint.errors import ClearjointError, ParameterError
 
 
 def _s_curve(u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -138,3 +138,27 @@ def test_cubic_predictor_is_exact_on_a_line_and_fourth_order_on_a_circle() -> No
 
     ratio = miss(0.02) / miss(0.01)
     assert 12.0 < ratio < 20.0  # 2^4 = 16; a quadratic predictor would give 8
+
+
+def test_a_step_past_the_end_with_no_point_there_is_not_called_reached() -> None:
+    # u = lam, but the residual cannot be evaluated within 1e-9 of lam = 1 (as when the
+    # exact map fails at the end of the range): a step passes the end, the correction on
+    # the end itself fails, and the branch ends short of it
+    def fails_at_end(u: np.ndarray, lam: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, None]:
+        if abs(lam - 1.0) < 1e-9:
+            raise ClearjointError(f"no evaluation at lambda = {lam!r}")
+        return np.array([u[0] - lam]), np.array([[1.0]]), np.array([-1.0]), None
+
+    branch = continue_branch(
+        fails_at_end,
+        np.array([0.0]),
+        0.0,
+        1.0,
+        u_scale=np.ones(1),
+        lam_scale=1.0,
+        settings=ContinuationSettings(step=0.03, max_step=0.03),
+    )
+    assert 0.9 < branch.lam[-1] < 1.0
+    assert branch.reason.startswith("passed the end of the range (lambda = 1)")
+    assert f"ends at lambda = {branch.lam[-1]:.10g}" in branch.reason
+    assert np.max(np.abs(branch.u[:, 0] - branch.lam)) < 1e-9

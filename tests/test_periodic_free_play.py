@@ -185,3 +185,225 @@ def test_a_curve_started_on_a_free_play_orbit_is_followed_from_the_other_end(
     # both ends on free-play orbits: no single curve, said so
     with pytest.raises(SimulationError, match="multiplier of exactly 1"):
         frequency_response(FREE, 1.0, 10.0, 12.0, damping_ratio=ZETA, restitution=0.8)
+
+
+#: the fixed frequency of the force curves (rad/s), below the contact resonance sqrt(100/1)
+W_F = 4.0
+
+
+@pytest.fixture(scope="module")
+def force_curve() -> FrequencyResponse:
+    return frequency_response(
+        FREE, 0.5, W_F, None, parameter="force", force_stop=5.0, damping_ratio=ZETA, restitution=0.8
+    )
+
+
+def test_force_curve_starts_on_free_play_orbits_linear_in_the_force(
+    force_curve: FrequencyResponse,
+) -> None:
+    # at 0.5 N the free mass's orbit (X = 0.0559) stays in the gap: a continuum; the curve
+    # follows its centred member, X = F0 / (w sqrt(m^2 w^2 + c^2)), linear in F0
+    curve = force_curve
+    assert curve.stop_reason == "reached"
+    assert curve.force_amplitude[0] == pytest.approx(0.5, rel=1e-12)
+    assert curve.force_amplitude[-1] == pytest.approx(5.0, rel=1e-12)
+    assert np.all(curve.omega == W_F)
+    fp = curve.free_play
+    assert fp is not None
+    end = int(np.argmin(fp))  # one run at the start, then the contact branch to the end
+    assert end > 20
+    assert fp[:end].all()
+    assert not fp[end:].any()
+    f = curve.force_amplitude[fp]
+    assert np.all(np.diff(f) > 0.0)
+    expected = f * _free_mass_amplitude(W_F)
+    assert np.max(np.abs(curve.amplitude[fp] / expected - 1.0)) < 1e-9
+    assert np.max(np.abs(curve.x_max[fp] + curve.x_min[fp])) < 1e-9 * 0.1
+    mu = np.sort(np.abs(curve.multipliers[fp]), axis=1)
+    assert np.max(np.abs(mu[:, 1] - 1.0)) < 1e-9
+    assert np.max(np.abs(mu[:, 0] - math.exp(-C_V * 2.0 * math.pi / W_F))) < 1e-9
+    assert not curve.stable[fp].any()
+    events = [e for e in curve.events if e.kind == "free_play"]
+    assert len(events) == 1
+    assert events[0].force_amplitude == pytest.approx(f[-1])
+
+
+def test_force_curve_joins_the_contact_branch_where_2x_equals_the_clearance(
+    force_curve: FrequencyResponse,
+) -> None:
+    curve = force_curve
+    # closed form: the free-mass orbit spans the gap, 2 F0 / (w sqrt(w^2 + c^2)) = 0.2
+    f_g = 0.1 * W_F * math.sqrt(W_F**2 + C_V**2)
+    fp = curve.free_play
+    assert fp is not None
+    first = int(np.argmin(fp))  # the first orbit with contact
+    assert curve.force_amplitude[first] == pytest.approx(f_g, rel=1e-3)
+    assert curve.x_max[first] == pytest.approx(0.1, rel=1e-3)
+    assert curve.x_min[first] == pytest.approx(-0.1, rel=1e-3)
+    assert f_g * (1.0 - 1e-3) < curve.force_amplitude[first - 1] < f_g  # the widest in-gap orbit
+
+
+def test_force_curve_contact_orbits_by_time_marching(force_curve: FrequencyResponse) -> None:
+    # contact points, stable and unstable: one forcing period of time_response from the
+    # curve's initial state closes the orbit (no Newton); stable ones are steady_state's
+    curve = force_curve
+    assert curve.free_play is not None
+    contact = np.nonzero(~curve.free_play)[0]
+    stable = contact[curve.stable[contact]]
+    unstable = contact[~curve.stable[contact]]
+    assert stable.size > 10
+    assert unstable.size > 10
+    kw = {"damping_ratio": ZETA, "restitution": 0.8}
+    for i in (*stable[:: stable.size // 3], *unstable[:: unstable.size // 3]):
+        f, z = float(curve.force_amplitude[i]), curve.initial_state[i]
+        size = np.array([curve.amplitude[i], curve.amplitude[i] * W_F])
+        one = time_response(FREE, f, W_F, 2.0 * math.pi / W_F, initial=z, **kw)  # type: ignore[arg-type]
+        assert np.max(np.abs(np.array(one.final_state) - z) / size) < 1e-8
+        assert one.x_max == pytest.approx(curve.x_max[i], abs=1e-8 * size[0])
+        assert one.x_max > 0.1 or one.x_min < -0.1  # it does reach an edge
+        if curve.stable[i]:
+            ss = steady_state(FREE, f, W_F, initial=z * (1.0 + 1e-6), **kw)  # type: ignore[arg-type]
+            assert ss.period_multiple == 1
+            assert abs(ss.x_max - curve.x_max[i]) / curve.amplitude[i] < 1e-9
+
+
+def test_force_curve_followed_down_ends_on_the_free_play_orbits(
+    force_curve: FrequencyResponse,
+) -> None:
+    down = frequency_response(
+        FREE, 5.0, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA, restitution=0.8
+    )
+    assert down.stop_reason == "reached"
+    assert down.free_play is not None
+    assert down.free_play[-1]
+    assert not down.free_play[0]
+    assert down.force_amplitude[-1] == pytest.approx(0.5, rel=1e-12)
+    f = down.force_amplitude[down.free_play]
+    expected = f * _free_mass_amplitude(W_F)
+    assert np.max(np.abs(down.amplitude[down.free_play] / expected - 1.0)) < 1e-9
+    # the curve started on the free-play orbits is this one turned round
+    assert np.array_equal(down.force_amplitude, force_curve.force_amplitude[::-1])
+    # both ends only inside the gap (below the fold at 1.24 N): no single curve, said so
+    with pytest.raises(SimulationError, match="multiplier of exactly 1"):
+        frequency_response(
+            FREE,
+            0.5,
+            W_F,
+            None,
+            parameter="force",
+            force_stop=1.0,
+            damping_ratio=ZETA,
+            restitution=0.8,
+        )
+
+
+def test_study_force_curve_from_inside_the_gap_by_time_marching() -> None:
+    # the example (examples/study.toml at 400 Hz, 100 N to 2 kN: friction 60 N, so
+    # no closed form): the free-play points close under time_response from their centred
+    # start and from it shifted in the gap (the position is not set), and the contact
+    # branch starts where the orbit touches both edges
+    from clearjoint.simulate.study import load_study
+
+    study = load_study(Path(__file__).parents[1] / "examples" / "study.toml")
+    kw: dict[str, object] = {
+        "damping_ratio": study.damping_ratio,
+        "friction": study.friction,
+        "restitution": study.restitution,
+    }
+    w = 2.0 * math.pi * 400.0
+    curve = frequency_response(
+        study.joint,
+        100.0,
+        w,
+        None,
+        parameter="force",
+        force_stop=2000.0,
+        **kw,  # type: ignore[arg-type]
+    )
+    assert curve.stop_reason == "reached"
+    assert curve.free_play is not None
+    first = int(np.argmin(curve.free_play))
+    assert curve.free_play[:first].all()
+    assert not curve.free_play[first:].any()
+    gap = study.joint.compression_gap
+    assert curve.x_max[first] == pytest.approx(gap, rel=1e-3)
+    assert curve.x_min[first] == pytest.approx(-study.joint.tension_gap, rel=1e-3)
+    for i in (0, first // 2, first - 1):
+        f = float(curve.force_amplitude[i])
+        room = gap - float(curve.x_max[i])
+        for shift in (0.0, 0.8 * room):
+            start = curve.initial_state[i] + np.array([shift, 0.0])
+            one = time_response(study.joint, f, w, 2.0 * math.pi / w, initial=start, **kw)  # type: ignore[arg-type]
+            size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
+            assert np.max(np.abs(np.array(one.final_state) - start) / size) < 1e-8
+            assert one.amplitude == pytest.approx(curve.amplitude[i], rel=1e-8)
+    # between the fold (220 N) and the junction (680 N) both kinds coexist, by time marching:
+    # near 400 N a free-play start kicked by 1 % in velocity stays in the gap with the
+    # curve's amplitude; from rest the joint settles on the stable contact orbit, which
+    # steady_state confirms
+    free = np.nonzero(curve.free_play)[0]
+    contact = np.nonzero(curve.stable)[0]
+    j = int(free[np.argmin(abs(curve.force_amplitude[free] - 400.0))])
+    k = int(contact[np.argmin(abs(curve.force_amplitude[contact] - 400.0))])
+    period = 2.0 * math.pi / w
+    for i, start, inside in ((j, curve.initial_state[j] * np.array([1.0, 1.01]), True),
+                             (k, np.zeros(2), False)):  # fmt: skip
+        f = float(curve.force_amplitude[i])
+        motion = time_response(study.joint, f, w, 100 * period, initial=start, **kw)  # type: ignore[arg-type]
+        last = time_response(study.joint, f, w, period, initial=motion.final_state, **kw)  # type: ignore[arg-type]
+        assert (last.x_max < gap) == inside
+        if inside:
+            assert last.amplitude == pytest.approx(curve.amplitude[i], rel=1e-8)
+    ss = steady_state(study.joint, f, w, initial=curve.initial_state[k] * (1.0 + 1e-6), **kw)  # type: ignore[arg-type]
+    assert ss.period_multiple == 1
+    assert abs(ss.x_max - curve.x_max[k]) / curve.amplitude[k] < 1e-9
+    assert last.amplitude == pytest.approx(curve.amplitude[k], rel=1e-6)
+
+
+def test_force_curve_from_the_coexistence_region_goes_round_the_fold_to_the_free_play() -> None:
+    # at 1.5 N (between the fold, 1.24 N, and the junction, 1.79 N) the transient finds the
+    # stable contact orbit; followed down, the curve goes round the fold, up the unstable
+    # branch past the start to the junction (2 X = clearance), then down the free play
+    curve = frequency_response(
+        FREE, 1.5, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA, restitution=0.8
+    )
+    assert curve.stop_reason == "reached"
+    assert curve.free_play is not None
+    assert not curve.free_play[0]
+    assert curve.free_play[-1]
+    assert curve.force_amplitude[-1] == pytest.approx(0.5, rel=1e-12)
+    f_g = 0.1 * W_F * math.sqrt(W_F**2 + C_V**2)
+    assert np.max(curve.force_amplitude) == pytest.approx(f_g, rel=1e-3)
+    assert [e.kind for e in curve.events].count("fold") >= 1
+    fp = curve.free_play
+    expected = curve.force_amplitude[fp] * _free_mass_amplitude(W_F)
+    assert np.max(np.abs(curve.amplitude[fp] / expected - 1.0)) < 1e-9
+
+
+def test_without_impact_loss_the_curve_goes_on_along_the_free_play_too() -> None:
+    # restitution 1: past the junction the orbits that reach past an edge by a hair
+    # (members of the continuum pushed against it) used to be followed, 1e-5 N a step,
+    # to max_points; they count as not touching, and the curve goes on as with e < 1
+    f_g = 0.1 * W_F * math.sqrt(W_F**2 + C_V**2)
+    w_g = brentq(lambda w: 2.0 * _free_mass_amplitude(w) - 0.2, 1.0, 10.0)
+    by_force = frequency_response(
+        FREE, 5.0, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA
+    )
+    by_omega = frequency_response(FREE, 1.0, 2.0, 12.0, damping_ratio=ZETA)
+    for curve, junction in ((by_force, f_g), (by_omega, w_g)):
+        assert curve.stop_reason == "reached"
+        fp = curve.free_play
+        assert fp is not None
+        first = int(np.argmax(fp))
+        assert first > 10
+        assert fp[first:].all()
+        lam = curve.force_amplitude if curve.parameter == "force" else curve.omega
+        assert lam[first - 1] == pytest.approx(junction, rel=1e-3)
+        expected = curve.force_amplitude[fp] * _free_mass_amplitude(curve.omega[fp])
+        assert np.max(np.abs(curve.amplitude[fp] / expected - 1.0)) < 1e-9
+        # the last contact orbit closes under one period of time marching
+        i = first - 1
+        f, w, z = float(curve.force_amplitude[i]), float(curve.omega[i]), curve.initial_state[i]
+        one = time_response(FREE, f, w, 2.0 * math.pi / w, initial=z, damping_ratio=ZETA)
+        size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
+        assert np.max(np.abs(np.array(one.final_state) - z) / size) < 1e-8

@@ -244,3 +244,17 @@ def test_friction_switched_off_explicitly_and_percent(tmp_path: Path) -> None:
     study = load_study(write(tmp_path, MINIMAL.replace("damping_ratio = 0.02", text)))
     assert study.friction is None
     assert study.damping_ratio == pytest.approx(0.02)
+
+
+def test_a_key_the_caller_does_not_need_may_be_left_out(tmp_path: Path) -> None:
+    # a force curve (frf --parameter force) takes its forces from the command line
+    path = tmp_path / "s.toml"
+    path.write_text(MINIMAL.replace('force_amplitude = "1kN"', ""), encoding="utf-8")
+    with pytest.raises(StudyError, match=r"\[excitation\] force_amplitude is required"):
+        load_study(path)
+    study = load_study(path, optional=("excitation.force_amplitude",))
+    assert math.isnan(study.force_amplitude)
+    assert study.omega == pytest.approx(2.0 * math.pi * 400.0)
+    # given, it is read as usual
+    full = load_study(write(tmp_path, MINIMAL), optional=("excitation.force_amplitude",))
+    assert full.force_amplitude == 1000.0

@@ -904,7 +904,11 @@ def _run_frf(args: argparse.Namespace) -> int:
 
     structure_study = _structure_study(args.study)
     if structure_study is None:
-        study = load_study(args.study)
+        # a force curve takes its forces from --from/--to, not from the study
+        force_curve = args.parameter == "force"
+        study = load_study(
+            args.study, optional=("excitation.force_amplitude",) if force_curve else ()
+        )
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     kind = "force" if args.parameter == "force" else "frequency"
@@ -1030,9 +1034,11 @@ def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Pa
         return 0
     lines = [f"study: {source}", repr(curve)]
     if free is not None and free.any():
+        by_force = curve.parameter == "force"
+        span = curve.force_amplitude[free] if by_force else curve.omega[free] / (2 * math.pi)
+        unit = f"N at {curve.omega[0] / (2 * math.pi):.6g} Hz" if by_force else "Hz"
         lines.append(
-            f"free play from {curve.omega[free].min() / (2 * math.pi):.6g} to "
-            f"{curve.omega[free].max() / (2 * math.pi):.6g} Hz: the orbit stays inside "
+            f"free play from {span.min():.6g} to {span.max():.6g} {unit}: the orbit stays inside "
             "the gap (gap_stiffness 0), one of a continuum; its amplitude is set by the dynamics, "
             "its position is not (the curve shows the orbit centred in the gap)"
         )

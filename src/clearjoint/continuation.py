@@ -173,8 +173,11 @@ class Branch:
     data : list
         What the residual returned as data at each converged point.
     reason : str
-        Why it stopped: "reached", "max_points", "left the range", "step too
-        small at lambda = ...: ..." (no step converged, the kink jump included),
+        Why it stopped: "reached" (the last point is ``lam_stop`` itself), "passed
+        the end of the range ...: the branch ends at lambda = ..." (a step went
+        past ``lam_stop`` but no point converged on it), "max_points", "left the
+        range", "step too small at lambda = ...: ..." (no step converged, the kink
+        jump included),
         or "ran back along its own path from lambda = ...: ..." (a kink crossing
         led back onto the branch already followed; those points are dropped),
         or "joined" (it reached the ``join`` point).
@@ -516,12 +519,14 @@ def continue_branch(
             elif float(t_new @ (y_new - y)) < 0.0:
                 t_new = -t_new  # go on away from the kink (at a grazing fold: back in lambda)
             if direction * (y_new[-1] - stop) >= 0.0:
-                reason = "reached"
                 if direction * (y_new[-1] - stop) == 0.0:
+                    reason = "reached"
                     ys.append(y_new)
                     ts.append(t_new)
                     datas.append(data_new)
                     iters.append(its)
+                else:
+                    reason = _short_of_end(stop * scale[-1], y[-1] * scale[-1])
                 break
             if not relabelled:
                 kinks.append(len(ys))
@@ -554,7 +559,9 @@ def continue_branch(
                 ts.append(_tangent(a_end, t_new))
                 datas.append(data_end)
                 iters.append(its_end)
-            reason = "reached"
+                reason = "reached"
+            else:
+                reason = _short_of_end(stop * scale[-1], y[-1] * scale[-1])
             break
         if kinks and differs is not None:
             back_steps = (
@@ -606,6 +613,14 @@ def continue_branch(
         data=datas,
         reason=reason,
         kinks=np.array(kinks, dtype=np.int64),
+    )
+
+
+def _short_of_end(stop: float, last: float) -> str:
+    """The stop reason when a step passed ``stop`` but no point converged on it."""
+    return (
+        f"passed the end of the range (lambda = {stop:.10g}) but no point converged there; "
+        f"the branch ends at lambda = {last:.10g}"
     )
 
 

@@ -582,7 +582,7 @@ class _MapResidual:
         self.refused_at: list[float] = []
 
     def _refused(self, out: FloatArray) -> bool:
-        return self.free_play_stop and _in_gap(self.p, out)
+        return self.free_play_stop and _in_gap(self.p, out, _TOUCH)
 
     def __call__(
         self, u: FloatArray, lam: float, derivative: bool = True
@@ -680,17 +680,29 @@ def _map_residual(p: FloatArray, parameter: str, free_play_stop: bool = False) -
     return _MapResidual(p, parameter, free_play_stop)
 
 
-def _in_gap(p: FloatArray, out: FloatArray) -> bool:
+#: An orbit reaching past an edge by less than this fraction of the clearance counts as
+#: not touching it (with restitution 1 such orbits are the continuum's members pushed
+#: against an edge: a family the continuation would otherwise creep along).
+_TOUCH = 1e-7
+
+
+def _in_gap(p: FloatArray, out: FloatArray, slack: float = 0.0) -> bool:
     """With k0 = 0, an orbit that never reaches a gap edge (``out``: a map_residual row).
 
     Inside the gap the force does not depend on x, so the orbit shifted by any
     constant is an orbit too: a continuum, with a Floquet multiplier exactly 1.
     """
-    return bool(p[kn.P_K0] == 0.0 and out[R_XMAX] < p[kn.P_GC] and out[R_XMIN] > -p[kn.P_GT])
+    tol = slack * (p[kn.P_GC] + p[kn.P_GT])
+    return bool(
+        p[kn.P_K0] == 0.0 and out[R_XMAX] < p[kn.P_GC] + tol and out[R_XMIN] > -p[kn.P_GT] - tol
+    )
 
 
-def _free_play_orbit(p: FloatArray, omega: float) -> FloatArray | None:
+def _free_play_orbit(p: FloatArray, omega: float, code: int = 0) -> FloatArray | None:
     """The member centred in the gap of the continuum of in-gap orbits at ``omega`` (k0 = 0).
+
+    ``omega`` is the continuation parameter's value: the forcing frequency (rad/s)
+    with ``code`` 0, the force amplitude F0 (N) with ``code`` 1 (``p`` giving the other).
 
     Inside the gap with k0 = 0 the velocity obeys m v' + c v + friction(v) = F0 sin(w t)
     whatever x is: its periodic solution v* is found by Newton on the velocity
@@ -707,15 +719,16 @@ def _free_play_orbit(p: FloatArray, omega: float) -> FloatArray | None:
         None when the orbit does not fit inside the gap or Newton fails.
     """
     q = p.copy()
-    _set_parameter(q, 0, omega)
-    m, c, f0 = q[kn.P_MASS], q[kn.P_DAMP], q[kn.P_F0]
+    lam = omega
+    _set_parameter(q, code, lam)
+    m, c, f0, omega = q[kn.P_MASS], q[kn.P_DAMP], q[kn.P_F0], q[kn.P_W]
     v = -f0 * m * omega / (c * c + (m * omega) ** 2)  # v(0) of the viscous free mass
     # the velocity orbit does not depend on where the edges are: solve it with them far off
     far = q.copy()
     far[kn.P_GC] = far[kn.P_GT] = 1e6 * (q[kn.P_GC] + q[kn.P_GT] + f0 / (m * omega**2))
     out = np.zeros(N_RES)
     for _ in range(30):
-        if map_residual(far, 0, 0.0, v, omega, out, False) != kn.STATUS_OK:
+        if map_residual(far, code, 0.0, v, lam, out, False) != kn.STATUS_OK:
             return None
         dv = -out[R_RES + 1] / out[R_JAC + 3]
         v += dv
@@ -724,7 +737,7 @@ def _free_play_orbit(p: FloatArray, omega: float) -> FloatArray | None:
     else:
         return None
     x0 = (q[kn.P_GC] - q[kn.P_GT]) / 2.0 - 0.5 * (out[R_XMAX] + out[R_XMIN])
-    if map_residual(q, 0, x0, v, omega, out, True) != kn.STATUS_OK or not _in_gap(q, out):
+    if map_residual(q, code, x0, v, lam, out, True) != kn.STATUS_OK or not _in_gap(q, out):
         return None
     size = out[R_XMAX] - out[R_XMIN]
     if abs(out[R_RES]) > 1e-9 * size or abs(out[R_RES + 1]) > 1e-9 * size * omega:
@@ -793,7 +806,7 @@ def frequency_response(
     With gap_stiffness 0, the branch stops where it meets the orbits that stay
     inside the gap (a continuum: any mean position) and goes on along the one
     centred in the gap (``free_play``); a start on such an orbit is followed from
-    the other end of the range and turned round (omega only).
+    the other end of the range and turned round.
 
     Parameters
     ----------
@@ -855,18 +868,36 @@ def frequency_response(
                 f"sqrt(k0/m) = {w_g!r} rad/s, so a free oscillation can be added to the orbit "
                 "(a continuum, no single curve); give damping_ratio > 0 or another omega_start"
             )
-        if parameter != "omega" or joint.gap_stiffness != 0.0:
+        if joint.gap_stiffness != 0.0:
             raise refusal
         # a free-play orbit at the start: follow the curve from the other end, which ends on
         # the free-play orbits (if that end is not one too), and turn it round
         kw = {"damping_ratio": damping_ratio, "friction": friction, "restitution": restitution}
+        force_mode = parameter == "force"
         try:
-            other = periodic_orbit(joint, f0, stop, **kw)  # type: ignore[arg-type]
+            other = periodic_orbit(
+                joint,
+                stop if force_mode else f0,
+                w0 if force_mode else stop,
+                **kw,  # type: ignore[arg-type]
+            )
         except SimulationError:
             raise refusal from None
         if np.min(np.abs(other.multipliers - 1.0)) < 1e-9:
             raise refusal
-        turned = frequency_response(joint, f0, stop, w0, max_points=max_points, **kw)  # type: ignore[arg-type]
+        if force_mode:
+            turned = frequency_response(
+                joint,
+                stop,
+                w0,
+                None,
+                parameter="force",
+                force_stop=f0,
+                max_points=max_points,
+                **kw,  # type: ignore[arg-type]
+            )
+        else:
+            turned = frequency_response(joint, f0, stop, w0, max_points=max_points, **kw)  # type: ignore[arg-type]
         return _turned_round(turned)
     p = _parameters(joint, f0, w0, damping_ratio, friction, restitution)
     x_scale = max(joint.clearance / 2.0, first.amplitude)
@@ -900,7 +931,7 @@ def frequency_response(
 
     # k0 = 0: orbits that stay inside the gap are a continuum; the branch stops where it
     # meets them and the member centred in the gap is followed instead (_free_play_tail)
-    free_play_stop = parameter == "omega" and joint.gap_stiffness == 0.0
+    free_play_stop = joint.gap_stiffness == 0.0
     residual = _map_residual(p, parameter, free_play_stop)
 
     def follow(
@@ -940,7 +971,7 @@ def frequency_response(
             break
         if free_play_stop:
             tail = _free_play_tail(
-                p, branch, residual.refused_at, stop, max_points - branch.lam.size
+                p, branch, residual.refused_at, stop, max_points - branch.lam.size, code
             )
             if tail is not None:
                 break
@@ -970,7 +1001,8 @@ def frequency_response(
         initial_state = np.concatenate((initial_state, tail[:, R_RES : R_RES + 2]))
         free_play = np.concatenate((free_play, np.ones(len(tail), dtype=bool)))
         reason = "reached" if tail[-1, N_RES] == stop else "max_points"
-    if reason == "reached" and abs(lam_all[-1] - stop) > 1e-12 * abs(stop - start):
+    short = reason.startswith("passed the end")  # continue_branch says so itself
+    if short or (reason == "reached" and abs(lam_all[-1] - stop) > 1e-12 * abs(stop - start)):
         # a step passed the end but no orbit converged at the end itself (e.g. a continuum
         # of sticking orbits there): the curve is short of the range, so say so
         unit = "rad/s" if parameter == "omega" else "N"
@@ -1072,7 +1104,12 @@ def _turned_round(curve: FrequencyResponse) -> FrequencyResponse:
 
 
 def _free_play_tail(
-    p: FloatArray, branch: Branch, refused_at: list[float], stop: float, points: int
+    p: FloatArray,
+    branch: Branch,
+    refused_at: list[float],
+    stop: float,
+    points: int,
+    code: int = 0,
 ) -> NDArray[np.float64] | None:
     """The centred in-gap orbits from where ``branch`` stopped on to ``stop`` (k0 = 0), or None.
 
@@ -1082,9 +1119,9 @@ def _free_play_tail(
     in-gap orbits (``refused_at``: within 1e-3 of the range of the stop), and the
     centred member (``_free_play_orbit``)
     exists close to that frequency (at 0.001, 0.01 or 0.1 of the first grid step on).
-    The grid is uniform in omega, 0.5 % of the range a step (at most ``points``
-    points in all). Rows: a map_residual row (x0, v0 in
-    the first two places) and omega.
+    The grid is uniform in the parameter (omega with ``code`` 0, F0 with 1), 0.5 %
+    of the range a step (at most ``points`` points in all). Rows: a map_residual
+    row (x0, v0 in the first two places) and the parameter.
     """
     last = branch.data[-1]
     gap = p[kn.P_GC] + p[kn.P_GT]
@@ -1101,7 +1138,7 @@ def _free_play_tail(
     near = lam + np.array([1e-3, 1e-2, 1e-1]) * (grid[0] - lam)
     rows: list[FloatArray] = []
     for w in np.concatenate((near, grid)):
-        orbit = _free_play_orbit(p, float(w))
+        orbit = _free_play_orbit(p, float(w), code)
         if orbit is None:
             if rows or w > near[-1]:
                 break

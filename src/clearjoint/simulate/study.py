@@ -13,6 +13,7 @@ examples/study.toml.
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -100,8 +101,16 @@ class Study:
         )
 
 
-def load_study(path: str | Path) -> Study:
+def load_study(path: str | Path, *, optional: Collection[str] = ()) -> Study:
     """Read a study TOML file, merge the defaults and validate every value.
+
+    Parameters
+    ----------
+    path : str or Path
+    optional : collection of str
+        Required keys, as "section.key", that the caller does not need (e.g.
+        "excitation.force_amplitude" for a force curve, whose forces the command
+        line gives); left out, they are NaN.
 
     Raises
     ------
@@ -129,6 +138,8 @@ def load_study(path: str | Path) -> Study:
         for key, (default, _kind) in spec.items():
             if key in given:
                 values[section][key] = given[key]
+            elif default is None and f"{section}.{key}" in optional:
+                values[section][key] = math.nan
             elif default is None and (section != "pin" or "pin" in raw):
                 raise StudyError(f"{where}: [{section}] {key} is required")
             else:
@@ -180,8 +191,8 @@ def _build(
     if not frequency > 0.0:
         raise StudyError(f"{where}: [excitation] frequency must be > 0 Hz, got {frequency!r}")
     omega = 2.0 * math.pi * frequency
-    force = ex["force_amplitude"]
-    if not (math.isfinite(force) and force >= 0.0):
+    force = ex["force_amplitude"]  # NaN when left out as optional (load_study)
+    if "excitation.force_amplitude" in stated and not (math.isfinite(force) and force >= 0.0):
         raise StudyError(
             f"{where}: [excitation] force_amplitude must be a finite force >= 0 N, got {force!r}"
         )
