@@ -217,28 +217,22 @@ def test_first_nonlinear_mode_of_a_small_mast_is_its_free_decay_backbone() -> No
     np.testing.assert_allclose(zeta, np.interp(a, peak, nm.damping_ratio), rtol=0.12)
 
 
-def test_friction_in_a_structure_joint_is_refused_with_what_is_supported() -> None:
-    """The message is true: the exact structure motion refuses friction too, and a Joint
-    with friction is carried by harmonic balance."""
-    from clearjoint import Friction, Joint
+def test_friction_in_a_structure_joint_is_carried_and_a_sticking_orbit_flagged() -> None:
+    """Friction in rigid members' joints is carried by HB (tests/test_harmonic_friction.py
+    checks it); nonlinear modes and the exact structure motion still refuse it, and an orbit
+    whose joints stick (20 N of friction against 40 N of forcing) is flagged untrusted."""
+    from clearjoint import Friction
     from clearjoint.structure import StructureError
 
     rub = Friction(coefficient=0.2, lateral_load=100.0)
     j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5, friction=rub)
     s = chain([1.0, 1.0], [math.inf, math.inf], [j, j], dampers=[5.0, 5.0])  # friction: rigid
-    for call in (
-        lambda: frequency_response(s, np.array([0.0, 40.0]), 300.0, 310.0),
-        lambda: nonlinear_modes(s, 1, [1e-3]),
-    ):
-        with pytest.raises(HarmonicError, match="not carried for a structure") as err:
-            call()
-        assert "for a single Joint only" in str(err.value)
-        assert "set friction=None" in str(err.value)
+    fr = frequency_response(s, np.array([0.0, 40.0]), 300.0, 310.0, max_points=2)
+    assert fr.omega.size == 2
+    sticking = [e for e in fr.events if e.kind == "untrusted"]
+    assert len(sticking) == 2
+    assert "it sticks" in sticking[0].note
+    with pytest.raises(HarmonicError, match="not by nonlinear_modes"):
+        nonlinear_modes(s, 1, [1e-3])
     with pytest.raises(StructureError, match="friction"):
         time_response(s, np.array([0.0, 40.0]), 300.0, 0.01)
-    joint = Joint(mass=1.0, clearance=0.35, compression_stiffness=3.0, gap_stiffness=1.0)
-    small = Friction(coefficient=0.005, lateral_load=1.0)
-    fr = frequency_response(
-        joint, 0.03, 1.3, 1.31, harmonics=3, max_points=2, damping_ratio=0.0144, friction=small
-    )
-    assert fr.omega.size == 2

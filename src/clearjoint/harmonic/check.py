@@ -155,6 +155,9 @@ def check_orbits(
     ------
     ParameterError
         Not a harmonic-balance curve of a Structure, an index off the curve, a bad tolerance.
+    HarmonicError
+        A structure with Coulomb friction in a joint: its exact motion does not carry
+        friction, so there is nothing exact to check against.
     """
     from clearjoint.harmonic import aft, monodromy
     from clearjoint.harmonic.system import build
@@ -166,6 +169,14 @@ def check_orbits(
         raise ParameterError(
             "check_orbits needs a curve of clearjoint.harmonic.frequency_response on a "
             "Structure; a Joint's orbits are checked by clearjoint.periodic's exact shooting"
+        )
+    if any(law.friction is not None and law.friction.force > 0.0 for law in structure.joint_laws):
+        from clearjoint.harmonic.system import HarmonicError
+
+        raise HarmonicError(
+            "check_orbits cannot check a structure with Coulomb friction in a joint: its exact "
+            "motion (clearjoint.structure.time_response) does not carry friction; "
+            "frequency_response skips the check there (pass check_points=0 to say so)"
         )
     if not (isinstance(tolerance, float | int) and math.isfinite(tolerance) and tolerance > 0):
         raise ParameterError(f"tolerance must be a finite number > 0, got {tolerance!r}")

@@ -156,15 +156,18 @@ def _refuse_losses(
 
 
 def _refuse_structure_losses(law: ClearanceJoint, index: int) -> None:
-    """Refuse a structure joint's friction or impacts, saying what is supported instead."""
-    if law.friction is not None and law.friction.force > 0.0:
+    """Refuse a structure joint's friction over the free-play stroke only, or impacts.
+
+    Friction over the whole path (region "everywhere") is carried, regularised; a
+    member holds it only when it is rigid (:meth:`ClearanceJoint.in_series`).
+    """
+    rubs = law.friction is not None and law.friction.force > 0.0
+    if rubs and law.friction is not None and law.friction.region != "everywhere":
         raise HarmonicError(
-            f"Coulomb friction in the joint of member {index} is not carried for a structure: "
-            "neither clearjoint.harmonic nor the exact clearjoint.structure motion models "
-            "joints that stick (friction is supported for a single Joint only: "
-            "clearjoint.harmonic.frequency_response regularised, clearjoint.periodic exact "
-            "stick-slip); set friction=None on the structure's joints (its loss may be "
-            "approximated by damping, e.g. rayleigh=), or study that joint alone as a Joint"
+            f"Coulomb friction over the free-play stroke only (joint of member {index}) is "
+            "not carried by clearjoint.harmonic; set region='everywhere' (friction over the "
+            "whole path, carried regularised) or friction=None, or study that joint alone "
+            "with clearjoint.periodic (exact stick-slip)"
         )
     if law.restitution != 1.0:
         raise HarmonicError(
@@ -212,14 +215,32 @@ def from_joint(
     )
 
 
-def from_structure(structure: Any) -> LinearSystem:
-    """The system of a :class:`~clearjoint.structure.Structure` (dense matrices)."""
+def from_structure(structure: Any, friction_speed: float = 0.0) -> LinearSystem:
+    """The system of a :class:`~clearjoint.structure.Structure` (dense matrices).
+
+    Coulomb friction of a (rigid member's) joint over its whole path is carried as
+    mu_s P tanh(v_j / v_eps) on its relative speed v_j = b_j . u', v_eps =
+    ``friction_speed`` (m/s, > 0 when some joint has friction); joints without
+    friction get a friction force of 0.
+    """
     from clearjoint.structure.model import OPEN
 
     laws: tuple[ClearanceJoint, ...] = structure.joint_laws
     for index, law in zip(structure.joint_members, laws, strict=True):
         _refuse_structure_losses(law, index)
     n_j = len(laws)
+    rub = np.array([0.0 if law.friction is None else law.friction.force for law in laws])
+    forces = None
+    if np.any(rub > 0.0):
+        if not friction_speed > 0.0:  # nonlinear_modes: no regularisation speed given
+            member = structure.joint_members[int(np.argmax(rub > 0.0))]
+            raise HarmonicError(
+                f"Coulomb friction in the joint of member {member} is carried (regularised) by "
+                "clearjoint.harmonic.frequency_response only, not by nonlinear_modes; "
+                "set friction=None on the structure's joints for nonlinear modes"
+            )
+        forces = rub
+        friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
     k_lin, _ = structure.pattern_stiffness(np.full(n_j, OPEN, dtype=np.int64))
     # pattern_stiffness("open") holds each joint's k0; the laws carry k0 themselves.
     b = structure.joint_directions
@@ -238,6 +259,8 @@ def from_structure(structure: Any) -> LinearSystem:
         dof_names=list(structure.dof_names),
         is_joint=False,
         source=structure,
+        friction_force=forces,
+        friction_speed=float(friction_speed),
     )
 
 
@@ -259,7 +282,7 @@ def build(
                 "damping_ratio, friction and restitution apply to a Joint; a Structure carries "
                 "its own damping (Member.damping, rayleigh) and joint losses"
             )
-        return from_structure(system)
+        return from_structure(system, friction_speed)
     raise ParameterTypeError(
         f"system must be a clearjoint.Joint or a clearjoint.structure.Structure, got {system!r}"
     )
@@ -293,9 +316,21 @@ def scale_length(system: LinearSystem) -> float:
 
 
 def friction_speed(system: Any, omega: float, given: float | None) -> float:
-    """The regularisation speed v_eps (m/s): ``given``, or 1e-3 * omega * c for a Joint."""
+    """The regularisation speed v_eps (m/s): ``given``, or 1e-3 * omega * c.
+
+    c is a Joint's clearance, or for a Structure the largest clearance of its joints
+    with friction (1 um at least); 0 for a Structure without friction.
+    """
     if given is not None:
         return _checks.positive("friction_regularization", given, unit="m/s")
     if isinstance(system, Joint):
         return 1e-3 * omega * max(system.clearance, 1e-6)
+    laws = getattr(system, "joint_laws", ())
+    gaps = [
+        float(law.clearance)
+        for law in laws
+        if law.friction is not None and law.friction.force > 0.0
+    ]
+    if gaps:
+        return 1e-3 * omega * max(max(gaps), 1e-6)
     return 0.0
