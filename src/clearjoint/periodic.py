@@ -584,6 +584,19 @@ class _MapResidual:
     def _refused(self, out: FloatArray) -> bool:
         return self.free_play_stop and _in_gap(self.p, out, _TOUCH)
 
+    def _corrected(
+        self, its: int, y: FloatArray, system: FloatArray, out: FloatArray, scale: FloatArray
+    ) -> tuple[FloatArray, FloatArray, Any, int] | None:
+        """A compiled correction's outcome: (y, [R_u, R_lam], data, its), or None (failed or
+        refused, counting its map evaluations either way)."""
+        self.evaluations += int(out[R_EVALS])
+        if its < 0:
+            return None
+        if self._refused(out):
+            self.refused_at.append(float(y[-1] * scale[-1]))
+            return None
+        return y, system[:2].copy(), out, int(its)
+
     def __call__(
         self, u: FloatArray, lam: float, derivative: bool = True
     ) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
@@ -624,13 +637,7 @@ class _MapResidual:
             system,
             out,
         )
-        self.evaluations += int(out[R_EVALS])
-        if its < 0:
-            return None
-        if self._refused(out):
-            self.refused_at.append(float(y[-1] * scale[-1]))
-            return None
-        return y, system[:2].copy(), out, int(its)
+        return self._corrected(its, y, system, out, scale)
 
     def step(
         self,
@@ -666,13 +673,8 @@ class _MapResidual:
             out,
             t_new,
         )
-        self.evaluations += int(out[R_EVALS])
-        if its < 0:
-            return None
-        if self._refused(out):
-            self.refused_at.append(float(y[-1] * scale[-1]))
-            return None
-        return (y, system[:2].copy(), out, int(its)), t_new
+        corrected = self._corrected(its, y, system, out, scale)
+        return None if corrected is None else (corrected, t_new)
 
 
 def _map_residual(p: FloatArray, parameter: str, free_play_stop: bool = False) -> _MapResidual:
