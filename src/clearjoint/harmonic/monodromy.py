@@ -77,23 +77,37 @@ def crossings(system: LinearSystem, basis: Basis, coefficients: FloatArray) -> F
     rows, joints = np.nonzero(change)
     if rows.size == 0:
         return np.zeros(0)
-    step = 2.0 * math.pi / n_t
-    lo = np.asarray(rows * step, dtype=np.float64)
-    hi = lo + step
     # the edge crossed: the compression one if either end is beyond it, else the tension one
     nxt = (rows + 1) % n_t
     compress = (state[rows, joints] == 1) | (state[nxt, joints] == 1)
     edge = np.where(compress, system.g_c[joints], -system.g_t[joints])
-    cols = rel[:, joints]  # (2H + 1, k)
-    f_lo = _at(basis, cols, lo) - edge
+    return _bisect(basis, rel[:, joints], edge, rows)
+
+
+def _bisect(
+    basis: Basis, columns: FloatArray, level: FloatArray, rows: NDArray[np.intp]
+) -> FloatArray:
+    """Sorted phases where column k of ``columns`` (2H + 1, k) crosses ``level[k]`` inside the
+    sample interval ``rows[k]`` (where its sign changes), by bisection to 2^-40 of it."""
+    step = 2.0 * math.pi / basis.samples
+    lo = np.asarray(rows * step, dtype=np.float64)
+    hi = lo + step
+    f_lo = _at(basis, columns, lo) - level
     for _ in range(_BISECTIONS):
         mid = np.asarray(0.5 * (lo + hi), dtype=np.float64)
-        f_mid = _at(basis, cols, mid) - edge
+        f_mid = _at(basis, columns, mid) - level
         same = np.sign(f_mid) == np.sign(f_lo)
         lo = np.where(same, mid, lo)
         f_lo = np.where(same, f_mid, f_lo)
         hi = np.where(same, hi, mid)
     return np.sort(np.mod(0.5 * (lo + hi), 2.0 * math.pi))
+
+
+def _pattern_stiffness(system: LinearSystem, state: NDArray[np.int64]) -> FloatArray:
+    """K plus each joint's tangent in its contact state (1 compression, -1 tension), N/m."""
+    k_j = system.k0 + system.k_c * (state == 1) + system.k_t * (state == -1)
+    b = system.directions
+    return np.asarray(system.stiffness + (b.T * k_j) @ b, dtype=np.float64)
 
 
 def _at(basis: Basis, columns: FloatArray, tau: FloatArray) -> FloatArray:
@@ -146,8 +160,7 @@ def monodromy(
             continue
         key = state.tobytes()
         if key not in cache:
-            k_j = system.k0 + system.k_c * (state == 1) + system.k_t * (state == -1)
-            cache[key] = -inv_m[:, None] * (system.stiffness + (b.T * k_j) @ b)
+            cache[key] = -inv_m[:, None] * _pattern_stiffness(system, state)
         a[n:, :n] = cache[key]
         phi = scipy.linalg.expm(a * (width / omega)) @ phi
     return phi
@@ -184,25 +197,12 @@ def multipliers(
 
 def _roots(basis: Basis, columns: FloatArray, level: FloatArray) -> FloatArray:
     """Phases in [0, 2 pi) where some column of ``columns`` (2H + 1, k) crosses its ``level``."""
-    n_t = basis.samples
     values = basis.to_time @ columns - level  # (N_t, k)
     above = values > 0.0
     rows, cols = np.nonzero(above != np.roll(above, -1, axis=0))
     if rows.size == 0:
         return np.zeros(0)
-    step = 2.0 * math.pi / n_t
-    lo = np.asarray(rows * step, dtype=np.float64)
-    hi = lo + step
-    picked = columns[:, cols]
-    f_lo = _at(basis, picked, lo) - level[cols]
-    for _ in range(_BISECTIONS):
-        mid = np.asarray(0.5 * (lo + hi), dtype=np.float64)
-        f_mid = _at(basis, picked, mid) - level[cols]
-        same = np.sign(f_mid) == np.sign(f_lo)
-        lo = np.where(same, mid, lo)
-        f_lo = np.where(same, f_mid, f_lo)
-        hi = np.where(same, hi, mid)
-    return np.sort(np.mod(0.5 * (lo + hi), 2.0 * math.pi))
+    return _bisect(basis, columns[:, cols], level[cols], rows)
 
 
 def integrated_monodromy(
@@ -266,8 +266,7 @@ def integrated_monodromy(
     for lo, hi, state in zip(edges[:-1], edges[1:], states, strict=True):
         if hi <= lo:
             continue
-        k_j = system.k0 + system.k_c * (state == 1) + system.k_t * (state == -1)
-        a[n:, :n] = -inv_m[:, None] * (system.stiffness + (b.T * k_j) @ b) / omega**2
+        a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, state) / omega**2
 
         def rhs(tau: float, y: FloatArray) -> FloatArray:
             gen = a.copy()
