@@ -220,15 +220,7 @@ def example_mast_curve(points: int) -> None:
         f"{MAST_FROM_HZ} to {MAST_TO_HZ} Hz, max_step {MAST_MAX_STEP}, {points} points at most:"
     )
     start = time.perf_counter()
-    fr = frequency_response(
-        s,
-        force,
-        2 * math.pi * MAST_FROM_HZ,
-        2 * math.pi * MAST_TO_HZ,
-        harmonics=7,
-        max_points=points,
-        max_step=MAST_MAX_STEP,
-    )
+    fr = _example_curve(s, force, points)
     took = time.perf_counter() - start
     hz = fr.omega / (2 * math.pi)
     peak = int(np.argmax(np.max(fr.amplitude, axis=1)))
@@ -415,12 +407,9 @@ def _example_at(force_n: float) -> tuple[Any, np.ndarray, int]:
     return s, force, int(np.argmax(np.abs(force)))
 
 
-def mast_check(force_n: float, points: int, checks: int) -> None:
-    """The example mast's H = 7 curve at ``force_n`` with ``checks`` points run through one
-    exact period (clearjoint.harmonic.check): residual, exact events, orbit crossings."""
-    s, force, dof = _example_at(force_n)
-    start = time.perf_counter()
-    fr = frequency_response(
+def _example_curve(s: Any, force: Any, points: int, **options: Any) -> Any:
+    """The example mast's H = 7 curve from MAST_FROM_HZ to MAST_TO_HZ (``options`` passed on)."""
+    return frequency_response(
         s,
         force,
         2 * math.pi * MAST_FROM_HZ,
@@ -428,8 +417,16 @@ def mast_check(force_n: float, points: int, checks: int) -> None:
         harmonics=7,
         max_points=points,
         max_step=MAST_MAX_STEP,
-        check_points=checks,
+        **options,
     )
+
+
+def mast_check(force_n: float, points: int, checks: int) -> None:
+    """The example mast's H = 7 curve at ``force_n`` with ``checks`` points run through one
+    exact period (clearjoint.harmonic.check): residual, exact events, orbit crossings."""
+    s, force, dof = _example_at(force_n)
+    start = time.perf_counter()
+    fr = _example_curve(s, force, points, check_points=checks)
     hz = fr.omega / (2 * math.pi)
     print(
         f"examples/mast.toml at {force_n} N, H = 7: {fr.omega.size} points in "
