@@ -16,8 +16,10 @@ steps longer than two elastic steps, :func:`previous_backlash`), on the same cyc
 backlash read on each branch and the level of the step (what the damper estimator fits,
 :mod:`clearjoint.identify.damper`), then the medians and the misses under other choices:
 the number of crossings N (a resolution), and the variant tried and not adopted (the slope
-fitted with the step by least absolute deviations, not read from the median step); last, the
-CPU time of the damper estimator per cycle average.
+fitted with the step by least absolute deviations, not read from the median step); then, per
+file, the evidence on why two branches of one loop can read different gaps (:func:`evidence`:
+the four explanations examined in docs/identify.md, each with its number); last, the CPU time
+of the damper estimator per cycle average.
 """
 
 from __future__ import annotations
@@ -26,10 +28,13 @@ import re
 import sys
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from clearjoint.identify import damper, identify_files
+from clearjoint.identify.cycles import cycle_bounds, excitation_frequency, stack, steady
+from clearjoint.records import read_record
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -107,6 +112,131 @@ def _misses(b: dict[str, float], tension: dict[str, int]) -> str:
     )
 
 
+def _cycles(path: Path) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """Each steady cycle's displacement and force (n, M), stacked as
+    :func:`clearjoint.identify.identify` stacks them (from the minimum of the average), and
+    the time step; None when the record has too few steady cycles."""
+    record = read_record(path)
+    frequency = excitation_frequency(record)
+    bounds = cycle_bounds(record, frequency)
+    kept = steady(record.displacement, bounds, 0.03)
+    if len(kept) < 3:
+        return None
+    st = stack(record, frequency, bounds, kept, {"x": record.displacement})
+    shift = int(np.argmin(st.channels["x"].mean(axis=0)))
+    if shift > st.samples // 2 and bounds[kept[0]][0] - (st.samples - shift) >= 0:
+        shift -= st.samples
+    channels = {"x": record.displacement, "f": record.force}
+    st = stack(record, frequency, bounds, kept, channels, shift)
+    return st.channels["x"], st.channels["f"], st.step
+
+
+class _Branch(NamedTuple):
+    """One branch of a loop as the damper estimator reads it."""
+
+    travel: np.ndarray  # travel from the reversal, m
+    f: np.ndarray  # force, N
+    s: np.ndarray  # the crossings, m
+    c: float  # the lower line's intercept, m
+    d: float  # the lines' slope, m per unit alpha
+    b: float  # the backlash, m
+    j: int  # the step lies between crossings j - 1 and j
+    start: float  # the level before (N)
+    stop: float  # the level after (N)
+
+    @property
+    def alpha_b(self) -> float:
+        return float(0.5 * (damper.ALPHAS[self.j - 1] + damper.ALPHAS[self.j]))
+
+    @property
+    def level(self) -> float:
+        """The backlash level, N."""
+        return self.start + self.alpha_b * (self.stop - self.start)
+
+
+def _branches(x: np.ndarray, f: np.ndarray) -> tuple[_Branch, _Branch]:
+    """The rising and the falling branch of a cycle (average) x, f (M,)."""
+    parts, rise, fall = _levels(x, f)
+    out = []
+    for part, start, stop in ((parts[0], fall, rise), (parts[1], rise, fall)):
+        travel, fb = np.abs(x[part] - x[part][0]), f[part]
+        s = damper._crossings(travel, fb, start, stop)
+        assert s is not None
+        out.append(_Branch(travel, fb, s, *damper._step_fit(s), start, stop))
+    return out[0], out[1]
+
+
+def _own_slopes(branch: _Branch) -> float:
+    """The backlash with each line's own slope (the median step on its side of the step
+    place), read as the distance between the lines at the step's level."""
+    a, n = damper.ALPHAS, damper.N_CROSSINGS
+    lines = []
+    for part in (slice(0, branch.j), slice(branch.j, n)):
+        d = float(np.median(np.diff(branch.s[part]))) * n
+        c = float(np.median(branch.s[part] - d * a[part]))
+        lines.append(c + d * branch.alpha_b)
+    return lines[1] - lines[0]
+
+
+def _left_early(branch: _Branch, other: float) -> float:
+    """The part of the way from the backlash level (alpha_b) to the new slip level that the
+    force covers within the first half of the gap, taking the gap as long as ``other`` (the
+    other branch's reading) from the end of the unloading: 0 for a flat backlash level, 1
+    when the force reaches the new level there."""
+    gap_start = max(branch.c + branch.d * branch.alpha_b, 0.0)
+    window = (branch.travel >= gap_start) & (branch.travel <= gap_start + 0.5 * other)
+    delta = branch.stop - branch.start
+    progress = np.sign(delta) * (branch.f[window] - branch.start) / abs(delta)
+    return float((progress.max() - branch.alpha_b) / (1.0 - branch.alpha_b))
+
+
+def _equalising_delay(x: np.ndarray, f: np.ndarray, step: float) -> str:
+    """The delays of the force against the displacement (whole samples within +-40 ms,
+    circular on the cycle average) at which the two branches' readings cross, in ms."""
+    ks = np.arange(-round(0.04 / step), round(0.04 / step) + 1)
+    diff = []
+    for k in ks:
+        rising, falling = _branches(x, np.roll(f, k))
+        diff.append(rising.b - falling.b)
+    change = np.nonzero(np.diff(np.sign(diff)) != 0)[0]
+    return ",".join(f"{1e3 * ks[i] * step:.0f}" for i in change) or "none"
+
+
+def evidence(folder: Path) -> None:
+    """Print, per accepted file, the numbers behind docs/identify.md's account of the two
+    branches: per-cycle readings and cycle means (not steady?), each line's own slope (a
+    softer loading?), the backlash level and how far the force leaves it early (drag or
+    oscillation in the gap?), and the delay of the force that would equalise the branches
+    (a lag between the channels?)."""
+    print(
+        "\nwhy branches differ: per-cycle b rising ; falling (mm) | cycle mean x (mm) | b with "
+        "own slopes rising / falling (mm) | backlash level rising / falling (kN) | left early "
+        "rising / falling | delay equalising the branches (ms)"
+    )
+    early: dict[str, float] = {}
+    for path in sorted(folder.glob("*.json")):
+        cycles = _cycles(path)
+        if cycles is None:
+            continue
+        xs, fs, step = cycles
+        per = [_branches(xx, ff) for xx, ff in zip(xs, fs, strict=True)]
+        x, f = xs.mean(axis=0), fs.mean(axis=0)
+        rising, falling = _branches(x, f)
+        left = (_left_early(rising, falling.b), _left_early(falling, rising.b))
+        early[path.stem] = max(left)
+        cycle_b = [" ".join(f"{1e3 * p[i].b:.1f}" for p in per) for i in (0, 1)]
+        print(
+            f"  {path.stem}: {cycle_b[0]} ; {cycle_b[1]} | "
+            + " ".join(f"{1e3 * float(np.mean(xx)):.2f}" for xx in xs)
+            + f" | {1e3 * _own_slopes(rising):.2f} / {1e3 * _own_slopes(falling):.2f}"
+            f" | {rising.level / 1e3:+.2f} / {falling.level / 1e3:+.2f}"
+            f" | {left[0]:.2f} / {left[1]:.2f} | {_equalising_delay(x, f, step)}"
+        )
+    ranked = sorted(early.items(), key=lambda kv: -kv[1])
+    top = ", ".join(f"{k} {v:.2f}" for k, v in ranked[:4])
+    print(f"largest 'left early' (either branch): {top}")
+
+
 def diagnose(results: list[tuple[object, object]]) -> None:
     loops = {Path(i.source).stem: i.loop for _, i in results}  # type: ignore[attr-defined]
     tension = {k: int(re.search(r"(\d+)lbtension", k)[1]) for k in loops}  # type: ignore[index]
@@ -138,6 +268,7 @@ def diagnose(results: list[tuple[object, object]]) -> None:
     _set_resolution(48)
     fitted = {k: _fitted_slope_backlash(*loop) for k, loop in loops.items()}
     print(f"variant, slope fitted too (N = 48): {_misses(fitted, tension)}")
+    evidence(Path(next(iter(results))[1].source).parent)  # type: ignore[attr-defined]
     # the estimator's cost: one call per cycle average (each file: the model choice and
     # one per jackknife replicate)
     start = time.process_time()
