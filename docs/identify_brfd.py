@@ -24,6 +24,7 @@ of the damper estimator per cycle average.
 
 from __future__ import annotations
 
+import json
 import re
 import sys
 import time
@@ -112,10 +113,16 @@ def _misses(b: dict[str, float], tension: dict[str, int]) -> str:
     )
 
 
-def _cycles(path: Path) -> tuple[np.ndarray, np.ndarray, float] | None:
-    """Each steady cycle's displacement and force (n, M), stacked as
-    :func:`clearjoint.identify.identify` stacks them (from the minimum of the average), and
-    the time step; None when the record has too few steady cycles."""
+#: Newtons per pound-force (the BRFD's actuator forces are in lb).
+LBF = 4.4482216152605
+
+
+def _cycles(path: Path) -> dict[str, np.ndarray] | None:
+    """Each steady cycle's displacement, friction force and the two actuator forces
+    ("x", "f", "act1", "act2"; N, (n, M)), stacked as :func:`clearjoint.identify.identify`
+    stacks them (from the minimum of the average), and "step" (the time step, s); None when
+    the record has too few steady cycles. The actuator forces are read from the JSON here:
+    the identification does not use them."""
     record = read_record(path)
     frequency = excitation_frequency(record)
     bounds = cycle_bounds(record, frequency)
@@ -126,9 +133,17 @@ def _cycles(path: Path) -> tuple[np.ndarray, np.ndarray, float] | None:
     shift = int(np.argmin(st.channels["x"].mean(axis=0)))
     if shift > st.samples // 2 and bounds[kept[0]][0] - (st.samples - shift) >= 0:
         shift -= st.samples
-    channels = {"x": record.displacement, "f": record.force}
+    content = json.loads(path.read_bytes())
+    assert content.get("actuator force units", "lb") == "lb"
+    data = np.asarray(content["data"], dtype=np.float64)
+    channels = {
+        "x": record.displacement,
+        "f": record.force,
+        "act1": data[:, 4] * LBF,
+        "act2": data[:, 5] * LBF,
+    }
     st = stack(record, frequency, bounds, kept, channels, shift)
-    return st.channels["x"], st.channels["f"], st.step
+    return {**st.channels, "step": np.array(st.step)}
 
 
 class _Branch(NamedTuple):
@@ -202,6 +217,22 @@ def _equalising_delay(x: np.ndarray, f: np.ndarray, step: float) -> str:
     return ",".join(f"{1e3 * ks[i] * step:.0f}" for i in change) or "none"
 
 
+def _actuator_gap(branch: _Branch, load: np.ndarray) -> float:
+    """Travel from the end of the friction force's unloading (this branch's gap start) to
+    where the actuator force that loads on this branch (``load``, (M,) over the branch) is
+    first halfway from its level over the first millimetre of the gap to its level over the
+    branch's last 40 % (its slip level): the contact as that channel sees it, m."""
+    gap_start = max(branch.c + branch.d * branch.alpha_b, 0.0)
+    travel = branch.travel
+    base = float(np.median(load[(travel >= gap_start) & (travel <= gap_start + 1e-3)]))
+    plateau = float(np.median(load[travel >= (1.0 - damper.PLATEAU) * travel[-1]]))
+    past = np.nonzero(
+        (travel > gap_start)
+        & (np.sign(plateau - base) * (load - base) >= 0.5 * abs(plateau - base))
+    )[0]
+    return float(travel[past[0]] - gap_start) if past.size else float("nan")
+
+
 def evidence(folder: Path) -> None:
     """Print, per accepted file, the numbers behind docs/identify.md's account of the two
     branches: per-cycle readings and cycle means (not steady?), each line's own slope (a
@@ -211,17 +242,24 @@ def evidence(folder: Path) -> None:
     print(
         "\nwhy branches differ: per-cycle b rising ; falling (mm) | cycle mean x (mm) | b with "
         "own slopes rising / falling (mm) | backlash level rising / falling (kN) | left early "
-        "rising / falling | delay equalising the branches (ms)"
+        "rising / falling | delay equalising the branches (ms) | actuator load's mid-rise after "
+        "the unloading, rising / falling (mm)"
     )
     early: dict[str, float] = {}
     for path in sorted(folder.glob("*.json")):
         cycles = _cycles(path)
         if cycles is None:
             continue
-        xs, fs, step = cycles
+        xs, fs, step = cycles["x"], cycles["f"], float(cycles["step"])
         per = [_branches(xx, ff) for xx, ff in zip(xs, fs, strict=True)]
         x, f = xs.mean(axis=0), fs.mean(axis=0)
         rising, falling = _branches(x, f)
+        parts = _parts(x)
+        # actuator 2 loads on the rising branch, actuator 1 on the falling one
+        act = (
+            _actuator_gap(rising, cycles["act2"].mean(axis=0)[parts[0]]),
+            _actuator_gap(falling, cycles["act1"].mean(axis=0)[parts[1]]),
+        )
         left = (_left_early(rising, falling.b), _left_early(falling, rising.b))
         early[path.stem] = max(left)
         cycle_b = [" ".join(f"{1e3 * p[i].b:.1f}" for p in per) for i in (0, 1)]
@@ -231,6 +269,7 @@ def evidence(folder: Path) -> None:
             + f" | {1e3 * _own_slopes(rising):.2f} / {1e3 * _own_slopes(falling):.2f}"
             f" | {rising.level / 1e3:+.2f} / {falling.level / 1e3:+.2f}"
             f" | {left[0]:.2f} / {left[1]:.2f} | {_equalising_delay(x, f, step)}"
+            f" | {1e3 * act[0]:.2f} / {1e3 * act[1]:.2f}"
         )
     ranked = sorted(early.items(), key=lambda kv: -kv[1])
     top = ", ".join(f"{k} {v:.2f}" for k, v in ranked[:4])
