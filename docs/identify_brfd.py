@@ -181,16 +181,18 @@ def _branches(x: np.ndarray, f: np.ndarray) -> tuple[_Branch, _Branch]:
     return out[0], out[1]
 
 
-def _own_slopes(branch: _Branch) -> float:
+def _own_slopes(branch: _Branch) -> tuple[float, float]:
     """The backlash with each line's own slope (the median step on its side of the step
-    place), read as the distance between the lines at the step's level."""
+    place), read as the distance between the lines at the step's level, and the loading
+    line's stiffness over the unloading line's."""
     a, n = damper.ALPHAS, damper.N_CROSSINGS
-    lines = []
+    lines, steps = [], []
     for part in (slice(0, branch.j), slice(branch.j, n)):
         d = float(np.median(np.diff(branch.s[part]))) * n
         c = float(np.median(branch.s[part] - d * a[part]))
         lines.append(c + d * branch.alpha_b)
-    return lines[1] - lines[0]
+        steps.append(d)
+    return lines[1] - lines[0], steps[0] / steps[1]
 
 
 def _left_early(branch: _Branch, other: float) -> float:
@@ -205,16 +207,22 @@ def _left_early(branch: _Branch, other: float) -> float:
     return float((progress.max() - branch.alpha_b) / (1.0 - branch.alpha_b))
 
 
-def _equalising_delay(x: np.ndarray, f: np.ndarray, step: float) -> str:
-    """The delays of the force against the displacement (whole samples within +-40 ms,
-    circular on the cycle average) at which the two branches' readings cross, in ms."""
+def _delays(x: np.ndarray, f: np.ndarray, step: float) -> tuple[str, str]:
+    """The two branches' readings with the force delayed by -16 and +16 ms (whole samples,
+    circular on the cycle average), and the delays within +-40 ms at which the two readings
+    cross (ms; "none")."""
     ks = np.arange(-round(0.04 / step), round(0.04 / step) + 1)
-    diff = []
+    diff, at = [], {}
     for k in ks:
         rising, falling = _branches(x, np.roll(f, k))
         diff.append(rising.b - falling.b)
+        at[int(k)] = f"{1e3 * rising.b:.1f}/{1e3 * falling.b:.1f}"
     change = np.nonzero(np.diff(np.sign(diff)) != 0)[0]
-    return ",".join(f"{1e3 * ks[i] * step:.0f}" for i in change) or "none"
+    k16 = round(0.016 / step)
+    return (
+        f"{at[-k16]} {at[k16]}",
+        ",".join(f"{1e3 * ks[i] * step:.0f}" for i in change) or "none",
+    )
 
 
 def _actuator_gap(branch: _Branch, load: np.ndarray) -> float:
@@ -234,18 +242,21 @@ def _actuator_gap(branch: _Branch, load: np.ndarray) -> float:
 
 
 def evidence(folder: Path) -> None:
-    """Print, per accepted file, the numbers behind docs/identify.md's account of the two
-    branches: per-cycle readings and cycle means (not steady?), each line's own slope (a
-    softer loading?), the backlash level and how far the force leaves it early (drag or
-    oscillation in the gap?), and the delay of the force that would equalise the branches
-    (a lag between the channels?)."""
+    """Print, per accepted file, the numbers behind docs/identify.md's account of why two
+    branches of one loop read different gaps, one explanation a field: the per-cycle
+    readings and cycle means (cycles not steady?), each line's own slope (a softer
+    loading?), a delay of the force (a lag between the channels?), the backlash level and
+    how far the force leaves it early (the force in the gap?), and where the actuator force
+    sees the contact. Then the crossings of every branch that reads less than half the
+    other (the rule of the "not one gap" flag)."""
     print(
-        "\nwhy branches differ: per-cycle b rising ; falling (mm) | cycle mean x (mm) | b with "
-        "own slopes rising / falling (mm) | backlash level rising / falling (kN) | left early "
-        "rising / falling | delay equalising the branches (ms) | actuator load's mid-rise after "
-        "the unloading, rising / falling (mm)"
+        "\nwhy branches differ, rising / falling branch: per-cycle b (mm) | cycle mean x (mm)"
+        " | own slopes: b (mm), k after / k before the gap | force delayed -16 ms, +16 ms: b"
+        " (mm); delays (ms) at which the branches read the same | backlash level (kN) | left"
+        " early | actuator load's mid-rise after the unloading (mm)"
     )
     early: dict[str, float] = {}
+    short: list[tuple[str, _Branch]] = []
     for path in sorted(folder.glob("*.json")):
         cycles = _cycles(path)
         if cycles is None:
@@ -262,18 +273,34 @@ def evidence(folder: Path) -> None:
         )
         left = (_left_early(rising, falling.b), _left_early(falling, rising.b))
         early[path.stem] = max(left)
-        cycle_b = [" ".join(f"{1e3 * p[i].b:.1f}" for p in per) for i in (0, 1)]
+        own = (_own_slopes(rising), _own_slopes(falling))
+        shifted, equal = _delays(x, f, step)
+        for name, mine, other in (("rising", rising, falling), ("falling", falling, rising)):
+            if other.b > damper.BRANCH_RATIO * mine.b:
+                short.append((f"{path.stem} {name}", mine))
+        cycle_b = " ".join(f"{1e3 * p[0].b:.1f}" for p in per) + " / "
+        cycle_b += " ".join(f"{1e3 * p[1].b:.1f}" for p in per)
         print(
-            f"  {path.stem}: {cycle_b[0]} ; {cycle_b[1]} | "
+            f"  {path.stem}: {cycle_b} | "
             + " ".join(f"{1e3 * float(np.mean(xx)):.2f}" for xx in xs)
-            + f" | {1e3 * _own_slopes(rising):.2f} / {1e3 * _own_slopes(falling):.2f}"
+            + f" | {1e3 * own[0][0]:.2f} / {1e3 * own[1][0]:.2f}, "
+            f"{own[0][1]:.2f} / {own[1][1]:.2f} | {shifted}; {equal}"
             f" | {rising.level / 1e3:+.2f} / {falling.level / 1e3:+.2f}"
-            f" | {left[0]:.2f} / {left[1]:.2f} | {_equalising_delay(x, f, step)}"
-            f" | {1e3 * act[0]:.2f} / {1e3 * act[1]:.2f}"
+            f" | {left[0]:.2f} / {left[1]:.2f} | {1e3 * act[0]:.2f} / {1e3 * act[1]:.2f}"
         )
     ranked = sorted(early.items(), key=lambda kv: -kv[1])
     top = ", ".join(f"{k} {v:.2f}" for k, v in ranked[:4])
     print(f"largest 'left early' (either branch): {top}")
+    for name, branch in short:
+        gap_start = max(branch.c + branch.d * branch.alpha_b, 0.0)
+        print(
+            f"{name} branch, the gap from {1e3 * gap_start:.2f} mm, crossings from alpha_b "
+            "(alpha: travel mm): "
+            + " ".join(
+                f"{a:.2f}: {1e3 * t:.2f}"
+                for a, t in zip(damper.ALPHAS[branch.j :], branch.s[branch.j :], strict=True)
+            )
+        )
 
 
 def diagnose(results: list[tuple[object, object]]) -> None:
