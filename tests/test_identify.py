@@ -96,6 +96,7 @@ def friction_loop(
     frequency: float = 1.0,
     backlash_falling: float | None = None,
     ringing: float = 0.0,
+    gap_dip: float = 0.0,
 ) -> Record:
     """A rigid-plastic friction loop with backlash under imposed x = X sin(w t), exactly.
 
@@ -123,7 +124,9 @@ def friction_loop(
         if travel <= unload:
             value = level + state * stiffness * travel
         elif travel <= unload + gap:
-            value = 0.0
+            inside = (travel - unload) / (0.8 * gap)
+            value = -gap_dip * friction * np.sin(np.pi * inside) ** 2 if state < 0 else 0.0
+            value = value if inside < 1.0 else 0.0
         else:
             elastic = stiffness * (travel - unload - gap)
             if elastic >= 0.7 * friction:
@@ -158,6 +161,30 @@ def test_a_loop_whose_branches_show_different_backlash_is_doubtful() -> None:
     # the same rule on the two other branch ratios: 1.8 passes, 2.2 does not
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 1.8)).flag == "ok"
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 2.2)).flag != "ok"
+
+
+def test_a_force_that_reaches_the_new_level_inside_the_gap_is_flagged() -> None:
+    """The two BRFD misses (docs/identify.md): on the falling branch the force leaves the
+    backlash level early in the gap and reaches the new slip level before the contact. The
+    crossings of the upper fractions then lie inside the gap: that branch reads short, the
+    rising one reads the gap, and the loop is flagged, not passed. A dip 80 % of the way
+    is one residual: the gap is read exactly."""
+    b, f_f, k, x_amp = 4e-3, 1e4, 5e6, 20e-3
+    plain = friction_loop(b, f_f, k, x_amp)
+    for depth in (0.8, 1.0):
+        dip = friction_loop(b, f_f, k, x_amp, gap_dip=depth)
+        assert np.min(dip.force - plain.force) == pytest.approx(-depth * f_f, rel=1e-3)
+    partway = identify(friction_loop(b, f_f, k, x_amp, gap_dip=0.8))
+    assert partway.flags["clearance_m"] == ("ok", "")
+    assert partway.summary["clearance_m"] == pytest.approx(b, rel=0.01)
+    result = identify(friction_loop(b, f_f, k, x_amp, gap_dip=1.0))
+    assert result.model == "damper"
+    flag, reason = result.flags["clearance_m"]
+    assert flag == "doubtful"
+    assert "not one gap" in reason
+    rising, falling = (float(v) for v in re.findall(r"([\d.]+) mm on the", reason))
+    assert rising == pytest.approx(1e3 * b, rel=0.02)  # the branch without the dip
+    assert falling < 0.5e3 * b  # the dip's first crossings read as the gap's far end
 
 
 def test_backlash_is_the_distance_between_the_elastic_lines() -> None:
