@@ -4,12 +4,14 @@ The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the for
 amplitude) by the same continuation as the exact shooting of
 :mod:`clearjoint.periodic`, and returned as the same
 :class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
-kept. Stability: for one DOF with constant damping from Hill's infinite
-determinant (one determinant per point); for a Structure from the exact monodromy
-of the HB orbit's piecewise-linear linearisation (:mod:`clearjoint.harmonic.monodromy`,
-no exponent to pick out of Hill's truncated spectrum), integrated when its joints
-carry friction (:func:`~clearjoint.harmonic.monodromy.integrated_monodromy`); for a
-Joint with friction from the eigenvalues of Hill's quadratic eigenproblem; events are located as in
+kept. Stability (``stability``): for one DOF with constant damping from Hill's infinite
+determinant (one determinant per point); for a Joint with friction from Hill's quadratic
+eigenproblem with the centroid sorting (:mod:`clearjoint.harmonic.hill`); for a Structure
+by default from the exact monodromy of the HB orbit's piecewise-linear linearisation
+(:mod:`clearjoint.harmonic.monodromy`), integrated when its joints carry friction
+(:func:`~clearjoint.harmonic.monodromy.integrated_monodromy`), since Hill's truncated
+eigenproblem disagrees with it on stiff contact (docs/harmonic.md, "Stability");
+``stability="hill"`` asks for Hill's method anyway. Events are located as in
 :mod:`clearjoint.periodic`: folds where the parameter component of the tangent
 changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
 through -1), grazings where a joint's extreme relative displacement crosses a gap
@@ -28,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.continuation import ContinuationSettings, continue_branch
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.harmonic import aft, check, monodromy, solve
+from clearjoint.harmonic import aft, check, hill, monodromy, solve
 from clearjoint.harmonic.solve import (
     TOLERANCE,
     SparseResidual,
@@ -66,6 +68,7 @@ def frequency_response(
     max_step: float = 0.02,
     friction_regularization: float | None = None,
     check_points: int = 5,
+    stability: Literal["hill", "monodromy"] | None = None,
 ) -> FrequencyResponse:
     """Return the frequency-response curve by harmonic balance and continuation (MODEL.md 5.3).
 
@@ -122,6 +125,17 @@ def frequency_response(
         is not to be trusted), and the whole check is in ``settings["orbit_check"]``.
         0 skips the check; it is skipped (no ``"orbit_check"``) when a joint has
         friction, which the exact structure motion does not carry.
+    stability : {"hill", "monodromy"}, optional
+        How the Floquet multipliers are found. ``"hill"``: Hill's method (the
+        infinite determinant for one DOF without friction, else the quadratic
+        eigenproblem with centroid sorting, :func:`clearjoint.harmonic.hill.spectrum`;
+        a point where it finds fewer than 2N resolved exponents gets NaN multipliers
+        and an ``"untrusted"`` event; ``settings["hill_defect"]`` holds each point's
+        shift defect). ``"monodromy"``: the exact monodromy of the HB orbit's
+        linearisation (:mod:`clearjoint.harmonic.monodromy`). Default: ``"hill"`` for
+        a Joint, ``"monodromy"`` for a Structure (on a 2-bay mast with stiff contact
+        Hill's method at H = 7 and 15 gives the other verdict at several points;
+        docs/harmonic.md, "Stability").
 
     Returns
     -------
@@ -158,6 +172,10 @@ def frequency_response(
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
     if isinstance(check_points, bool) or not isinstance(check_points, int) or check_points < 0:
         raise ParameterError(f"check_points must be an integer >= 0, got {check_points!r}")
+    if stability not in (None, "hill", "monodromy"):
+        raise ParameterError(
+            f"stability must be 'hill' or 'monodromy' (or None for the default), got {stability!r}"
+        )
     basis = aft.Basis.make(h, n_t)
     k_ref = model.reference_stiffness
 
@@ -224,6 +242,7 @@ def frequency_response(
         "samples": n_t,
         "damping_ratio": damping_ratio,
         "force_pattern": unit_force,
+        "stability": stability or ("hill" if model.is_joint else "monodromy"),
     }
     response = _response(
         model,
@@ -365,6 +384,7 @@ def _response(
 ) -> FrequencyResponse:
     n_pts = lam.size
     n, n_c = model.n_dof, 2 * basis.harmonics + 1
+    by_hill = settings["stability"] == "hill"
     omega = lam.copy() if parameter == "omega" else np.full(n_pts, w0)
     peak = float(np.max(np.abs(pattern)))
     force = lam.copy() if parameter == "force" else np.full(n_pts, peak)
@@ -376,10 +396,12 @@ def _response(
     rel = np.einsum("pcn,jn->cpj", coef, b).reshape(n_c, -1)
     d_max, d_min = (v.reshape(n_pts, b.shape[0]) for v in basis.extremes(rel))
     multipliers = np.empty((n_pts, 2 * n), dtype=np.complex128)
-    determinant = n == 1 and model.friction_force is None
+    determinant = by_hill and n == 1 and model.friction_force is None
     jacobians = np.empty((n_pts, n_c, n_c)) if determinant else None
+    defect = np.zeros(n_pts)
+    unresolved: list[int] = []
     for i in range(n_pts):
-        if not model.is_joint:  # a structure: the monodromy of the orbit's linearisation
+        if not by_hill:  # the exact monodromy of the orbit's linearisation
             multipliers[i] = monodromy.multipliers(model, basis, coef[i], float(omega[i]))
             continue
         ev = evaluations[i] if i < len(evaluations) else None
@@ -389,16 +411,38 @@ def _response(
         if jacobians is not None:  # one DOF, constant damping: Hill's determinant
             jacobians[i] = ev.jacobian
             continue
-        lam_i = aft.hill_exponents(model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent)
-        multipliers[i] = aft.hill_multipliers(lam_i, float(omega[i]))
+        try:
+            found = hill.spectrum(
+                model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent
+            )
+        except HarmonicError:  # fewer than 2N resolved exponents: no verdict
+            multipliers[i] = np.nan
+            defect[i] = np.inf
+            unresolved.append(i)
+            continue
+        multipliers[i] = found.multipliers
+        defect[i] = found.defect
     if jacobians is not None:
         multipliers[:] = aft.hill_determinant_multipliers(model, basis, jacobians, omega)
+    if by_hill:
+        settings["hill_defect"] = defect
     stable = np.max(np.abs(multipliers), axis=1) < 1.0
     amplitude = 0.5 * (x_max - x_min)
     x0 = coef[:, 0, :] + coef[:, 1::2, :].sum(axis=1)
     v0 = omega[:, None] * np.einsum("c,pcn->pn", _velocity_row(basis), coef)
     initial = np.concatenate((x0, v0), axis=1)
     events = _events(model, lam, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1))
+    events += [
+        ResponseEvent(
+            "untrusted",
+            float(omega[i]),
+            float(force[i]),
+            float(np.max(amplitude[i])),
+            f"Hill's eigenproblem at H = {basis.harmonics} resolves fewer than the 2N = {2 * n} "
+            "exponents: no stability verdict here; raise harmonics or use stability='monodromy'",
+        )
+        for i in unresolved
+    ]
     if model.is_joint:
         x_max, x_min, amplitude, coef_out = x_max[:, 0], x_min[:, 0], amplitude[:, 0], coef[:, :, 0]
     else:
