@@ -50,7 +50,13 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
-from clearjoint.harmonic.aft import Basis, _damping_operator, add_joint_blocks
+from clearjoint.harmonic.aft import (
+    Basis,
+    _damping_operator,
+    add_joint_blocks,
+    check_harmonics,
+    evaluate,
+)
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
 
 FloatArray = NDArray[np.float64]
@@ -185,6 +191,54 @@ def spectrum(
     kbar = centroids(basis, vec[:size], n)
     chosen, defect = select(lam, kbar, omega, 2 * n)
     return _result(lam[chosen], kbar[chosen], defect, period)
+
+
+def orbit_spectrum(
+    system: LinearSystem,
+    coefficients: FloatArray,
+    omega: float,
+    *,
+    harmonics: int | None = None,
+    sorting: Sorting = "centroid",
+) -> HillSpectrum:
+    """Return Hill's spectrum of an HB orbit, the perturbation carried by ``harmonics``.
+
+    The orbit's H harmonics are padded with zeros to ``harmonics`` >= H and the
+    Jacobian of the padded orbit is taken (the same orbit; only the perturbation
+    gets more harmonics). Hill's truncation error is then measured apart from the
+    orbit's: on a structure whose contact modes lie far above H w the perturbation
+    needs many more harmonics than the orbit (docs/harmonic.md, "Stability").
+
+    Parameters
+    ----------
+    system : LinearSystem
+    coefficients : (2H + 1, N) ndarray
+        The HB orbit, m.
+    omega : float
+        w, rad/s.
+    harmonics : int, optional
+        H' >= H harmonics of the perturbation; default H.
+    sorting : {"centroid", "imaginary"}
+
+    Returns
+    -------
+    HillSpectrum
+
+    Raises
+    ------
+    HarmonicError
+        H' < H, or as :func:`spectrum`.
+    """
+    q = np.asarray(coefficients, dtype=np.float64)
+    h = (q.shape[0] - 1) // 2
+    hp, n_t = check_harmonics(h if harmonics is None else harmonics, None)
+    if hp < h:
+        raise HarmonicError(f"harmonics must be >= the orbit's H = {h}, got {harmonics!r}")
+    padded = np.zeros((2 * hp + 1, system.n_dof))
+    padded[: 2 * h + 1] = q
+    basis = Basis.make(hp, n_t)
+    ev = evaluate(system, basis, padded.ravel(), omega, np.zeros(system.n_dof))
+    return spectrum(system, basis, ev.jacobian, omega, ev.velocity_tangent, sorting=sorting)
 
 
 def select(

@@ -412,9 +412,7 @@ def _response(
             jacobians[i] = ev.jacobian
             continue
         try:
-            found = hill.spectrum(
-                model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent
-            )
+            found = hill.spectrum(model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent)
         except HarmonicError:  # fewer than 2N resolved exponents: no verdict
             multipliers[i] = np.nan
             defect[i] = np.inf

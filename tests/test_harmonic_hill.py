@@ -1,0 +1,222 @@
+"""Hill's method with centroid sorting (MODEL.md 5.3) against independent routes.
+
+The references: the closed-form exponents of a linear system (an orbit inside every
+gap), the exact monodromy of the same HB orbit (products of matrix exponentials
+between its gap-edge crossings, harmonic/monodromy.py), and for one joint the
+Floquet multipliers of the exact orbit by shooting (clearjoint.periodic).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.linalg
+from scipy.optimize import linear_sum_assignment
+
+from clearjoint import ClearanceJoint, ParameterError
+from clearjoint.harmonic import HarmonicError, aft, frequency_response, hill, monodromy
+from clearjoint.harmonic.system import build
+from clearjoint.periodic import periodic_orbit
+from clearjoint.structure import Structure, chain, mast
+from test_harmonic_aft import PYHARM, PYHARM_ZETA
+
+FORCE = np.array([0.0, 0.0, 40.0])
+
+
+@pytest.fixture(scope="module")
+def three_links() -> Structure:
+    """The 3-link chain of tests/test_harmonic_structure.py (joints 0.1 mm, 1e7 N/m)."""
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+
+
+def _set_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest distance between two sets of multipliers, paired to minimise it."""
+    cost = np.abs(a[:, None] - b[None, :])
+    rows, cols = linear_sum_assignment(cost)
+    return float(cost[rows, cols].max())
+
+
+def test_centroid_of_single_harmonics_by_hand() -> None:
+    """c_(+-h) = (a_h -+ i b_h) / 2: a_2 = 1, b_2 = i is e^(2 i w t) alone (centroid 2);
+    a real cosine weighs k = +-2 equally (0); the mean alone is 0; b_1 = i gives -1."""
+    basis = aft.Basis.make(3, 64)
+    v = np.zeros((7, 4), dtype=np.complex128)
+    v[3, 0], v[4, 0] = 1.0, 1j  # a_2, b_2
+    v[3, 1] = 1.0
+    v[0, 2] = 1.0
+    v[2, 3] = 1j  # b_1 = i: (0 - i i) / 2 = 1/2 at k = +1, (0 + i i) / 2 = -1/2 at k = -1
+    v[1, 3] = 1.0  # a_1 = 1: c_+1 = (1 + 1) / 2 = 1, c_-1 = 0
+    np.testing.assert_allclose(hill.centroids(basis, v, 1), [2.0, 0.0, 0.0, 1.0], atol=1e-15)
+
+
+def test_linear_orbit_gives_the_closed_form_exponents() -> None:
+    """A 2-bay mast forced gently stays inside every gap: the perturbation equation has
+    constant coefficients, its exponents are the eigenvalues of [[0, I], [-M^-1 K, -M^-1 C]]
+    (closed form), several of them far above H w. The centroid picks the natural member of
+    each family; the smallest-abs(Im) sorting cannot (those families have no member in its
+    strip) and gets other multipliers."""
+    s = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0.0, 2e-6))
+    model = build(s, 0.0, None, 1.0)
+    force = np.zeros(s.n_dof)
+    force[-2] = 1.0
+    w = 2.0 * math.pi * 45.0
+    fr = frequency_response(s, force, w, 1.0001 * w, harmonics=7, max_points=2, check_points=0)
+    assert fr.coefficients is not None
+    rel = fr.coefficients[0] @ model.directions.T
+    assert np.max(np.abs(rel)) < 0.9 * float(np.min(model.g_c))  # inside every gap
+    n = s.n_dof
+    inv_m = 1.0 / np.diag(model.mass)
+    a = np.block(
+        [
+            [np.zeros((n, n)), np.eye(n)],
+            [-inv_m[:, None] * model.open_stiffness(), -inv_m[:, None] * model.damping],
+        ]
+    )
+    lam = scipy.linalg.eigvals(a)
+    assert np.max(np.abs(lam.imag)) > 10.0 * w  # modes far above H w / 2
+    exact = np.exp(lam * 2.0 * math.pi / w)
+    found = hill.orbit_spectrum(model, fr.coefficients[0], w)
+    assert _set_distance(np.sort_complex(found.exponents), np.sort_complex(lam)) < 1e-6 * w
+    assert _set_distance(found.multipliers, exact) < 1e-9
+    assert np.max(np.abs(found.centroid)) < 1e-6
+    assert found.defect < 1e-6
+    strip = hill.orbit_spectrum(model, fr.coefficients[0], w, sorting="imaginary")
+    assert _set_distance(strip.multipliers, exact) > 0.1
+
+
+@pytest.mark.parametrize(("harmonics", "tolerance"), [(7, 0.05), (15, 0.012)])
+def test_chain_agrees_with_the_exact_monodromy_of_the_same_orbit(
+    three_links: Structure, harmonics: int, tolerance: float
+) -> None:
+    """The 3-link chain at five frequencies, each orbit beyond a gap edge: Hill's 2N
+    multipliers (centroid sorting) against the exact monodromy of the same HB orbit, all
+    six paired, within a tolerance that shrinks with H (measured: worst 0.041 at H = 7,
+    9.3e-3 at H = 15; `bench_harmonic.py --hill-agreement`), and the same verdict. At H = 7,
+    400 rad/s the centroid alone kept a spurious family (largest 0.159 against 0.792)."""
+    model = build(three_links, 0.0, None, 1.0)
+    for w in (200.0, 300.0, 400.0, 600.0, 800.0):
+        fr = frequency_response(
+            three_links, FORCE, w, 1.001 * w, harmonics=harmonics, max_points=2, check_points=0
+        )
+        assert fr.coefficients is not None
+        q = fr.coefficients[0]
+        basis = aft.Basis.make(harmonics, int(fr.settings["samples"]))
+        exact = monodromy.multipliers(model, basis, q, w)
+        found = hill.orbit_spectrum(model, q, w)
+        assert _set_distance(found.multipliers, exact) < tolerance, w
+        assert (np.max(np.abs(found.multipliers)) < 1.0) == (np.max(np.abs(exact)) < 1.0), w
+        if harmonics == 7 and w == 400.0:
+            assert np.max(np.abs(found.multipliers)) == pytest.approx(0.7923, abs=1e-3)
+
+
+def test_stiff_contact_needs_many_more_harmonics_in_the_perturbation() -> None:
+    """A 2-bay mast whose joints close onto 1e8 N/m (contact modes far above H w): at the
+    orbit's own H = 7 Hill's multipliers miss the exact monodromy's by order 1 (the
+    reason structures keep the monodromy by default); carrying the perturbation with
+    H' = 31 on the same orbit brings them within 0.15 (docs/harmonic.md, "Stability")."""
+    s = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0.0, 2e-6))
+    model = build(s, 0.0, None, 1.0)
+    force = np.zeros(s.n_dof)
+    force[-2] = 5.0
+    w = 2.0 * math.pi * 51.92
+    fr = frequency_response(s, force, w, 1.0001 * w, harmonics=7, max_points=2, check_points=0)
+    assert fr.coefficients is not None
+    q = fr.coefficients[0]
+    rel = q @ model.directions.T
+    basis = aft.Basis.make(7, int(fr.settings["samples"]))
+    assert np.max(basis.extremes(rel)[0]) > float(np.min(model.g_c))  # in contact
+    exact = monodromy.multipliers(model, basis, q, w)
+    errors = [
+        _set_distance(hill.orbit_spectrum(model, q, w, harmonics=h).multipliers, exact)
+        for h in (7, 31)
+    ]
+    assert errors[0] > 0.3
+    assert errors[1] < 0.15
+
+
+@pytest.mark.parametrize("omega", [0.6, 1.2, 1.45, 1.7])
+def test_one_joint_agrees_with_the_exact_orbits_floquet_multipliers(omega: float) -> None:
+    """pyHarm's joint (H = 12): the eigenproblem with centroid sorting against the
+    multipliers of the exact orbit by shooting (clearjoint.periodic) started from the HB
+    orbit, and against Hill's infinite determinant of the same HB orbit."""
+    model = build(PYHARM, PYHARM_ZETA, None, 1.0)
+    fr = frequency_response(
+        PYHARM, 0.03, omega, 1.0001 * omega, harmonics=12, damping_ratio=PYHARM_ZETA, max_points=2
+    )
+    assert fr.coefficients is not None
+    q = fr.coefficients[0][:, None]
+    found = hill.orbit_spectrum(model, q, omega)
+    exact = periodic_orbit(
+        PYHARM, 0.03, omega, damping_ratio=PYHARM_ZETA, initial=fr.initial_state[0]
+    )
+    assert abs(float(np.max(np.abs(exact.multipliers))) - 1.0) > 0.03  # away from bifurcations
+    assert _set_distance(found.multipliers, np.asarray(exact.multipliers)) < 0.02
+    assert (np.max(np.abs(found.multipliers)) < 1.0) == exact.stable
+    np.testing.assert_allclose(  # the determinant route: the same truncation, same numbers
+        np.sort_complex(found.multipliers), np.sort_complex(fr.multipliers[0]), atol=1e-6
+    )
+
+
+def test_frequency_response_stability_option(three_links: Structure) -> None:
+    """stability="hill" on a structure against the default exact monodromy, and
+    stability="monodromy" on a joint against the default Hill determinant."""
+    curve = dict(harmonics=7, max_points=6, check_points=0)
+    by_hill = frequency_response(three_links, FORCE, 300.0, 320.0, stability="hill", **curve)
+    by_mono = frequency_response(three_links, FORCE, 300.0, 320.0, **curve)
+    assert by_hill.settings["stability"] == "hill"
+    assert by_mono.settings["stability"] == "monodromy"
+    assert by_hill.settings["hill_defect"].shape == by_hill.omega.shape
+    np.testing.assert_array_equal(by_hill.omega, by_mono.omega)
+    np.testing.assert_array_equal(by_hill.stable, by_mono.stable)
+    for a, b in zip(by_hill.multipliers, by_mono.multipliers, strict=True):
+        assert _set_distance(a, b) < 0.05
+    joint = dict(harmonics=12, damping_ratio=PYHARM_ZETA, max_points=5)
+    det = frequency_response(PYHARM, 0.03, 1.2, 1.25, **joint)
+    mono = frequency_response(PYHARM, 0.03, 1.2, 1.25, stability="monodromy", **joint)
+    assert det.settings["stability"] == "hill"
+    np.testing.assert_allclose(np.abs(det.multipliers), np.abs(mono.multipliers), atol=2e-3)
+    with pytest.raises(ParameterError, match="stability must be 'hill' or 'monodromy'"):
+        frequency_response(PYHARM, 0.03, 1.2, 1.25, stability="floquet")  # type: ignore[arg-type]
+
+
+def test_unresolved_points_are_flagged_not_guessed(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Where Hill's eigenproblem resolves fewer than 2N exponents the point gets NaN
+    multipliers and an "untrusted" event, never a verdict."""
+    with pytest.raises(HarmonicError, match="fewer than the 2N = 4"):
+        hill.select(np.array([-1.0 + 0j, -2.0, -3.0]), np.array([0.0, 0.1, 2.0]), 1.0, 4)
+
+    def refuse(*args: object, **kwargs: object) -> hill.HillSpectrum:
+        raise HarmonicError("no")
+
+    monkeypatch.setattr(hill, "spectrum", refuse)
+    fr = frequency_response(
+        three_links,
+        FORCE,
+        300.0,
+        301.0,
+        harmonics=3,
+        max_points=2,
+        check_points=0,
+        stability="hill",
+    )
+    assert np.isnan(fr.multipliers).all()
+    assert not fr.stable.any()
+    assert [e.kind for e in fr.events].count("untrusted") == fr.omega.size
+    assert "stability='monodromy'" in fr.events[-1].note
+
+
+def test_negative_real_multiplier_members_count_once() -> None:
+    """The two members -+ i w / 2 of a negative real multiplier's family (centroids +-1/2)
+    are one family: with 2N = 2 the other family is kept beside one of them."""
+    w = 10.0
+    lam = np.array([-1.0 + 5.0j, -1.0 - 5.0j, -1.0 + 15.0j, -1.0 - 15.0j, -3.0 + 0j, -3.0 + 10j])
+    kbar = np.array([-0.5, 0.5, -1.5, 1.5, 0.0, -1.0])
+    kept, _ = hill.select(lam, kbar, w, 2)
+    assert sorted(kept.tolist())[-1] == 4
+    assert len({round(abs(lam[i].imag)) for i in kept}) == 2
+    assert repr(hill.HillSpectrum(lam[:2], lam[:2], kbar[:2], 0.0)).startswith("HillSpectrum(2")
