@@ -599,6 +599,168 @@ def hill_sorting() -> None:
             )
 
 
+def _set_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest distance between two sets of multipliers, paired to minimise it."""
+    from scipy.optimize import linear_sum_assignment
+
+    cost = np.abs(a[:, None] - b[None, :])
+    rows, cols = linear_sum_assignment(cost)
+    return float(cost[rows, cols].max())
+
+
+def _hill_pair(model: Any, q: np.ndarray, w: float, h: int | None = None) -> tuple[Any, Any]:
+    """Hill's spectrum of one orbit with the centroid and with the imaginary-part sorting."""
+    from clearjoint.harmonic import HarmonicError, hill
+
+    out = []
+    for sorting in ("centroid", "imaginary"):
+        try:
+            out.append(hill.orbit_spectrum(model, q, w, harmonics=h, sorting=sorting))
+        except HarmonicError:
+            out.append(None)
+    return out[0], out[1]
+
+
+def _line(ref: np.ndarray, found: Any) -> str:
+    if found is None:
+        return "   unresolved        "
+    mu = found.multipliers
+    same = (np.max(np.abs(mu)) < 1.0) == (np.max(np.abs(ref)) < 1.0)
+    return f"{np.max(np.abs(mu)):8.4f} {_set_distance(ref, mu):8.1e} {'ok' if same else 'NO'}"
+
+
+def hill_agreement() -> None:
+    """Hill's method (centroid and imaginary-part sortings) against exact references.
+
+    For each case and H: the largest |mu| of the reference, then per sorting the largest
+    |mu|, the worst distance between the two sets of 2N multipliers (paired to minimise
+    it) and whether the stable/unstable verdict is the same (ok / NO). References: the
+    exact monodromy of the same HB orbit (structures), the exact orbit's multipliers by
+    shooting (clearjoint.periodic, one joint). Then the 2-bay mast's contact orbits with
+    the perturbation carried by H' > H harmonics (the same orbit, padded).
+    """
+    from clearjoint import ClearanceJoint, Friction
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.system import build, friction_speed
+    from clearjoint.periodic import periodic_orbit
+    from clearjoint.structure import chain, mast
+
+    head = "ref |mu|  | centroid: |mu| set-dist verdict | imaginary: |mu| set-dist verdict"
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    s = chain([1.0] * 3, [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+    force = np.array([0.0, 0.0, 40.0])
+    model = build(s, 0.0, None, 1.0)
+    print("3-link chain (tests/test_harmonic_hill.py), 40 N, against the exact monodromy")
+    print(f"  H    w rad/s  {head}")
+    for h in (3, 7, 15):
+        for w in (200.0, 300.0, 400.0, 600.0, 800.0):
+            fr = frequency_response(
+                s, force, w, 1.001 * w, harmonics=h, max_points=2, check_points=0
+            )
+            q = fr.coefficients[0]
+            ref = monodromy.multipliers(model, aft.Basis.make(h, fr.settings["samples"]), q, w)
+            c, i = _hill_pair(model, q, w)
+            print(
+                f"  {h:2d} {w:8.0f}    {np.max(np.abs(ref)):8.4f} | "
+                f"{_line(ref, c)} | {_line(ref, i)}"
+            )
+
+    m = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0, 2e-6))
+    mm = build(m, 0.0, None, 1.0)
+    tip = np.zeros(m.n_dof)
+    tip[m.dof_names.index("n5x")] = 5.0
+    print("2-bay mast (joints 1e-4 m, 1e8 N/m), 5 N at the tip, 40 Hz up, 150 points,")
+    print("every 6th point against the exact monodromy (contact from about 49.1 Hz)")
+    for h in (3, 7, 15):
+        fr = frequency_response(
+            m,
+            tip,
+            2 * math.pi * 40,
+            2 * math.pi * 260,
+            harmonics=h,
+            max_points=150,
+            check_points=0,
+            max_step=0.05,
+        )
+        basis = aft.Basis.make(h, fr.settings["samples"])
+        print(f"  H = {h}: {fr.omega.size} points to {fr.omega[-1] / (2 * math.pi):.1f} Hz")
+        counts = {"centroid": [0, 0, 0, 0.0], "imaginary": [0, 0, 0, 0.0]}
+        for k in range(0, fr.omega.size, 6):
+            w, q = float(fr.omega[k]), fr.coefficients[k]
+            ref = monodromy.multipliers(mm, basis, q, w)
+            for name, found in zip(counts, _hill_pair(mm, q, w), strict=True):
+                tally = counts[name]
+                tally[0] += 1
+                if found is None:
+                    tally[2] += 1
+                    continue
+                mu = found.multipliers
+                tally[1] += (np.max(np.abs(mu)) < 1.0) != (np.max(np.abs(ref)) < 1.0)
+                tally[3] = max(tally[3], _set_distance(ref, mu))
+        for name, (n, wrong, unresolved, worst) in counts.items():
+            print(
+                f"    {name:9s}: {n} points, {wrong} other verdicts, {unresolved} unresolved, "
+                f"worst set distance {worst:.2e}"
+            )
+    print("  the same H = 7 orbit, the perturbation with H' harmonics (orbit_spectrum):")
+    for hz in (51.92, 54.17):
+        w = 2 * math.pi * hz
+        fr = frequency_response(m, tip, w, 1.0001 * w, harmonics=7, max_points=2, check_points=0)
+        q = fr.coefficients[0]
+        ref = monodromy.multipliers(mm, aft.Basis.make(7, fr.settings["samples"]), q, w)
+        for hp in (7, 15, 31, 63):
+            start = time.perf_counter()
+            c, i = _hill_pair(mm, q, w, hp)
+            took = time.perf_counter() - start
+            print(
+                f"    {hz:6.2f} Hz H' = {hp:2d}: {np.max(np.abs(ref)):8.4f} | {_line(ref, c)} | "
+                f"{_line(ref, i)} | both sortings {took:.1f} s (size {2 * m.n_dof * (2 * hp + 1)})"
+            )
+
+    joint_model = build(JOINT, ZETA, None, 1.0)
+    print("one joint (pyHarm's case, 0.03 N), against the exact orbit's multipliers (shooting)")
+    print(f"  H    w rad/s  {head}")
+    for h in (3, 7, 15):
+        for w in (0.6, 1.2, 1.45, 1.7):
+            fr = frequency_response(
+                JOINT, 0.03, w, 1.0001 * w, harmonics=h, damping_ratio=ZETA, max_points=2
+            )
+            exact = periodic_orbit(JOINT, 0.03, w, damping_ratio=ZETA, initial=fr.initial_state[0])
+            ref = np.asarray(exact.multipliers)
+            c, i = _hill_pair(joint_model, fr.coefficients[0][:, None], w)
+            print(
+                f"  {h:2d} {w:8.2f}    {np.max(np.abs(ref)):8.4f} | "
+                f"{_line(ref, c)} | {_line(ref, i)}"
+            )
+    rub = Friction(0.005, 1.0)
+    print("one joint with friction Friction(0.005, 1.0), the regularised HB orbit's Hill")
+    print("multipliers against the exact stick-slip orbit's (regularisation error included)")
+    print(f"  H    w rad/s  {head}")
+    for h in (7, 15):
+        for w in (0.8, 1.0, 1.3, 1.6):
+            fr = frequency_response(
+                JOINT,
+                0.03,
+                w,
+                1.0001 * w,
+                harmonics=h,
+                damping_ratio=ZETA,
+                friction=rub,
+                max_points=2,
+            )
+            exact = periodic_orbit(
+                JOINT, 0.03, w, damping_ratio=ZETA, friction=rub, initial=fr.initial_state[0]
+            )
+            ref = np.asarray(exact.multipliers)
+            fm = build(JOINT, ZETA, rub, 1.0, friction_speed(JOINT, w, None))
+            c, i = _hill_pair(fm, fr.coefficients[0][:, None], w)
+            print(
+                f"  {h:2d} {w:8.2f}    {np.max(np.abs(ref)):8.4f} | "
+                f"{_line(ref, c)} | {_line(ref, i)}"
+            )
+    sys.stdout.flush()
+
+
 def samples_error() -> None:
     """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
     from clearjoint.harmonic import aft, solve, system
@@ -659,9 +821,15 @@ def main() -> None:
     parser.add_argument("--mast-shoot", type=float, metavar="N", help="exact orbit near HB at N")
     parser.add_argument("--at", default="0.9,1.28", help="Hz list for --mast-orders/--mast-shoot")
     parser.add_argument("--hill-sorting", action="store_true", help="Hill's exponent picks")
+    parser.add_argument(
+        "--hill-agreement", action="store_true", help="Hill's method against exact references"
+    )
     args = parser.parse_args()
     if args.hill_sorting:
         hill_sorting()
+        return
+    if args.hill_agreement:
+        hill_agreement()
         return
     freqs = [float(v) for v in args.at.split(",")]
     if args.mast_check:
