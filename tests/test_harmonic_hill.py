@@ -173,6 +173,7 @@ def test_frequency_response_stability_option(three_links: Structure) -> None:
     np.testing.assert_array_equal(by_hill.stable, by_mono.stable)
     for a, b in zip(by_hill.multipliers, by_mono.multipliers, strict=True):
         assert _set_distance(a, b) < 0.05
+    assert not [e for e in by_hill.events if e.kind == "untrusted"]
     joint = dict(harmonics=12, damping_ratio=PYHARM_ZETA, max_points=5)
     det = frequency_response(PYHARM, 0.03, 1.2, 1.25, **joint)
     mono = frequency_response(PYHARM, 0.03, 1.2, 1.25, stability="monodromy", **joint)
@@ -260,3 +261,22 @@ def test_damped_mathieu_against_the_integrated_monodromy(omega: float) -> None:
     if omega == 1.3:
         strip = hill.spectrum(model, basis, jac, omega, sorting="imaginary")
         assert _set_distance(strip.multipliers, exact) > 0.5
+
+
+def test_hill_on_stiff_contact_flags_the_points_the_monodromy_contradicts() -> None:
+    """stability="hill" on the 2-bay mast in contact at H = 7 (largest multiplier 0.80 by
+    Hill, 1.43 by the exact monodromy of the same orbit): the point is flagged, naming
+    both numbers; the default (the monodromy) calls it unstable."""
+    s = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0.0, 2e-6))
+    force = np.zeros(s.n_dof)
+    force[-2] = 5.0
+    w = 2.0 * math.pi * 51.92
+    curve = dict(harmonics=7, max_points=2, check_points=0)
+    by_hill = frequency_response(s, force, w, 1.0001 * w, stability="hill", **curve)
+    by_mono = frequency_response(s, force, w, 1.0001 * w, **curve)
+    assert not by_mono.stable.any()
+    assert by_hill.stable.all()
+    flagged = [e for e in by_hill.events if e.kind == "untrusted"]
+    assert len(flagged) == 2
+    assert "exact monodromy" in flagged[0].note
+    assert not [e for e in by_mono.events if e.kind == "untrusted"]

@@ -130,7 +130,9 @@ def frequency_response(
         infinite determinant for one DOF without friction, else the quadratic
         eigenproblem with centroid sorting, :func:`clearjoint.harmonic.hill.spectrum`;
         a point where it finds fewer than 2N resolved exponents gets NaN multipliers
-        and an ``"untrusted"`` event; ``settings["hill_defect"]`` holds each point's
+        and an ``"untrusted"`` event; for a Structure each point is also checked
+        against the exact monodromy of its orbit, and one whose verdict differs gets
+        an ``"untrusted"`` event; ``settings["hill_defect"]`` holds each point's
         shift defect). ``"monodromy"``: the exact monodromy of the HB orbit's
         linearisation (:mod:`clearjoint.harmonic.monodromy`). Default: ``"hill"`` for
         a Joint, ``"monodromy"`` for a Structure (on a 2-bay mast with stiff contact
@@ -400,6 +402,7 @@ def _response(
     jacobians = np.empty((n_pts, n_c, n_c)) if determinant else None
     defect = np.zeros(n_pts)
     unresolved: list[int] = []
+    disagree: list[tuple[int, float, float]] = []
     for i in range(n_pts):
         if not by_hill:  # the exact monodromy of the orbit's linearisation
             multipliers[i] = monodromy.multipliers(model, basis, coef[i], float(omega[i]))
@@ -420,6 +423,11 @@ def _response(
             continue
         multipliers[i] = found.multipliers
         defect[i] = found.defect
+        if not model.is_joint:  # cross-check against the exact monodromy of the same orbit
+            exact = float(np.max(np.abs(monodromy.multipliers(model, basis, coef[i], omega[i]))))
+            mine = float(np.max(np.abs(found.multipliers)))
+            if (mine < 1.0) != (exact < 1.0):
+                disagree.append((i, mine, exact))
     if jacobians is not None:
         multipliers[:] = aft.hill_determinant_multipliers(model, basis, jacobians, omega)
     if by_hill:
@@ -440,6 +448,18 @@ def _response(
             "exponents: no stability verdict here; raise harmonics or use stability='monodromy'",
         )
         for i in unresolved
+    ]
+    events += [
+        ResponseEvent(
+            "untrusted",
+            float(omega[i]),
+            float(force[i]),
+            float(np.max(amplitude[i])),
+            f"Hill's largest multiplier {mine:.4g} and the exact monodromy's {exact:.4g} of the "
+            "same orbit give other verdicts (the perturbation needs more harmonics than "
+            "the orbit); use stability='monodromy'",
+        )
+        for i, mine, exact in disagree
     ]
     if model.is_joint:
         x_max, x_min, amplitude, coef_out = x_max[:, 0], x_min[:, 0], amplitude[:, 0], coef[:, :, 0]
