@@ -640,7 +640,7 @@ def hill_agreement() -> None:
     the perturbation carried by H' > H harmonics (the same orbit, padded).
     """
     from clearjoint import ClearanceJoint, Friction
-    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic import aft, hill, monodromy
     from clearjoint.harmonic.system import build, friction_speed
     from clearjoint.periodic import periodic_orbit
     from clearjoint.structure import chain, mast
@@ -718,19 +718,40 @@ def hill_agreement() -> None:
             )
 
     joint_model = build(JOINT, ZETA, None, 1.0)
-    print("one joint (pyHarm's case, 0.03 N), against the exact orbit's multipliers (shooting)")
-    print(f"  H    w rad/s  {head}")
-    for h in (3, 7, 15):
-        for w in (0.6, 1.2, 1.45, 1.7):
-            fr = frequency_response(
-                JOINT, 0.03, w, 1.0001 * w, harmonics=h, damping_ratio=ZETA, max_points=2
-            )
-            exact = periodic_orbit(JOINT, 0.03, w, damping_ratio=ZETA, initial=fr.initial_state[0])
-            ref = np.asarray(exact.multipliers)
-            c, i = _hill_pair(joint_model, fr.coefficients[0][:, None], w)
+    print("one joint (pyHarm's case, 0.03 N, the curve 1.0 to 1.7 rad/s), every 3rd contact")
+    print("point against the exact orbit's multipliers (shooting), abs(mu) - 1 > 0.03 there")
+    for h in (3, 7, 15, 31):
+        curve = frequency_response(
+            JOINT, 0.03, 1.0, 1.7, harmonics=h, damping_ratio=ZETA, max_step=0.1
+        )
+        for name in ("centroid", "imaginary"):
+            wrong = 0
+            worst_top = 0.0
+            dist: list[float] = []
+            for k in range(0, curve.omega.size, 3):
+                if curve.amplitude[k] < 1.1 * 0.1745:
+                    continue
+                w = float(curve.omega[k])
+                try:
+                    exact = periodic_orbit(
+                        JOINT, 0.03, w, damping_ratio=ZETA, initial=curve.initial_state[k]
+                    )
+                except Exception:  # no exact orbit near this HB one (low H): skip it
+                    continue
+                ref = np.asarray(exact.multipliers)
+                if abs(float(np.max(np.abs(ref))) - 1.0) < 0.03:
+                    continue
+                found = hill.orbit_spectrum(
+                    joint_model, curve.coefficients[k][:, None], w, sorting=name
+                )
+                top = float(np.max(np.abs(found.multipliers)))
+                wrong += (top < 1.0) != exact.stable
+                dist.append(_set_distance(ref, found.multipliers))
+                worst_top = max(worst_top, abs(top / float(np.max(np.abs(ref))) - 1.0))
             print(
-                f"  {h:2d} {w:8.2f}    {np.max(np.abs(ref)):8.4f} | "
-                f"{_line(ref, c)} | {_line(ref, i)}"
+                f"  H = {h:2d} {name:9s}: {len(dist)} points, {wrong} other verdicts, set "
+                f"distance median {np.median(dist):.2e} worst {max(dist):.2e}, "
+                f"largest |mu| within {worst_top:.1%}"
             )
     rub = Friction(0.005, 1.0)
     print("one joint with friction Friction(0.005, 1.0), the regularised HB orbit's Hill")

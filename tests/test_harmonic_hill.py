@@ -137,27 +137,41 @@ def test_stiff_contact_needs_many_more_harmonics_in_the_perturbation() -> None:
     assert errors[1] < 0.15
 
 
-@pytest.mark.parametrize("omega", [0.6, 1.2, 1.45, 1.7])
-def test_one_joint_agrees_with_the_exact_orbits_floquet_multipliers(omega: float) -> None:
-    """pyHarm's joint (H = 12): the eigenproblem with centroid sorting against the
-    multipliers of the exact orbit by shooting (clearjoint.periodic) started from the HB
-    orbit, and against Hill's infinite determinant of the same HB orbit."""
+def test_one_joint_agrees_with_the_exact_orbits_floquet_multipliers() -> None:
+    """pyHarm's joint (H = 12), the curve's contact points (both stable branches and the
+    unstable one): the eigenproblem with centroid sorting against the multipliers of the
+    exact orbit by shooting (clearjoint.periodic) started from the HB orbit, away from
+    bifurcations (abs(mu) - 1 > 0.03), and against Hill's infinite determinant of the same
+    HB orbit (the same truncation by another route). Measured (20 points): paired
+    multipliers within 7.0e-3 (median), 4.8e-2 (worst, 1.53 rad/s beside the fold, where
+    the HB orbit's own error matters most); 3.2e-4 from the determinant. Both shrink with
+    H (`bench_harmonic.py --hill-agreement`)."""
     model = build(PYHARM, PYHARM_ZETA, None, 1.0)
-    fr = frequency_response(
-        PYHARM, 0.03, omega, 1.0001 * omega, harmonics=12, damping_ratio=PYHARM_ZETA, max_points=2
+    curve = frequency_response(
+        PYHARM, 0.03, 1.0, 1.7, harmonics=12, damping_ratio=PYHARM_ZETA, max_step=0.1
     )
-    assert fr.coefficients is not None
-    q = fr.coefficients[0][:, None]
-    found = hill.orbit_spectrum(model, q, omega)
-    exact = periodic_orbit(
-        PYHARM, 0.03, omega, damping_ratio=PYHARM_ZETA, initial=fr.initial_state[0]
-    )
-    assert abs(float(np.max(np.abs(exact.multipliers))) - 1.0) > 0.03  # away from bifurcations
-    assert _set_distance(found.multipliers, np.asarray(exact.multipliers)) < 0.02
-    assert (np.max(np.abs(found.multipliers)) < 1.0) == exact.stable
-    np.testing.assert_allclose(  # the determinant route: the same truncation, same numbers
-        np.sort_complex(found.multipliers), np.sort_complex(fr.multipliers[0]), atol=1e-6
-    )
+    assert curve.coefficients is not None
+    compared = unstable = 0
+    for i in range(0, curve.omega.size, 3):
+        if curve.amplitude[i] < 1.1 * 0.1745:  # contact only (free play is linear)
+            continue
+        w = float(curve.omega[i])
+        exact = periodic_orbit(
+            PYHARM, 0.03, w, damping_ratio=PYHARM_ZETA, initial=curve.initial_state[i]
+        )
+        ref = np.asarray(exact.multipliers)
+        if abs(float(np.max(np.abs(ref))) - 1.0) < 0.03:
+            continue
+        found = hill.orbit_spectrum(model, curve.coefficients[i][:, None], w)
+        assert _set_distance(found.multipliers, ref) < 0.06
+        top = float(np.max(np.abs(found.multipliers)))
+        assert top == pytest.approx(float(np.max(np.abs(ref))), rel=0.05)
+        assert (top < 1.0) == exact.stable
+        assert _set_distance(found.multipliers, curve.multipliers[i]) < 1e-3
+        compared += 1
+        unstable += not exact.stable
+    assert compared >= 12
+    assert unstable >= 4
 
 
 def test_frequency_response_stability_option(three_links: Structure) -> None:
