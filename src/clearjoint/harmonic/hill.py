@@ -25,19 +25,21 @@ keep is the sorting problem (Lazarus & Thomas, C. R. Mecanique 338, 2010):
   (0.159 instead of 0.792 on a 3-link chain at H = 7, 400 rad/s). So each member
   with abs(kbar) <= 3/4 gets a shift defect
 
-      d = (min_j |lambda_j - (lambda + i w)| + min_j |lambda_j - (lambda - i w)|) / w,
+      d = (min_j abs(lambda_j - (lambda + i w)) + min_j abs(lambda_j - (lambda - i w))) / w,
 
   zero for a family Hill's truncated problem resolves (the spectrum is invariant
   under the shift near its centre), and the 2N with the smallest d are kept, one
   per family (two candidates that differ by i k w within 0.01 w and whose centroids
   differ by -k, as the members kbar = -+1/2 of a negative real multiplier do, count
-  once). ``defect`` is the
-  largest d kept: a resolution measure of the verdict.
+  once). ``defect`` is the largest d kept: a resolution measure of the verdict.
 
 The eigenproblem is solved densely (eigenvectors included): size 2N (2H + 1), cost
-growing as its cube, about 0.1 s at size 400 and tens of seconds at 2000 (a 10-bay
-mast at H = 7 is 1800). For large structures the exact monodromy of the HB orbit
-(:mod:`clearjoint.harmonic.monodromy`) is the cheaper route.
+growing as its cube; both sortings together took 0.1-0.2 s at size 240, 2-7 s at
+1008 and 10-30 s at 2032 on 2 shared cores (``bench_harmonic.py --hill-agreement``);
+a 10-bay mast (40 DOF) at H = 7 is 1200. A stiff-contact structure also needs many
+more harmonics in the perturbation than in the orbit (:func:`orbit_spectrum`), so
+for structures the exact monodromy of the HB orbit
+(:mod:`clearjoint.harmonic.monodromy`) is the default route.
 """
 
 from __future__ import annotations
@@ -58,6 +60,16 @@ from clearjoint.harmonic.aft import (
     evaluate,
 )
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
+
+__all__ = [
+    "CANDIDATE_CENTROID",
+    "SAME_FAMILY",
+    "HillSpectrum",
+    "centroids",
+    "orbit_spectrum",
+    "select",
+    "spectrum",
+]
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
