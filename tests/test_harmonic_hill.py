@@ -294,3 +294,42 @@ def test_hill_on_stiff_contact_flags_the_points_the_monodromy_contradicts() -> N
     assert len(flagged) == 2
     assert "exact monodromy" in flagged[0].note
     assert not [e for e in by_mono.events if e.kind == "untrusted"]
+
+
+def test_neimark_sacker_crossings_are_events_and_collisions_are_not() -> None:
+    """A complex pair 0.9 -> 1.1 at angle +-1 rad between w = 2 and 3 (a real pair beside
+    it): one "neimark_sacker" event at w = 2.5 by linear interpolation. A real multiplier
+    through +1 and a complex pair that meets the real axis outside the circle (the largest
+    complex modulus drops from 1.2 to the inside pair's 0.5) give none."""
+    from clearjoint.harmonic.response import _events
+
+    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), 0.0, None, 1.0)
+    omega = np.array([1.0, 2.0, 3.0, 4.0])
+    force = np.ones(4)
+    amplitude = np.full(4, 1e-6)
+    d = np.zeros((4, 2))  # never beyond a gap edge: no grazing
+
+    def run(mu: np.ndarray) -> list[str]:
+        found = _events(model, omega, mu, d, d, omega, force, amplitude)
+        return [e.kind for e in found]
+
+    turn = np.exp(1j * np.array([1.0, -1.0]))
+    mu = np.array(
+        [np.concatenate((r * turn, [0.3, 0.2])) for r in (0.8, 0.9, 1.1, 1.2)],
+        dtype=np.complex128,
+    )
+    found = _events(model, omega, mu, d, d, omega, force, amplitude)
+    assert [e.kind for e in found] == ["neimark_sacker"]
+    assert found[0].omega == pytest.approx(2.5)
+    real = mu.copy()
+    real[:, :2] = np.array([[0.8, 0.1], [0.9, 0.1], [1.1, 0.1], [1.2, 0.1]])
+    assert run(real) == []
+    collide = np.array(
+        [
+            [1.2 * np.exp(0.2j), 1.2 * np.exp(-0.2j), 0.5j, -0.5j],
+            [1.3, 1.1, 0.5j, -0.5j],
+            [1.4, 1.0 + 1e-9, 0.5j, -0.5j],
+            [1.5, 0.9, 0.5j, -0.5j],
+        ]
+    )
+    assert run(collide) == []

@@ -541,6 +541,20 @@ def _turning_points(lam: FloatArray, tolerance: float) -> list[int]:
     return points
 
 
+#: A multiplier counts as one of a complex pair when abs(Im mu) exceeds this fraction of abs(mu).
+COMPLEX_PAIR = 1e-3
+
+
+def _complex_pair_test(multipliers: NDArray[np.complex128]) -> FloatArray:
+    """Largest abs(mu) - 1 over each point's complex multipliers (NaN where it has none):
+    its sign change between two points with as many complex multipliers is a
+    Neimark-Sacker crossing (a complex pair through the unit circle)."""
+    mag = np.abs(multipliers)
+    pair = np.abs(multipliers.imag) > COMPLEX_PAIR * mag
+    top = np.max(np.where(pair, mag, -np.inf), axis=1)
+    return np.where(np.isfinite(top), top - 1.0, np.nan)
+
+
 def _events(
     model: LinearSystem,
     lam: FloatArray,
@@ -551,10 +565,11 @@ def _events(
     force: FloatArray,
     amplitude: FloatArray,
 ) -> list[ResponseEvent]:
-    """Folds, period doublings and grazings between successive points.
+    """Folds, period doublings, Neimark-Sacker crossings and grazings between successive points.
 
-    Period doublings and grazings are located linearly between the points where
-    their test function changes sign. Folds are the points where the parameter
+    Period doublings, Neimark-Sacker crossings (:func:`_complex_pair_test`) and
+    grazings are located linearly between the points where their test function
+    changes sign. Folds are the points where the parameter
     turns back by more than ``FOLD_TOLERANCE`` of its largest value: the sampled
     law makes the HB branch zigzag by about 1e-4 of the parameter where it is
     nearly flat at a fold (each sample crossing a gap edge is a tiny kink), and
@@ -570,13 +585,23 @@ def _events(
             np.prod(1.0 + multipliers, axis=1).real,
             "a multiplier passes -1: a period-2 branch is born here (not followed)",
         ),
+        (
+            "neimark_sacker",
+            _complex_pair_test(multipliers),
+            "a complex pair of multipliers crosses the unit circle: a quasi-periodic "
+            "motion (torus) is born here (not followed)",
+        ),
     ]
     for j in range(model.directions.shape[0]):
         name = "" if model.is_joint else f" of joint {j}"
         tests.append(("grazing", d_max[:, j] - model.g_c[j], f"touches the compression edge{name}"))
         tests.append(("grazing", -model.g_t[j] - d_min[:, j], f"touches the tension edge{name}"))
+    mag = np.abs(multipliers)
+    pairs = np.sum(np.abs(multipliers.imag) > COMPLEX_PAIR * mag, axis=1)
     for kind, g, note in tests:
         for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
+            if kind == "neimark_sacker" and pairs[i] != pairs[i + 1]:
+                continue  # a pair met the real axis in between: not a crossing of one pair
             frac = float(g[i] / (g[i] - g[i + 1]))
 
             def lerp(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
