@@ -14,8 +14,9 @@ eigenproblem disagrees with it on stiff contact (docs/harmonic.md, "Stability");
 ``stability="hill"`` asks for Hill's method anyway. Events are located as in
 :mod:`clearjoint.periodic`: folds where the parameter component of the tangent
 changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
-through -1), grazings where a joint's extreme relative displacement crosses a gap
-edge.
+through -1), Neimark-Sacker crossings where the largest modulus among the complex
+multipliers crosses 1, grazings where a joint's extreme relative displacement crosses a
+gap edge.
 """
 
 from __future__ import annotations
