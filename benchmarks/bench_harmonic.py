@@ -795,6 +795,50 @@ def hill_agreement() -> None:
     sys.stdout.flush()
 
 
+def neimark_sacker_check() -> None:
+    """The Neimark-Sacker events of the softer 2-bay mast's curve against the exact motion.
+
+    The curve (20 N at the tip, 60 to 110 Hz, H = 15, stability by the exact monodromy of
+    each HB orbit) and, at points either side of and between its events, the one-period
+    orbit check's residual and 200 periods of the exact motion (structure.time_response)
+    from the HB state: its distance at forcing phase 0 from the HB state every 25 periods
+    and the change over the last period, relative to the HB state (a constant distance and
+    no change: a stable period-1 motion near the HB orbit).
+    """
+    from clearjoint import ClearanceJoint
+    from clearjoint.harmonic.check import check_orbits
+    from clearjoint.structure import mast, time_response
+
+    s = mast(2, joints=ClearanceJoint(5e-5, 5e7, gap_stiffness=1e5), rayleigh=(0.0, 2e-5))
+    f = np.zeros(s.n_dof)
+    f[s.dof_names.index("n5x")] = 20.0
+    n = s.n_dof
+    fr = frequency_response(
+        s, f, 2 * math.pi * 60, 2 * math.pi * 110, harmonics=15, max_points=150, check_points=0
+    )
+    marks = [(e.kind, round(e.omega / (2 * math.pi), 2)) for e in fr.events]
+    print(f"softer 2-bay mast, 20 N, H = 15: {fr.omega.size} points, events {marks}")
+    hz = fr.omega / (2 * math.pi)
+    for target in (74.0, 76.5, 78.5, 80.5, 82.5, 85.0):
+        i = int(np.argmin(np.abs(hz - target)))
+        w = float(fr.omega[i])
+        period = 2 * math.pi / w
+        mu = fr.multipliers[i]
+        top = mu[np.argmax(np.abs(mu))]
+        residual = check_orbits(fr, [i]).residual[0]
+        x = fr.initial_state[i]
+        motion = time_response(s, f, w, 200 * period, initial=(x[:n], x[n:]), samples_per_period=64)
+        u = motion.u[::64][:201]
+        dev = np.linalg.norm(u - x[:n], axis=1) / np.linalg.norm(x[:n])
+        step = float(np.linalg.norm(u[-1] - u[-2]) / np.linalg.norm(x[:n]))
+        print(
+            f"  {hz[i]:6.2f} Hz: largest mu {top:.3f} (abs {abs(top):.3f}), orbit residual "
+            f"{residual:.1e}; exact motion at phase 0, periods 25, 50, ..., 200: "
+            + " ".join(f"{d:.3f}" for d in dev[25::25])
+            + f"; last period-to-period change {step:.1e}"
+        )
+
+
 def samples_error() -> None:
     """HB x_max against the exact orbit (clearjoint.periodic) as N_t grows, pyHarm's case."""
     from clearjoint.harmonic import aft, solve, system
@@ -858,12 +902,18 @@ def main() -> None:
     parser.add_argument(
         "--hill-agreement", action="store_true", help="Hill's method against exact references"
     )
+    parser.add_argument(
+        "--neimark-sacker", action="store_true", help="a curve's NS events against exact motion"
+    )
     args = parser.parse_args()
     if args.hill_sorting:
         hill_sorting()
         return
     if args.hill_agreement:
         hill_agreement()
+        return
+    if args.neimark_sacker:
+        neimark_sacker_check()
         return
     freqs = [float(v) for v in args.at.split(",")]
     if args.mast_check:
