@@ -94,7 +94,7 @@ def test_chain_agrees_with_the_exact_monodromy_of_the_same_orbit(
     """The 3-link chain at five frequencies, each orbit beyond a gap edge: Hill's 2N
     multipliers (centroid sorting) against the exact monodromy of the same HB orbit, all
     six paired, within a tolerance that shrinks with H (measured: worst 0.041 at H = 7,
-    9.3e-3 at H = 15; `bench_harmonic.py --hill-agreement`), and the same verdict. At H = 7,
+    9.3e-3 at H = 15; `benchmarks/bench_hill.py --agreement`), and the same verdict. At H = 7,
     400 rad/s the centroid alone kept a spurious family (largest 0.159 against 0.792)."""
     model = build(three_links, 0.0, None, 1.0)
     for w in (200.0, 300.0, 400.0, 600.0, 800.0):
@@ -145,7 +145,7 @@ def test_one_joint_agrees_with_the_exact_orbits_floquet_multipliers() -> None:
     HB orbit (the same truncation by another route). Measured (20 points): paired
     multipliers within 7.0e-3 (median), 4.8e-2 (worst, 1.53 rad/s beside the fold, where
     the HB orbit's own error matters most); 3.2e-4 from the determinant. Both shrink with
-    H (`bench_harmonic.py --hill-agreement`)."""
+    H (`benchmarks/bench_hill.py --agreement`)."""
     model = build(PYHARM, PYHARM_ZETA, None, 1.0)
     curve = frequency_response(
         PYHARM, 0.03, 1.0, 1.7, harmonics=12, damping_ratio=PYHARM_ZETA, max_step=0.1

@@ -35,7 +35,7 @@ keep is the sorting problem (Lazarus & Thomas, C. R. Mecanique 338, 2010):
 
 The eigenproblem is solved densely (eigenvectors included): size 2N (2H + 1), cost
 growing as its cube; both sortings together took 0.1-0.2 s at size 240, 2-7 s at
-1008 and 9-30 s at 2032 on 2 shared cores (``bench_harmonic.py --hill-agreement``);
+1008 and 9-30 s at 2032 on 2 shared cores (``benchmarks/bench_hill.py --agreement``);
 a 10-bay mast (40 DOF) at H = 7 is 1200. A stiff-contact structure also needs many
 more harmonics in the perturbation than in the orbit (:func:`orbit_spectrum`), so
 for structures the exact monodromy of the HB orbit
