@@ -302,3 +302,27 @@ def test_samples_reach_harmonic_balance(tmp_path: Path, capsys: pytest.CaptureFi
         s, [0.0, 0.0, 40.0], 2 * math.pi * 50, 2 * math.pi * 52, harmonics=3, samples=14
     )
     np.testing.assert_allclose(json.loads(text)["x_max_m"], direct.x_max, rtol=1e-9, atol=1e-15)
+
+
+def test_frf_without_an_orbit_at_the_start_says_so_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The example mast at 20 N, H = 15 in small: the start's force continuation (which the
+    chain needs at 800 rad/s) held to 10 points, so it gives up; progress lines, then one
+    error line saying what to do, exit 2 (the mast itself: 67 s, docs/harmonic.md)."""
+    from clearjoint.harmonic import response
+
+    monkeypatch.setattr(response, "START_POINTS", (10, 10))
+    study, out = _chain_study(tmp_path), tmp_path / "frf.nc"
+    start = f"{800 / (2 * math.pi)}Hz"
+    args = ["frf", str(study), "--from", start, "--to", "130Hz", "--method", "harmonic"]
+    code, _, err = run([*args, "--out", str(out)], capsys)
+    assert code == 2
+    *progress, last = err.strip().splitlines()
+    assert progress
+    assert progress[0].startswith("clearjoint frf: start at 127.324 Hz: Newton from the linear")
+    assert last.startswith(f"clearjoint frf: error: {study}: no harmonic-balance orbit at 127.324")
+    assert "lower [excitation] force_amplitude" in last
+    assert f"clearjoint structure {study} respond" in last
+    assert "Traceback" not in err
+    assert not out.exists()

@@ -11,7 +11,9 @@ exit code 2 and one line on stderr that says what is wrong and where.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import logging
 import math
 import os
 import sys
@@ -1141,6 +1143,7 @@ def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: 
     import math
 
     from clearjoint import harmonic
+    from clearjoint.harmonic.response import NoPeriodicResponse
     from clearjoint.units import parse_quantity
 
     if args.method != "harmonic":
@@ -1165,28 +1168,34 @@ def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: 
         if not (math.isfinite(frequency) and frequency > 0.0):
             raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
         pattern = study.force * (start / float(np.max(np.abs(study.force))))
-        return harmonic.frequency_response(
-            study.structure,
-            pattern,
-            2.0 * math.pi * frequency,
-            None,
-            harmonics=h,
-            samples=samples,
-            parameter="force",
-            force_stop=stop,
-            max_points=args.max_points,
-        )
+        try:
+            return harmonic.frequency_response(
+                study.structure,
+                pattern,
+                2.0 * math.pi * frequency,
+                None,
+                harmonics=h,
+                samples=samples,
+                parameter="force",
+                force_stop=stop,
+                max_points=args.max_points,
+            )
+        except NoPeriodicResponse as exc:
+            raise _no_orbit(exc, study.source, start) from None
     if args.frequency:
         raise ParameterError("--frequency goes with --parameter force; drop it or add that")
-    return harmonic.frequency_response(
-        study.structure,
-        study.force,
-        2.0 * math.pi * start,
-        2.0 * math.pi * stop,
-        harmonics=h,
-        samples=samples,
-        max_points=args.max_points,
-    )
+    try:
+        return harmonic.frequency_response(
+            study.structure,
+            study.force,
+            2.0 * math.pi * start,
+            2.0 * math.pi * stop,
+            harmonics=h,
+            samples=samples,
+            max_points=args.max_points,
+        )
+    except NoPeriodicResponse as exc:
+        raise _no_orbit(exc, study.source, float(np.max(np.abs(study.force)))) from None
 
 
 def _progress_bar(*columns: Any) -> Any:
@@ -1196,6 +1205,38 @@ def _progress_bar(*columns: Any) -> Any:
 
     return Progress(
         *columns, console=Console(stderr=True), transient=True, disable=not sys.stderr.isatty()
+    )
+
+
+@contextlib.contextmanager
+def _harmonic_progress(command: str) -> Any:
+    """Print clearjoint.harmonic's progress lines (its slow start) on stderr, one line each."""
+    logger = logging.getLogger("clearjoint.harmonic")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter(f"clearjoint {command}: %(message)s"))
+    level = logger.level
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
+
+
+def _no_orbit(exc: Any, source: str, force: float) -> ParameterError:
+    """The start found no harmonic-balance orbit: say so in CLI terms, with what to do."""
+    hz = exc.omega / (2.0 * math.pi)
+    reached = (
+        f"; following the force up from a small one reached only {exc.reached * force:.3g} N"
+        if exc.reached > 0.0
+        else ""
+    )
+    return ParameterError(
+        f"{source}: no harmonic-balance orbit at {hz:.6g} Hz and {force:.3g} N{reached}: at this "
+        "force the joints may rattle with no periodic orbit (docs/harmonic.md); lower "
+        "[excitation] force_amplitude, or start elsewhere (--from), or take the exact motion: "
+        f"clearjoint structure {source} respond"
     )
 
 
@@ -1503,7 +1544,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "structure": _run_structure,
     }
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), _harmonic_progress(args.command):
             warnings.showwarning = _warning_printer(args.command)
             return runners[args.command](args)
     except BrokenPipeError:  # the reader stopped early (| head): not an error of ours
