@@ -8,9 +8,11 @@ is a, its sine coefficient 0 (the phase). Then
 
     natural frequency w(a),
     energy dissipated per cycle E_diss = xi * integral of u'^T M u' dt over one period,
-    damping ratio zeta(a) = E_diss / (4 pi E_max)   (the loss factor of MODEL.md
-        section 2 halved; E_max the largest potential energy over the orbit),
-    EPMC's own ratio xi / (2 w)   (equal to zeta for sinusoidal motion only).
+    damping ratio zeta(a) = E_diss / (4 pi E_max),
+    EPMC's own ratio xi / (2 w).
+
+zeta is the loss factor of MODEL.md section 2 halved, E_max the largest potential
+energy over the orbit; EPMC's ratio equals it for sinusoidal motion only.
 
 For one joint without losses xi = 0 and w(a) is the paper's 2 pi / T(A) of
 section 1 (the dynamic stiffness is the backbone of the mode).
@@ -109,7 +111,9 @@ class NonlinearMode:
         )
 
     def plot(self, ax: Axes | None = None) -> Axes:
-        """Plot frequency (Hz, solid) and damping ratio (dashed, right axis) against amplitude.
+        """Plot frequency (Hz, solid) and both damping ratios (right axis) against amplitude.
+
+        ``damping_ratio`` dashed, ``epmc_damping_ratio`` dotted.
 
         Returns
         -------
@@ -128,8 +132,11 @@ class NonlinearMode:
             ax.set_xscale("log")
         if np.any(self.damping_ratio[self.converged] > 0.0):
             twin = ax.twinx()
-            twin.plot(a_um, self.damping_ratio, "--", color="C3", label="damping ratio")
-            twin.set_ylabel("damping ratio", color="C3")
+            twin.plot(
+                a_um, self.damping_ratio, "--", color="C3", label="damping ratio E/(4 pi E_max)"
+            )
+            twin.plot(a_um, self.epmc_damping_ratio, ":", color="C3", label="EPMC xi/(2 w)")
+            twin.set_ylabel("damping ratio (dashed; EPMC xi/(2 w) dotted)", color="C3")
         ax.set_title(f"nonlinear mode {self.mode} (EPMC, H = {self.harmonics})")
         return ax
 
