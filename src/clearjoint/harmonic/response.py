@@ -22,6 +22,7 @@ gap edge.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 from typing import Any, Literal
 
@@ -50,6 +51,35 @@ from clearjoint.joint import Friction
 from clearjoint.periodic import FrequencyResponse, ResponseEvent, _parameter_range
 
 FloatArray = NDArray[np.float64]
+
+#: Progress of slow steps (the start's force continuation), at INFO; ``clearjoint frf``
+#: prints it on stderr.
+LOGGER = logging.getLogger("clearjoint.harmonic")
+
+#: The start's force continuation takes at most this many unknown-points (points times
+#: unknowns), between ``START_POINTS`` (40 and 2000) points: a 40-DOF structure at H = 15
+#: (1240 unknowns, about 1 s and 6 evaluations a point on 2 busy cores) gives up after 40.
+START_BUDGET = 50_000
+START_POINTS = (40, 2000)
+
+
+class NoPeriodicResponse(HarmonicError):
+    """No HB solution was found at the start of a curve (the message says how far the
+    force continuation got and what to try).
+
+    Attributes
+    ----------
+    omega : float
+        The start frequency, rad/s.
+    reached : float
+        The fraction of the force the start's force continuation reached (0 if it was
+        not tried).
+    """
+
+    def __init__(self, message: str, omega: float, reached: float) -> None:
+        super().__init__(message)
+        self.omega = omega
+        self.reached = reached
 
 
 def frequency_response(
@@ -330,11 +360,13 @@ def _start_plain(
         ev = aft.evaluate(model, basis, q, omega, force)
         return ev.residual / k_ref, ev.jacobian / k_ref
 
+    hz = omega / (2.0 * math.pi)
     for stiffness in (model.open_stiffness(), model.closed_stiffness()):
         guess = linear_guess(model, basis, omega, force, stiffness)
         found = newton(function, guess, max(scale, float(np.max(np.abs(guess)))))
         if found is not None:
             return found[0]
+    reached = 0.0
     # Homotopy: from a force small enough for the open (all joints in free-play) linear
     # response to stay inside every gap, follow the solution up to the full force.
     open_guess = linear_guess(model, basis, omega, force, model.open_stiffness())
@@ -343,8 +375,29 @@ def _start_plain(
     room = np.minimum(model.g_c, model.g_t)
     if reach.size and np.all(np.isfinite(reach)) and np.max(reach) > 0.0 and np.all(room > 0):
         fraction = min(0.5 * float(np.min(room / np.maximum(reach, 1e-300))), 0.5)
+        peak = float(np.max(np.abs(force)))
+        points = int(np.clip(START_BUDGET // open_guess.size, *START_POINTS))
+        LOGGER.info(
+            "start at %.6g Hz: Newton from the linear responses found no orbit; following "
+            "the force up from %.3g N to %.3g N (at most %d points)",
+            hz,
+            fraction * peak,
+            peak,
+            points,
+        )
+        calls = [0, fraction]
 
         def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
+            calls[0] += 1
+            calls[1] = max(calls[1], lam)
+            if calls[0] % 25 == 0:
+                LOGGER.info(
+                    "start at %.6g Hz: force continuation at %.3g N of %.3g N (%d evaluations)",
+                    hz,
+                    lam * peak,
+                    peak,
+                    calls[0],
+                )
             ev = aft.evaluate(model, basis, u, omega, lam * force)
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * basis.harmonics + 1, -1)[2] = -force
@@ -359,16 +412,29 @@ def _start_plain(
                 u_scale=np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess))))),
                 lam_scale=1.0,
                 settings=ContinuationSettings(
-                    step=0.01, min_step=1e-7, max_step=0.1, max_points=2000, tolerance=TOLERANCE
+                    step=0.01, min_step=1e-7, max_step=0.1, max_points=points, tolerance=TOLERANCE
                 ),
             )
         except ClearjointError:
             branch = None
         if branch is not None and branch.reason == "reached":
             return np.asarray(branch.u[-1], dtype=np.float64)
-    raise HarmonicError(
+        reached = float(calls[1]) if branch is None else float(np.max(branch.lam))
+        raise NoPeriodicResponse(
+            f"harmonic balance found no periodic response at omega_start = {omega!r} rad/s "
+            f"({hz:.6g} Hz): Newton from the linear responses failed and the force "
+            f"continuation reached only {reached * peak:.3g} N of {peak:.3g} N"
+            + ("" if branch is None else f" ({branch.reason} after {len(branch.lam)} points)")
+            + "; at this force there may be no periodic orbit (the joints may rattle): start "
+            "at a lower force or another frequency, or use the exact time response",
+            omega,
+            reached,
+        )
+    raise NoPeriodicResponse(
         f"harmonic balance found no periodic response at omega_start = {omega!r} rad/s; "
-        "start the curve at another frequency"
+        "start the curve at another frequency",
+        omega,
+        reached,
     )
 
 
