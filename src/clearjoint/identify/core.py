@@ -14,10 +14,11 @@ MODEL.md section 3. The steps:
 5. the joint's parameters: without an acceleration channel, or when the cycles were
    stacked by interpolation (a period that is not a whole number of samples), by the weak
    form (:mod:`clearjoint.identify.weak`: no derivative of the displacement, test functions
-   that stop at the contact instants); with an acceleration on a whole-sample stack, or
-   when a contact lasts too few samples for test functions, by robust least squares over
-   the average's samples (the velocity's sign and drag from its spectral derivative); the
-   damper's and the line's by their per-sample fits;
+   that stop at the contact instants), and when the average's displacement noise exceeds
+   ``SAMPLE_FIT_NOISE`` of the amplitude; with an acceleration on a whole-sample stack of
+   a quieter average, or when a contact lasts too few samples for test functions, by
+   robust least squares over the average's samples (the velocity's sign and drag from its
+   spectral derivative); the damper's and the line's by their per-sample fits;
 6. a jackknife over the cycles (the average without each of at most eight contiguous
    groups of cycles in turn, all replicates fitted in one batched solve) for every
    standard error; the energy per cycle is each cycle's own loop area (the closed
@@ -80,6 +81,11 @@ RESIDUAL_FACTOR = 3.0
 #: Samples this close to a gap edge (a fraction of the clearance) belong to no stage's
 #: test functions: the contact instants are where the stages' laws switch.
 EDGE_MARGIN = 0.05
+#: The sample-by-sample fit of a joint needs a cycle average whose displacement noise
+#: (scatter over the cycles / sqrt(n)) is below this part of the amplitude; noisier, the
+#: weak form (the rig's records: 1.5e-4..4.1e-4; the independent simulator's at 1 % noise
+#: and 24 cycles: 1.5e-3, at 6 cycles 3.2e-3).
+SAMPLE_FIT_NOISE = 1e-3
 #: Equations each stage needs for the weak form (else the stages are fitted sample by
 #: sample on the cycle average, as when a contact lasts only a few samples).
 MIN_EQUATIONS = 4
@@ -342,13 +348,18 @@ def _identify_stack(
         edges = (first_fit.lower_edge, first_fit.upper_edge)
         margin = EDGE_MARGIN * (edges[1] - edges[0])
         model = "joint"
-        # the weak form without a measured acceleration, or when the cycles were stacked
-        # by interpolation (a period that is not a whole number of samples): averaging
-        # cycles sampled at different phases smooths the contact corners and the friction
-        # reversals by about a sample, which biases a sample-by-sample fit (friction 5-20 %
-        # low); the weak form uses only integrals of x, F (and a) against test functions
-        # that stop before the contact instants, so it does not see that smoothing
-        if "a" not in st.channels or not st.exact:
+        # the weak form without a measured acceleration, when the cycles were stacked by
+        # interpolation (a period that is not a whole number of samples: averaging cycles
+        # sampled at different phases smooths the contact corners and the friction
+        # reversals by about a sample, which biases a sample-by-sample fit, friction 5-20 %
+        # low; the weak form uses only integrals of x, F and a against test functions that
+        # stop before the contact instants), or when the cycle average is too noisy for
+        # the sample fit (its velocity's sign follows the noise near the reversals: an
+        # errors-in-variables bias of the friction, 10-50 % low with 6-16 cycles at 1 %
+        # noise, not covered by its standard error; docs/identify.md, measured by
+        # docs/identify_bias.py --cycles)
+        noisy = noise_x > SAMPLE_FIT_NOISE * 0.5 * float(np.ptp(x))
+        if "a" not in st.channels or not st.exact or noisy:
             # imported here: a damper or a line (the BRFD folder) never needs the weak form
             from clearjoint.identify.weak import stage_runs, weak_system
 
@@ -449,6 +460,7 @@ def _identify_stack(
     spread: dict[str, float] = {}
     stderr: dict[str, float] = {}
     per_cycle: dict[str, FloatArray] = {}
+    bias: dict[str, float] = {}  # the jackknife's estimate of each fitted value's bias
     own = {
         "amplitude_m": 0.5 * np.ptp(xs, axis=1),
         "energy_per_cycle_j": _loop_areas(xs, fs),
@@ -471,6 +483,8 @@ def _identify_stack(
             pseudo = g * est - (g - 1) * np.array([vv.get(q, math.nan) for vv in loo])
             cyc = pseudo[member]
             finite = np.isfinite(pseudo)
+            if finite.sum() > 1:
+                bias[q] = est - float(np.mean(pseudo[finite]))
             se = (
                 float(np.std(pseudo[finite], ddof=1)) / math.sqrt(g)
                 if finite.sum() > 1
@@ -614,9 +628,11 @@ def _flags(
                 flags[q] = ("doubtful", reason)
     if mass_missing:
         reason = f"force control without a mass: m = {mass:.4g} kg estimated from the record"
-        for q in fitted:
+        for q in fitted:  # the issue's own rule: shown beside any other doubt
             if flags[q][0] == "ok":
                 flags[q] = ("doubtful", reason)
+            elif flags[q][0] == "doubtful":
+                flags[q] = ("doubtful", f"{flags[q][1]}; {reason}")
     return flags
 
 
