@@ -25,7 +25,9 @@ MODEL.md section 3. The steps:
    integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
-   exceeds a quarter of it, a fit residual above the noise floor, a force-controlled
+   exceeds a quarter of it, a fit residual above the noise floor (the weak form's
+   equation residual; the damper model's residual on the loop,
+   :mod:`clearjoint.identify.loopcheck`), a force-controlled
    record without a mass (then estimated from the record, with a warning), or a damper
    whose backlash reads more than twice as long on one branch as on the other.
 """
@@ -56,6 +58,7 @@ from clearjoint.identify.cycles import (
     steady_rule,
 )
 from clearjoint.identify.damper import BRANCH_RATIO, _damper_fit
+from clearjoint.identify.loopcheck import damper_residual
 from clearjoint.identify.result import QUANTITIES, CycleResult, Identification
 from clearjoint.identify.segments import (
     STAGE_COMPRESSION,
@@ -431,6 +434,7 @@ def _identify_stack(
             fits = [fit or first_fit for fit in batch]
         elif model == "damper":
             assert head_damper is not None
+            residual = damper_residual(x, f, parts, head_damper)
             fits.append(head_damper)  # replicate 0 is the average itself: fitted above
             for xr_, fr_, rr_, vr_ in zip(
                 reps_x[1:], reps_f[1:], reps_r[1:], reps_v[1:], strict=True
