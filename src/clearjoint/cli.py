@@ -888,6 +888,7 @@ def _run_report(args: argparse.Namespace) -> int:
         Path(args.out),
         force=args.force,
         progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+        warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
     )
     for path in written:
         print(f"wrote {path}")
