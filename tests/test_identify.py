@@ -285,6 +285,16 @@ def test_cli_writes_csv_and_netcdf_and_says_why_a_file_was_not_used(
         assert f"{key}_std" in table[0]
     assert len(list((tmp_path / "figures").glob("*.png"))) == 2 * len(files)
     assert main(["identify", *files, "--out", str(out), "--quiet"]) == 2  # no overwrite
+    capsys.readouterr()
+    # figures already there: nothing is written (not even the new table), the message names
+    # the option that chose them
+    other = tmp_path / "f2.csv"
+    figures = ["--figures", str(tmp_path / "figures")]
+    assert main(["identify", *files, "--out", str(other), "--quiet", *figures]) == 2
+    err = capsys.readouterr().err
+    assert "choose another --figures or pass --force" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not other.exists()
     nc = tmp_path / "results.nc"
     assert main(["identify", *files, "--out", str(nc), "--quiet"]) == 0
     with xr.open_dataset(nc, engine="h5netcdf") as data:

@@ -712,6 +712,9 @@ def _run_identify(args: argparse.Namespace) -> int:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
     rows = [ident.row() for _, ident in results]
+    if args.figures:  # every output checked before any is written
+        targets = [t for _, ident in results for t in _figure_files(ident, Path(args.figures))]
+        refuse_to_overwrite(targets, force=args.force, option="--figures")
     _write_rows(rows, out)
     if args.figures:
         _identify_figures(results, Path(args.figures), force=args.force)
@@ -750,6 +753,12 @@ def _write_rows(rows: list[dict[str, Any]], out: Path) -> None:
     data.to_netcdf(out, engine="h5netcdf")
 
 
+def _figure_files(ident: Any, folder: Path) -> list[Path]:
+    """The two figures ``clearjoint identify --figures`` writes for one identification."""
+    stem = Path(ident.source).stem
+    return [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
+
+
 def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
     from clearjoint._checks import refuse_to_overwrite
     from clearjoint.figures import displacement_stages_figure, identified_loop_figure
@@ -757,8 +766,8 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     for record, ident in results:
         stem = Path(ident.source).stem
-        targets = [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
-        refuse_to_overwrite(targets, force=force)
+        targets = _figure_files(ident, folder)
+        refuse_to_overwrite(targets, force=force, option="--figures")
         first = ident.cycles[0]
         span = slice(first.start, ident.cycles[-1].stop)
         runs = ident.stage_runs(record.time)
