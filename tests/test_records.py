@@ -167,6 +167,17 @@ def test_bad_records_name_the_file_and_the_problem(tmp_path: Path, body: str, wo
     assert str(path) in str(info.value)
 
 
+def test_a_record_of_two_cycles_is_refused_with_the_steady_cycle_rule(tmp_path: Path) -> None:
+    """The same sentence as the identification's refusals (clearjoint.identify.steady_rule)."""
+    from clearjoint.identify.cycles import STEADY_RULE
+
+    path = write_csv(tmp_path, CSV_MAGIC + '\n# frequency = "2 Hz"\n' + csv_body(UNIFORM))
+    with pytest.raises(RecordError) as info:
+        read_record(path)
+    assert str(info.value).endswith(STEADY_RULE)
+    assert "at least 3 steady cycles" in str(info.value)
+
+
 def test_resampling_is_offered_and_works(tmp_path: Path) -> None:
     times = [0.0, 0.011] + [0.011 + i / 100 for i in range(1, 60)]
     path = write_csv(tmp_path, csv_body(times))
