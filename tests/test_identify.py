@@ -203,6 +203,27 @@ def test_exact_friction_loop_with_backlash() -> None:
     )
 
 
+def test_a_dampers_samples_are_staged_by_force_not_by_position() -> None:
+    """The loop figure colours samples by Identification.stage: on a damper, a sample on a
+    slip plateau is never "free-play", and one at zero force (in the gap) always is, at any
+    displacement (they used to be staged by the gap edges' positions)."""
+    friction = 1e4
+    record = friction_loop(4e-3, friction, 5e6, 20e-3)
+    result = identify(record)
+    assert result.model == "damper"
+    force = result.restoring_force
+    slipping = np.abs(force) > 0.9 * friction
+    assert np.all(result.stage[slipping] == np.sign(force[slipping]))
+    in_gap = (force == 0.0) & (record.time > 1.0)  # after the ramp in
+    assert np.all(result.stage[in_gap] == 0)
+    assert np.ptp(record.displacement[in_gap]) > 4e-3  # free play on both sides of zero
+    assert {name for name, _, _ in result.stage_runs(record.time)} == {
+        "free-play",
+        "compression",
+        "tension",
+    }
+
+
 @pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
 def test_real_brfd_records() -> None:
     results, failures = identify_files([str(p) for p in sorted(BRFD.glob("*.json"))])

@@ -59,7 +59,7 @@ from clearjoint.identify.cycles import (
 )
 from clearjoint.identify.damper import BRANCH_RATIO, _damper_fit
 from clearjoint.identify.loopcheck import damper_residual
-from clearjoint.identify.result import QUANTITIES, CycleResult, Identification
+from clearjoint.identify.result import QUANTITIES, CycleResult, Identification, damper_stages
 from clearjoint.identify.segments import (
     STAGE_COMPRESSION,
     STAGE_TENSION,
@@ -552,7 +552,9 @@ def _identify_stack(
     )
     force_all = restoring_force(record, _record_acceleration(record, frequency), m_guess)
     stage = np.zeros(record.time.size, dtype=np.int8)
-    if model != "line":
+    if model == "damper":  # it plays free after each reversal: staged by its force
+        stage = damper_stages(force_all, summary["friction_force_n"])
+    elif model != "line":
         stage[record.displacement >= head.upper_edge] = STAGE_COMPRESSION
         stage[record.displacement <= head.lower_edge] = STAGE_TENSION
     return Identification(
