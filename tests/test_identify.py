@@ -323,6 +323,15 @@ def test_cli_writes_csv_and_netcdf_and_says_why_a_file_was_not_used(
         assert "clearance_m_std" in data
 
 
+def test_identify_help_names_every_column_kind(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["identify", "--help"])
+    assert info.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for word in ("_std", "_se", "flag (ok, doubtful, rejected)", "flag_reason"):
+        assert word in text, word
+
+
 def test_cli_refuses_when_nothing_is_usable(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -265,10 +265,13 @@ def test_brfd_adapter_reads_all_31_files_in_si() -> None:
         assert np.max(np.abs(r.displacement)) == pytest.approx(r.displacement_amplitude, rel=0.25)
 
 
-@pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
 def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
-    path = tmp_path / "1Hz0lbtension1amplitude.json"
-    path.write_text(json.dumps({"data": [[0.0, 1.0]] * 20, "displacement units": "in"}))
+    # a shipped record's own content with one column dropped (runs on a fresh clone)
+    shipped = Path(__file__).resolve().parent / "data" / "brfd" / "2Hz0lbtension0.5amplitude.json"
+    content = json.loads(shipped.read_text())
+    content["data"] = [row[:5] for row in content["data"]]
+    path = tmp_path / shipped.name
+    path.write_text(json.dumps(content))
     with pytest.raises(RecordError, match="must have 6 columns"):
         read_brfd(path)
 

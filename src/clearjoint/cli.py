@@ -179,8 +179,10 @@ def _identify_parser(sub: Any) -> None:
         help="clearance, stiffness, friction and energy per cycle from test records",
         description=(
             "Identify every record (CSV, netCDF, BRFD JSON; recognised by content): one row "
-            "per file in --out (.csv or .nc) with each quantity's mean over the steady "
-            "cycles and its spread in a _std column; one line for every file not used."
+            "per file in --out (.csv or .nc) with each quantity's value over the steady "
+            "cycles, its spread over the cycles (_std) and its standard error (_se), then "
+            "a credibility flag (ok, doubtful, rejected) and flag_reason; one line for "
+            "every file not used."
         ),
     )
     p.add_argument("files", nargs="+", help="record files")
