@@ -43,11 +43,18 @@ def _row(label: str, frequency: float, rate: float, cycles: int, folder: Path) -
         errors = " | ".join(f"{100 * (s[k] / truth[k] - 1):+.2f}" for k, _ in KEYS)
         se = 100 * result.stderr["friction_force_n"] / truth["friction_force_n"]
         flag, reason = result.flags["friction_force_n"]
-        why = reason.split(":")[0][:60] if flag != "ok" else ""
-        print(
-            f"| {label} | {seed} | {errors} | {se:.1f} | {flag} {why} |".replace("  ", " "),
-            flush=True,
-        )
+        print(f"| {label} | {seed} | {errors} | {se:.1f} | {flag}{_short(reason)} |", flush=True)
+
+
+def _short(reason: str) -> str:
+    """The flag's reason in a few words (the table's last column)."""
+    if not reason:
+        return ""
+    if reason.startswith("fit residual"):
+        return f" (residual {reason.split(' is ')[1].split(' times')[0]}x floor)"
+    if "standard error" in reason:
+        return f" (SE {reason.split('error of ')[1].split(' of')[0]})"
+    return f" ({reason.split(':')[0]})"
 
 
 def main() -> None:
