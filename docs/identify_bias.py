@@ -3,6 +3,8 @@
 
     python docs/identify_bias.py --off-grid     # 40 Hz at 12 000/12 010/11 990/12 030 Hz, 37 Hz
     python docs/identify_bias.py --cycles       # 6, 10, 24 cycles at 40 Hz, 12 kHz
+    python docs/identify_bias.py --brfd-residuals  # the damper fit residual / noise floor
+    python docs/identify_bias.py --bouc-wen     # the same on a smooth loop with no gap
 
 1 % noise on every channel, with an acceleration channel, seeds 1-5. Errors in % of the
 simulator's own truth; the friction's standard error (in % of the truth) and its flag.
@@ -57,13 +59,51 @@ def _short(reason: str) -> str:
     return f" ({reason.split(':')[0]})"
 
 
+def _brfd_residuals() -> None:
+    """Each BRFD file's damper fit residual over its noise floor (flagged above 3)."""
+    import re
+
+    import clearjoint.identify.core as core
+    from clearjoint.identify.cycles import IdentificationError
+
+    factor = core.RESIDUAL_FACTOR
+    core.RESIDUAL_FACTOR = 0.0  # every residual then shows in the reasons, with its ratio
+    folder = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
+    ratios = []
+    for path in sorted(folder.glob("*.json")):
+        try:
+            result = identify(read_record(path))
+        except IdentificationError:
+            continue
+        found = re.search(r"fit residual \S+ N is ([0-9.]+) times", result.flag_reason)
+        if found:
+            ratios.append((float(found.group(1)), path.name))
+    core.RESIDUAL_FACTOR = factor
+    for ratio, name in sorted(ratios):
+        print(f"{ratio:4.1f}  {name}{'  (flagged)' if ratio > factor else ''}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--off-grid", action="store_true")
     parser.add_argument(
         "--cycles", nargs="*", type=int, default=None, help="numbers of cycles (6 10 24)"
     )
+    parser.add_argument(
+        "--brfd-residuals",
+        action="store_true",
+        help="each BRFD file's damper-model residual over its noise floor (../shared/data/brfd)",
+    )
+    parser.add_argument("--bouc-wen", action="store_true", help="Bouc-Wen loops, no gap")
     args = parser.parse_args()
+    if args.bouc_wen:
+        from test_identify_loopcheck import bouc_wen
+
+        for noise, seed in ((0.0, 0), (0.01, 1), (0.01, 2), (0.01, 3), (0.01, 4)):
+            result = identify(bouc_wen(noise, seed))
+            print(f"noise {noise:.0%} seed {seed}: {result.model}, {result.flag_reason}")
+    if args.brfd_residuals:
+        _brfd_residuals()
     head = " | ".join(name for _, name in KEYS)
     folder = Path(tempfile.mkdtemp())
     if args.off_grid:
