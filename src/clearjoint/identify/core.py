@@ -11,14 +11,15 @@ MODEL.md section 3. The steps:
    with backlash when a displacement-controlled loop's branches end on slip plateaus;
    else a clearance joint (steep, flat, steep stages, found on both branches or lent by
    one to the other, better than a straight line by BIC); else a straight line;
-5. the joint's parameters: without an acceleration channel, or when the cycles were
-   stacked by interpolation (a period that is not a whole number of samples), by the weak
-   form (:mod:`clearjoint.identify.weak`: no derivative of the displacement, test functions
-   that stop at the contact instants), and when the average's displacement noise exceeds
-   ``SAMPLE_FIT_NOISE`` of the amplitude; with an acceleration on a whole-sample stack of
-   a quieter average, or when a contact lasts too few samples for test functions, by
-   robust least squares over the average's samples (the velocity's sign and drag from its
-   spectral derivative); the damper's and the line's by their per-sample fits;
+5. the joint's parameters by the weak form (:mod:`clearjoint.identify.weak`: no
+   derivative of the displacement, test functions that stop at the contact instants)
+   without an acceleration channel, when the cycles were stacked by interpolation (a
+   period that is not a whole number of samples), or when the average's displacement
+   noise exceeds ``SAMPLE_FIT_NOISE`` of the amplitude; else (an acceleration on a
+   whole-sample stack of a quiet average), or when a contact lasts too few samples for
+   test functions, by robust least squares over the average's samples (the velocity's
+   sign and drag from its spectral derivative); the damper's and the line's by their
+   per-sample fits;
 6. a jackknife over the cycles (the average without each of at most eight contiguous
    groups of cycles in turn, all replicates fitted in one batched solve) for every
    standard error; the energy per cycle is each cycle's own loop area (the closed
@@ -464,7 +465,6 @@ def _identify_stack(
     spread: dict[str, float] = {}
     stderr: dict[str, float] = {}
     per_cycle: dict[str, FloatArray] = {}
-    bias: dict[str, float] = {}  # the jackknife's estimate of each fitted value's bias
     own = {
         "amplitude_m": 0.5 * np.ptp(xs, axis=1),
         "energy_per_cycle_j": _loop_areas(xs, fs),
@@ -487,8 +487,6 @@ def _identify_stack(
             pseudo = g * est - (g - 1) * np.array([vv.get(q, math.nan) for vv in loo])
             cyc = pseudo[member]
             finite = np.isfinite(pseudo)
-            if finite.sum() > 1:
-                bias[q] = est - float(np.mean(pseudo[finite]))
             se = (
                 float(np.std(pseudo[finite], ddof=1)) / math.sqrt(g)
                 if finite.sum() > 1
@@ -513,7 +511,7 @@ def _identify_stack(
     )
     if model == "joint" and system is None and not st.exact:
         reason = (
-            f"{rate_note(record, frequency)}: the cycles were stacked by interpolation and a "
+            f"{_rate_note(record, frequency)}: the cycles were stacked by interpolation and a "
             "contact is too short for the weak form, so the fit is sample by sample on a "
             "stack smoothed by about a sample (friction may read low)"
         )
@@ -575,7 +573,7 @@ def _identify_stack(
     )
 
 
-def rate_note(record: Record, frequency: float) -> str:
+def _rate_note(record: Record, frequency: float) -> str:
     """The sampling rate and the samples a period, in words (for a flag's reason)."""
     return (
         f"{record.sampling_rate:g} Hz sampling is {record.sampling_rate / frequency:.2f} "
