@@ -230,6 +230,27 @@ def test_exact_friction_loop_with_backlash() -> None:
     )
 
 
+def test_a_dampers_samples_are_staged_by_force_not_by_position() -> None:
+    """The loop figure colours samples by Identification.stage: on a damper, a sample on a
+    slip plateau is never "free-play", and one at zero force (in the gap) always is, at any
+    displacement (they used to be staged by the gap edges' positions)."""
+    friction = 1e4
+    record = friction_loop(4e-3, friction, 5e6, 20e-3)
+    result = identify(record)
+    assert result.model == "damper"
+    force = result.restoring_force
+    slipping = np.abs(force) > 0.9 * friction
+    assert np.all(result.stage[slipping] == np.sign(force[slipping]))
+    in_gap = (force == 0.0) & (record.time > 1.0)  # after the ramp in
+    assert np.all(result.stage[in_gap] == 0)
+    assert np.ptp(record.displacement[in_gap]) > 4e-3  # free play on both sides of zero
+    assert {name for name, _, _ in result.stage_runs(record.time)} == {
+        "free-play",
+        "compression",
+        "tension",
+    }
+
+
 @pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
 def test_real_brfd_records() -> None:
     results, failures = identify_files([str(p) for p in sorted(BRFD.glob("*.json"))])
@@ -312,11 +333,30 @@ def test_cli_writes_csv_and_netcdf_and_says_why_a_file_was_not_used(
         assert f"{key}_std" in table[0]
     assert len(list((tmp_path / "figures").glob("*.png"))) == 2 * len(files)
     assert main(["identify", *files, "--out", str(out), "--quiet"]) == 2  # no overwrite
+    capsys.readouterr()
+    # figures already there: nothing is written (not even the new table), the message names
+    # the option that chose them
+    other = tmp_path / "f2.csv"
+    figures = ["--figures", str(tmp_path / "figures")]
+    assert main(["identify", *files, "--out", str(other), "--quiet", *figures]) == 2
+    err = capsys.readouterr().err
+    assert "choose another --figures or pass --force" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not other.exists()
     nc = tmp_path / "results.nc"
     assert main(["identify", *files, "--out", str(nc), "--quiet"]) == 0
     with xr.open_dataset(nc, engine="h5netcdf") as data:
         assert data.sizes["file"] == len(files)
         assert "clearance_m_std" in data
+
+
+def test_identify_help_names_every_column_kind(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["identify", "--help"])
+    assert info.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for word in ("_std", "_se", "flag (ok, doubtful, rejected)", "flag_reason"):
+        assert word in text, word
 
 
 def test_cli_refuses_when_nothing_is_usable(
@@ -373,6 +413,42 @@ def test_one_percent_noise_on_every_channel_with_acceleration(
         assert s[key] == pytest.approx(truth[key], rel=0.02), key
     assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10)
     assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+@pytest.mark.parametrize(("frequency", "rate"), [(40.0, 12_010.0), (37.0, 12_000.0)])
+def test_a_period_that_is_not_a_whole_number_of_samples(
+    tmp_path: Path, frequency: float, rate: float
+) -> None:
+    """300.25 and 324.3 samples a period: the cycles are stacked by interpolation; the
+    targets hold as on a whole number (sample-by-sample fits on that stack gave the
+    friction 8-21 % low, flagged ok)."""
+    joint = TrueJoint(frequency_hz=frequency)
+    truth = steady_truth(joint)
+    for seed in (1, 3):
+        path = write_record(joint, tmp_path / f"{seed}.csv", noise=0.01, rate=rate, seed=seed)
+        s = identify(read_record(path)).summary
+        assert s["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01), seed
+        for key in KEYS[1:]:
+            assert s[key] == pytest.approx(truth[key], rel=0.02), (seed, key)
+        assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10), seed
+        assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+def test_an_interpolated_stack_fitted_sample_by_sample_is_doubtful(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path
+) -> None:
+    """100 Hz at 12 010 Hz: a contact too short for the weak form on an interpolated stack
+    (the friction reads 16 % low without an acceleration channel): flagged, with the rate."""
+    joint, _ = independent[100.0]
+    path = write_record(joint, tmp_path / "r.csv", noise=0.01, rate=12_010.0, acceleration=False)
+    flags = identify(read_record(path)).flags
+    assert flags["friction_force_n"][0] == "doubtful"
+    flag, reason = flags["clearance_m"]  # its standard error is small: this is the reason
+    assert flag == "doubtful"
+    assert "120.10 samples a period" in reason
+    assert "interpolation" in reason
+    exact = write_record(joint, tmp_path / "e.csv", noise=0.0, rate=12_000.0)
+    assert "interpolation" not in identify(read_record(exact)).flags["clearance_m"][1]
 
 
 @pytest.mark.parametrize("frequency", [40.0, 100.0])
@@ -553,7 +629,8 @@ def test_batched_replicate_fits_equal_the_fits_one_by_one(
     import clearjoint.identify.core as core
 
     joint, _ = independent[40.0]
-    path = write_record(joint, tmp_path / "noisy.csv", noise=0.01, acceleration=True)
+    # 0.2 % noise: a quiet average, fitted sample by sample (at 1 % the weak form is used)
+    path = write_record(joint, tmp_path / "noisy.csv", noise=0.002, acceleration=True)
     t = np.arange(4000) / 2000.0
     x = 1e-4 * np.sin(2 * np.pi * 10.0 * t)
     v = 2e-3 * np.pi * np.cos(2 * np.pi * 10.0 * t)

@@ -181,8 +181,10 @@ def _identify_parser(sub: Any) -> None:
         help="clearance, stiffness, friction and energy per cycle from test records",
         description=(
             "Identify every record (CSV, netCDF, BRFD JSON; recognised by content): one row "
-            "per file in --out (.csv or .nc) with each quantity's mean over the steady "
-            "cycles and its spread in a _std column; one line for every file not used."
+            "per file in --out (.csv or .nc) with each quantity's value over the steady "
+            "cycles, its spread over the cycles (_std) and its standard error (_se), then "
+            "a credibility flag (ok, doubtful, rejected) and flag_reason; one line for "
+            "every file not used."
         ),
     )
     p.add_argument("files", nargs="+", help="record files")
@@ -739,6 +741,9 @@ def _run_identify(args: argparse.Namespace) -> int:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
     rows = [ident.row() for _, ident in results]
+    if args.figures:  # every output checked before any is written
+        targets = [t for _, ident in results for t in _figure_files(ident, Path(args.figures))]
+        refuse_to_overwrite(targets, force=args.force, option="--figures")
     _write_rows(rows, out)
     if args.figures:
         _identify_figures(results, Path(args.figures), force=args.force)
@@ -777,6 +782,12 @@ def _write_rows(rows: list[dict[str, Any]], out: Path) -> None:
     data.to_netcdf(out, engine="h5netcdf")
 
 
+def _figure_files(ident: Any, folder: Path) -> list[Path]:
+    """The two figures ``clearjoint identify --figures`` writes for one identification."""
+    stem = Path(ident.source).stem
+    return [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
+
+
 def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
     from clearjoint._checks import refuse_to_overwrite
     from clearjoint.figures import displacement_stages_figure, identified_loop_figure
@@ -784,8 +795,8 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     for record, ident in results:
         stem = Path(ident.source).stem
-        targets = [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
-        refuse_to_overwrite(targets, force=force)
+        targets = _figure_files(ident, folder)
+        refuse_to_overwrite(targets, force=force, option="--figures")
         first = ident.cycles[0]
         span = slice(first.start, ident.cycles[-1].stop)
         runs = ident.stage_runs(record.time)
@@ -915,6 +926,7 @@ def _run_report(args: argparse.Namespace) -> int:
         Path(args.out),
         force=args.force,
         progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+        warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
     )
     for path in written:
         print(f"wrote {path}")
