@@ -347,8 +347,11 @@ def diagnose(results: list[tuple[object, object]]) -> None:
 
 def main() -> None:
     args = [a for a in sys.argv[1:] if a != "--diagnose"]
-    folder = Path(args[0]) if args else ROOT.parent.parent / "shared/data/brfd"
-    results, failures = identify_files([str(p) for p in sorted(folder.glob("*.json"))])
+    folder = Path(args[0]) if args else ROOT.parent / "shared" / "data" / "brfd"
+    files = sorted(folder.glob("*.json"))
+    if not files:  # a table of nothing would read as "0 outside 15 %"
+        sys.exit(f"no BRFD records (*.json) in {folder}: pass the folder as the first argument")
+    results, failures = identify_files([str(p) for p in files])
     if "--diagnose" in sys.argv:
         diagnose(results)  # type: ignore[arg-type]
         return

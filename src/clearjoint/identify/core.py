@@ -522,9 +522,10 @@ def _identify_stack(
         b_rise, b_fall = fits[0].backlash_branches
         low, high = min(b_rise, b_fall), max(b_rise, b_fall)
         apart = high > BRANCH_RATIO * low  # False when a reading is missing (NaN)
-        if apart and flags["clearance_m"][0] == "ok":
-            flags["clearance_m"] = (
-                "doubtful",
+        if apart:
+            _doubt(
+                flags,
+                "clearance_m",
                 f"backlash {b_rise * 1e3:.3g} mm on the rising branch and {b_fall * 1e3:.3g} mm "
                 f"on the falling one (more than {BRANCH_RATIO:g} times apart): not one gap "
                 "crossed both ways",
@@ -633,11 +634,18 @@ def _flags(
     if mass_missing:
         reason = f"force control without a mass: m = {mass:.4g} kg estimated from the record"
         for q in fitted:  # the issue's own rule: shown beside any other doubt
-            if flags[q][0] == "ok":
-                flags[q] = ("doubtful", reason)
-            elif flags[q][0] == "doubtful":
-                flags[q] = ("doubtful", f"{flags[q][1]}; {reason}")
+            _doubt(flags, q, reason)
     return flags
+
+
+def _doubt(flags: dict[str, tuple[str, str]], quantity: str, reason: str) -> None:
+    """Flag ``quantity`` doubtful for ``reason``; a doubt already there keeps its reason and
+    gets this one beside it (every doubt is shown); a rejection stays as it is."""
+    flag, was = flags[quantity]
+    if flag == "ok":
+        flags[quantity] = ("doubtful", reason)
+    elif flag == "doubtful":
+        flags[quantity] = ("doubtful", f"{was}; {reason}")
 
 
 def flag_outliers(results: list[Identification]) -> list[Identification]:
