@@ -172,24 +172,27 @@ def frequency_response(
     # a structure's stability comes from the monodromy, not from the evaluation: do not
     # keep one per point (each holds a dense Jacobian: 46 MB at 40 bays, H = 7)
     keep = model.is_joint
+    # a large structure: its Jacobian assembled sparse, and the corrector's bordered solves
+    # and the tangent by sparse LU (continuation hands them to the residual's own corrector
+    # when chord_parameter is set)
+    sparse = not model.is_joint and q0.size > solve.SPARSE_ABOVE
+    sparse_jacobian = solve.SparseJacobian(model, basis) if sparse else None
 
-    def residual(
-        u: FloatArray, lam: float
-    ) -> tuple[FloatArray, FloatArray, FloatArray, aft.Evaluation | None]:
+    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, Any, FloatArray, Any]:
         if not lam > 0.0:
             raise HarmonicError(f"the parameter left the positive range ({lam!r})")
         w, f = at(lam)
-        ev = aft.evaluate(model, basis, u, w, f)
+        ev = aft.evaluate(model, basis, u, w, f, jacobian=sparse_jacobian is None)
         if parameter == "omega":
             d_lam = ev.d_omega
         else:
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
+        if sparse_jacobian is not None:
+            jac = sparse_jacobian(ev, w, model.damping) * (1.0 / k_ref)
+            return ev.residual / k_ref, jac, d_lam / k_ref, None
         return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev if keep else None
 
-    # a large structure: the corrector's bordered solves by sparse LU (continuation hands
-    # them to the residual's own corrector when chord_parameter is set)
-    sparse = not model.is_joint and q0.size > solve.SPARSE_ABOVE
     # one DOF in w: the whole corrector compiled (one call per correction)
     compiled = (
         parameter == "omega"
