@@ -298,7 +298,7 @@ def example_mast(bays: int) -> tuple[Any, np.ndarray]:
 MAST_SIZES = "5:7,10:7,20:7,40:7,10:3,10:15"
 
 
-def mast_sizes(sizes: str, points: int, force_n: float) -> None:
+def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
     """The example mast's cost against bays and H: the frequency response (``points``
     points from 0.8 times the open first mode, the study's force pattern scaled to
     ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes), one line each."""
@@ -310,6 +310,7 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> None:
         f"{MAST_MAX_STEP}; modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
     )
     print(f"  load before: {os.getloadavg()[0]:.2f} (1-min average)")
+    summary: list[str] = []
     for item in sizes.split(","):
         bays, h = (int(v) for v in item.split(":"))
         s, pattern = example_mast(bays)
@@ -337,6 +338,16 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> None:
             f"load {os.getloadavg()[0]:.2f}",
             flush=True,
         )
+        ended = (
+            f"all {points} points asked"
+            if fr.omega.size == points
+            else f"{fr.omega.size} of {points} points: {fr.stop_reason}"
+        )
+        print(f"      curve stop: {fr.stop_reason} ({ended})", flush=True)
+        summary.append(
+            f"{bays:2d} bays, H = {h:2d}: curve {fr.omega.size} points {took:.1f} s "
+            f"({took / fr.omega.size:.3f} s/point; {ended})"
+        )
         amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
         start = time.perf_counter()
         nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
@@ -348,6 +359,8 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> None:
             f"{int(nm.converged.sum())}/50 converged, {span}, load {os.getloadavg()[0]:.2f}",
             flush=True,
         )
+        summary[-1] += f"; mode 50 amplitudes {took:.1f} s ({int(nm.converged.sum())} converged)"
+    return summary
 
 
 def mast_decay(bays: int, beta: float, cycles: int) -> None:
@@ -631,6 +644,68 @@ def samples_error() -> None:
         print(f"  H = {h}: " + ", ".join(row))
 
 
+def pyharm_part(python: str | None) -> float | None:
+    """pyHarm's SDOF clearance case, H = 12: our curve, pyHarm's, and the ratio (or None)."""
+    print(f"pyHarm SDOF clearance case, H = {H}, omega 0.05 to 1.8 rad/s")
+    first, second, curve = ours(H, 512, PYHARM_MAX_STEP)
+    print(
+        f"clearjoint.harmonic (N_t = 512, as pyHarm): {curve.omega.size} points, "  # type: ignore[attr-defined]
+        f"first call {first:.3f} s, best of {REPEATS - 1} more {second:.3f} s"
+    )
+    print(describe("  clearjoint", curve.omega, curve.amplitude))  # type: ignore[attr-defined]
+    for e in curve.events:  # type: ignore[attr-defined]
+        print(f"  {e.kind}: omega = {e.omega:.4f} rad/s, X = {e.amplitude:.4f}")
+    if python:
+        ph = pyharm(python, H)
+        if not ph:
+            print(
+                f"pyHarm did not finish within {PYHARM_TIMEOUT} s "
+                "(it sometimes stalls after the fold)"
+            )
+            return None
+        om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])
+        print(
+            f"pyHarm (nti = 512): {ph['points']} points, first call {ph['first_s']:.3f} s, "
+            f"best of {REPEATS - 1} more {ph['best_s']:.3f} s"
+        )
+        print(describe("  pyHarm", om, amp))
+        # the load of the shared machine drifts: time ours again after pyHarm and compare
+        # with the slower of our two best times (the ratio that favours pyHarm)
+        _, again, _ = ours(H, 512, PYHARM_MAX_STEP)
+        print(f"clearjoint.harmonic again after pyHarm: best of {REPEATS - 1} {again:.3f} s")
+        second = max(second, again)
+        ratio = float(ph["best_s"]) / second  # type: ignore[arg-type]
+        per_point = (float(ph["best_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
+            second / curve.omega.size  # type: ignore[attr-defined]
+        )
+        print(f"ratio pyHarm / clearjoint (whole curve, best warm call): {ratio:.2f}x")
+        print(f"ratio per point: {per_point:.2f}x")
+    else:
+        print("pyHarm not run (give --pyharm PYTHON to compare)")
+        return None
+    return ratio
+
+
+#: The issue's sizes, the 10-bay H = 7 mast first (the issue's mast part), then the growth.
+ISSUE_SIZES = "10:7,5:7,20:7,10:3,10:15,40:7"
+
+
+def issue_run(python: str | None, points: int) -> None:
+    """The issue's speed section in one run: pyHarm's case, then the mast and its growth."""
+    started = time.perf_counter()
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    ratio = pyharm_part(python)
+    print(flush=True)
+    summary = mast_sizes(ISSUE_SIZES, points, MAST_FORCE_N)
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    print("summary (one run):")
+    shown = "not run" if ratio is None else f"{ratio:.2f}x (target 10x)"
+    print(f"  pyHarm's SDOF case, H = {H}, whole curve: pyHarm / clearjoint {shown}")
+    for line in summary:
+        print(f"  mast {line}")
+    print(f"  whole run {time.perf_counter() - started:.0f} s", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
@@ -659,7 +734,16 @@ def main() -> None:
     parser.add_argument("--mast-shoot", type=float, metavar="N", help="exact orbit near HB at N")
     parser.add_argument("--at", default="0.9,1.28", help="Hz list for --mast-orders/--mast-shoot")
     parser.add_argument("--hill-sorting", action="store_true", help="Hill's exponent picks")
+    parser.add_argument(
+        "--issue",
+        action="store_true",
+        help="the issue's speed section in one run: pyHarm's case (with --pyharm), the 10-bay "
+        f"mast (H = 7, --mast-points points, 50 amplitudes) and its growth ({ISSUE_SIZES})",
+    )
     args = parser.parse_args()
+    if args.issue:
+        issue_run(args.pyharm, args.mast_points)
+        return
     if args.hill_sorting:
         hill_sorting()
         return
@@ -689,42 +773,7 @@ def main() -> None:
     if args.mast:
         mast_benchmarks(args.mast_points)
         return
-    print(f"pyHarm SDOF clearance case, H = {H}, omega 0.05 to 1.8 rad/s")
-    first, second, curve = ours(H, 512, PYHARM_MAX_STEP)
-    print(
-        f"clearjoint.harmonic (N_t = 512, as pyHarm): {curve.omega.size} points, "  # type: ignore[attr-defined]
-        f"first call {first:.3f} s, best of {REPEATS - 1} more {second:.3f} s"
-    )
-    print(describe("  clearjoint", curve.omega, curve.amplitude))  # type: ignore[attr-defined]
-    for e in curve.events:  # type: ignore[attr-defined]
-        print(f"  {e.kind}: omega = {e.omega:.4f} rad/s, X = {e.amplitude:.4f}")
-    if args.pyharm:
-        ph = pyharm(args.pyharm, H)
-        if not ph:
-            print(
-                f"pyHarm did not finish within {PYHARM_TIMEOUT} s "
-                "(it sometimes stalls after the fold)"
-            )
-            return
-        om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])
-        print(
-            f"pyHarm (nti = 512): {ph['points']} points, first call {ph['first_s']:.3f} s, "
-            f"best of {REPEATS - 1} more {ph['best_s']:.3f} s"
-        )
-        print(describe("  pyHarm", om, amp))
-        # the load of the shared machine drifts: time ours again after pyHarm and compare
-        # with the slower of our two best times (the ratio that favours pyHarm)
-        _, again, _ = ours(H, 512, PYHARM_MAX_STEP)
-        print(f"clearjoint.harmonic again after pyHarm: best of {REPEATS - 1} {again:.3f} s")
-        second = max(second, again)
-        ratio = float(ph["best_s"]) / second  # type: ignore[arg-type]
-        per_point = (float(ph["best_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
-            second / curve.omega.size  # type: ignore[attr-defined]
-        )
-        print(f"ratio pyHarm / clearjoint (whole curve, best warm call): {ratio:.2f}x")
-        print(f"ratio per point: {per_point:.2f}x")
-    else:
-        print("pyHarm not run (give --pyharm PYTHON to compare)")
+    pyharm_part(args.pyharm)
     print("growth with H (default N_t = 32 (2H + 1) rounded up to a power of two):")
     for h in (3, 7, 12, 15, 31):
         _, warm, c = ours(h, None, PYHARM_MAX_STEP)
