@@ -84,3 +84,33 @@ def test_sparse_and_dense_tangents_follow_the_same_branch(
     size = float(np.abs(dense.coefficients).max())  # type: ignore[arg-type]
     np.testing.assert_allclose(sparse.coefficients, dense.coefficients, rtol=0.0, atol=1e-10 * size)
     assert np.array_equal(sparse.stable, dense.stable)
+
+
+def test_sparse_start_homotopy_is_the_dense_one(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When Newton from the linear guesses fails, the start follows the force up from a
+    level inside the gaps; above SPARSE_ABOVE by the sparse corrector and tangent: the
+    same orbit as the dense continuation, and one that solves HB."""
+    from clearjoint.harmonic import response
+
+    model = from_structure(three_links)
+    basis = aft.Basis.make(5, 128)
+    k_ref = model.reference_stiffness
+    monkeypatch.setattr(response, "newton", lambda *args, **kwargs: None)
+    dense = response._start_plain(model, basis, 400.0, FORCE, k_ref)
+    calls: list[int] = []
+    original = cont._sparse_tangent
+
+    def counted(a: object, previous: np.ndarray) -> np.ndarray:
+        calls.append(1)
+        return original(a, previous)
+
+    monkeypatch.setattr(cont, "_sparse_tangent", counted)
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    sparse = response._start_plain(model, basis, 400.0, FORCE, k_ref)
+    assert calls
+    size = float(np.abs(dense).max())
+    np.testing.assert_allclose(sparse, dense, rtol=0.0, atol=1e-10 * size)
+    ev = aft.evaluate(model, basis, sparse, 400.0, FORCE)
+    assert float(np.abs(ev.residual).max()) < 1e-9 * k_ref * size

@@ -306,10 +306,16 @@ def _start_plain(
     """Solve HB at the start: Newton from the open and the closed linear responses, else a
     continuation in the force from a level where the open linear response fits the gaps."""
     scale = 0.5 * scale_length(model)
+    # a large structure: the Jacobian assembled sparse for Newton and the homotopy below
+    n_u = (2 * basis.harmonics + 1) * model.n_dof
+    sparse = (
+        None if model.is_joint or n_u <= solve.SPARSE_ABOVE else solve.SparseJacobian(model, basis)
+    )
 
-    def function(q: FloatArray) -> tuple[FloatArray, FloatArray]:
-        ev = aft.evaluate(model, basis, q, omega, force)
-        return ev.residual / k_ref, ev.jacobian / k_ref
+    def function(q: FloatArray) -> tuple[FloatArray, Any]:
+        ev = aft.evaluate(model, basis, q, omega, force, jacobian=sparse is None)
+        jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
+        return ev.residual / k_ref, jac / k_ref
 
     for stiffness in (model.open_stiffness(), model.closed_stiffness()):
         guess = linear_guess(model, basis, omega, force, stiffness)
@@ -325,22 +331,28 @@ def _start_plain(
     if reach.size and np.all(np.isfinite(reach)) and np.max(reach) > 0.0 and np.all(room > 0):
         fraction = min(0.5 * float(np.min(room / np.maximum(reach, 1e-300))), 0.5)
 
-        def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
-            ev = aft.evaluate(model, basis, u, omega, lam * force)
+        def residual(u: FloatArray, lam: float) -> tuple[FloatArray, Any, FloatArray, None]:
+            ev = aft.evaluate(model, basis, u, omega, lam * force, jacobian=sparse is None)
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * basis.harmonics + 1, -1)[2] = -force
-            return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, None
+            jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
+            return ev.residual / k_ref, jac / k_ref, d_lam / k_ref, None
 
         try:
             branch = continue_branch(
-                residual,
+                residual if sparse is None else SparseResidual(residual),
                 fraction * open_guess,
                 fraction,
                 1.0,
                 u_scale=np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess))))),
                 lam_scale=1.0,
                 settings=ContinuationSettings(
-                    step=0.01, min_step=1e-7, max_step=0.1, max_points=2000, tolerance=TOLERANCE
+                    step=0.01,
+                    min_step=1e-7,
+                    max_step=0.1,
+                    max_points=2000,
+                    tolerance=TOLERANCE,
+                    chord_parameter=sparse is not None,  # the sparse corrector and tangent
                 ),
             )
         except ClearjointError:

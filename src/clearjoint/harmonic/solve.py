@@ -29,12 +29,14 @@ TOLERANCE = 1e-11
 SPARSE_ABOVE = 400
 
 
-def linear_solve(jacobian: FloatArray, rhs: FloatArray) -> FloatArray:
+def linear_solve(jacobian: Any, rhs: FloatArray) -> FloatArray:
     """Solve jacobian x = rhs: dense LU, or sparse LU above :data:`SPARSE_ABOVE` unknowns.
 
-    A singular matrix falls back to least squares (dense) in both cases.
+    ``jacobian`` is a dense array or a scipy sparse matrix (:class:`SparseJacobian`),
+    which is always factored sparse. A singular matrix falls back to least squares
+    (dense) in both cases.
     """
-    if jacobian.shape[0] > SPARSE_ABOVE:
+    if not isinstance(jacobian, np.ndarray) or jacobian.shape[0] > SPARSE_ABOVE:
         import scipy.sparse
         import scipy.sparse.linalg
 
@@ -50,7 +52,8 @@ def linear_solve(jacobian: FloatArray, rhs: FloatArray) -> FloatArray:
             return np.asarray(np.linalg.solve(jacobian, rhs), dtype=np.float64)
         except np.linalg.LinAlgError:
             pass
-    return np.asarray(np.linalg.lstsq(jacobian, rhs, rcond=None)[0], dtype=np.float64)
+    dense = jacobian if isinstance(jacobian, np.ndarray) else jacobian.toarray()
+    return np.asarray(np.linalg.lstsq(dense, rhs, rcond=None)[0], dtype=np.float64)
 
 
 class SparseJacobian:
@@ -161,7 +164,7 @@ def linear_guess(
 
 
 def newton(
-    function: Callable[[FloatArray], tuple[FloatArray, FloatArray]],
+    function: Callable[[FloatArray], tuple[FloatArray, Any]],
     q0: FloatArray,
     scale: float,
     *,
@@ -169,6 +172,8 @@ def newton(
     residual: Callable[[FloatArray], FloatArray] | None = None,
 ) -> tuple[FloatArray, int] | None:
     """Damped Newton on a dimensionless residual: ``function(q) -> (R, dR/dq)``.
+
+    dR/dq dense or scipy sparse (:func:`linear_solve`).
 
     Steps are halved (up to 12 times) until max abs(R) falls; ``scale`` (m) makes q
     dimensionless in the convergence test. ``residual(q) -> R``, if given, is used
