@@ -346,6 +346,8 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
             if fr.omega.size == points
             else f"{fr.omega.size} of {points} points: {fr.stop_reason}"
         )
+        if points < asked:
+            ended += f", capped from {asked}"
         print(f"      curve stop: {fr.stop_reason} ({ended})", flush=True)
         summary.append(
             f"{bays:2d} bays, H = {h:2d}: curve {fr.omega.size} points {took:.1f} s "
