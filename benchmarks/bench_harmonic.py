@@ -719,6 +719,63 @@ def issue_run(python: str | None, points: int) -> None:
     print(f"  whole run {time.perf_counter() - started:.0f} s", flush=True)
 
 
+def one_curve(bays: int, points: int) -> None:
+    """Time one mast curve (as --mast-sizes) after a 2-point warm-up; print it as JSON."""
+    import clearjoint
+
+    s, pattern = example_mast(bays)
+    force = pattern * (MAST_FORCE_N / float(np.max(np.abs(pattern))))
+    f_open = float(s.modes("open").omega[0])
+    f_closed = float(s.modes("closed").omega[0])
+    options: dict[str, Any] = {"harmonics": 7, "max_step": MAST_MAX_STEP}
+    frequency_response(s, force, 0.8 * f_open, 1.2 * f_closed, max_points=2, **options)
+    wall, cpu = time.perf_counter(), time.process_time()
+    fr = frequency_response(s, force, 0.8 * f_open, 1.2 * f_closed, max_points=points, **options)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    print(
+        json.dumps(
+            {
+                "src": str(Path(clearjoint.__file__).parents[1]),
+                "points": int(fr.omega.size),
+                "wall": wall,
+                "cpu": cpu,
+                "unstable": int(np.sum(~fr.stable)),
+                "omega": fr.omega.tolist(),
+            }
+        )
+    )
+
+
+def old_against_new(old_src: str, bays: int, points: int) -> None:
+    """The same mast curve timed with another clearjoint src tree and this one, in turn."""
+    runs = {}
+    for src in (old_src, str(Path(__file__).resolve().parents[1] / "src")):
+        env = dict(os.environ, PYTHONPATH=src)
+        done = subprocess.run(
+            [sys.executable, __file__, "--one-curve", f"{bays}:{points}"],
+            capture_output=True,
+            text=True,
+            check=True,
+            env=env,
+        )
+        runs[src] = json.loads(done.stdout.strip().splitlines()[-1])
+        r = runs[src]
+        print(
+            f"  {r['src']}: {r['points']} points, {r['wall']:.1f} s wall, {r['cpu']:.1f} s CPU, "
+            f"{r['unstable']} unstable",
+            flush=True,
+        )
+    old, new = runs.values()
+    same = min(len(old["omega"]), len(new["omega"]))
+    gap = np.abs(np.array(old["omega"][:same]) - np.array(new["omega"][:same]))
+    first = int(np.argmax(gap > 1e-9 * np.array(old["omega"][:same])))
+    print(
+        f"{bays} bays, H = 7, {points} points: old / this tree {old['wall'] / new['wall']:.2f}x "
+        f"wall, {old['cpu'] / new['cpu']:.2f}x CPU; the points agree in w to 1e-9 up to "
+        f"point {first if gap.max() > 0 else same}"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
@@ -753,7 +810,19 @@ def main() -> None:
         help="the issue's speed section in one run: pyHarm's case (with --pyharm), the 10-bay "
         f"mast (H = 7, --mast-points points, 50 amplitudes) and its growth ({ISSUE_SIZES})",
     )
+    parser.add_argument(
+        "--old-src",
+        help="time the 10-bay mast's curve (--mast-points) with another clearjoint src tree "
+        "(e.g. main's: git archive main src | tar -x -C OLD) and with this one, in turn",
+    )
+    parser.add_argument("--one-curve", help=argparse.SUPPRESS)  # BAYS:POINTS, for --old-src
     args = parser.parse_args()
+    if args.one_curve:
+        one_curve(*(int(v) for v in args.one_curve.split(":")))
+        return
+    if args.old_src:
+        old_against_new(args.old_src, 10, args.mast_points)
+        return
     if args.issue:
         issue_run(args.pyharm, args.mast_points)
         return
