@@ -15,6 +15,15 @@ are shared and threaded BLAS on 25 x 25 matrices only adds waiting.
 
 It also prints the peak, both folds, and how the time grows with H.
 
+    python benchmarks/bench_harmonic.py --issue --pyharm /work/venv-pyharm/bin/python
+
+runs the issue's whole speed section in one run (docs/harmonic.md, "Speed"): pyHarm's
+case and its ratio, then the example mast's 300-point curve and 50-amplitude first mode
+at 10 bays, H = 7, and the same for 5, 20, 40 bays (H = 7) and H = 3, 15 (10 bays), each
+curve's stop reason said; the 40-bay curve is capped at 20 points (ISSUE_SIZES), with
+the time 300 would take. ``--old-src OLD/src`` times the 10-bay curve with another src
+tree and this one in turn (a before/after ratio in one run).
+
     python benchmarks/bench_harmonic.py --mast [--mast-points 300]
 
 times the planar mast (clearjoint.structure.mast, hinge joints ClearanceJoint(1e-4, 1e8,
