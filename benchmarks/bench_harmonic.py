@@ -426,7 +426,7 @@ def mast_decay(bays: int, beta: float, cycles: int) -> None:
             print(f"  {k:5d}  {1e3 * a[k]:14.4f}  {bb.omega[k] / (2 * math.pi):10.4f}  (outside)")
             continue
         w_e = float(np.interp(a[k], peak, nm.frequency[ok]))
-        z_e = float(np.interp(a[k], peak, nm.damping_ratio[ok]))
+        z_e = float(np.interp(a[k], peak, nm.epmc_damping_ratio[ok]))
         print(
             f"  {k:5d}  {1e3 * a[k]:14.4f}  {bb.omega[k] / (2 * math.pi):10.4f}  "
             f"{w_e / (2 * math.pi):9.4f}  {bb.omega[k] / w_e - 1:+9.2e}  "

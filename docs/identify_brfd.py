@@ -16,20 +16,26 @@ steps longer than two elastic steps, :func:`previous_backlash`), on the same cyc
 backlash read on each branch and the level of the step (what the damper estimator fits,
 :mod:`clearjoint.identify.damper`), then the medians and the misses under other choices:
 the number of crossings N (a resolution), and the variant tried and not adopted (the slope
-fitted with the step by least absolute deviations, not read from the median step); last, the
-CPU time of the damper estimator per cycle average.
+fitted with the step by least absolute deviations, not read from the median step); then, per
+file, the evidence on why two branches of one loop can read different gaps (:func:`evidence`:
+the four explanations examined in docs/identify.md, each with its number); last, the CPU time
+of the damper estimator per cycle average.
 """
 
 from __future__ import annotations
 
+import json
 import re
 import sys
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from clearjoint.identify import damper, identify_files
+from clearjoint.identify.cycles import cycle_bounds, excitation_frequency, stack, steady
+from clearjoint.records import read_record
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -107,6 +113,196 @@ def _misses(b: dict[str, float], tension: dict[str, int]) -> str:
     )
 
 
+#: Newtons per pound-force (the BRFD's actuator forces are in lb).
+LBF = 4.4482216152605
+
+
+def _cycles(path: Path) -> dict[str, np.ndarray] | None:
+    """Each steady cycle's displacement, friction force and the two actuator forces
+    ("x", "f", "act1", "act2"; N, (n, M)), stacked as :func:`clearjoint.identify.identify`
+    stacks them (from the minimum of the average), and "step" (the time step, s); None when
+    the record has too few steady cycles. The actuator forces are read from the JSON here:
+    the identification does not use them."""
+    record = read_record(path)
+    frequency = excitation_frequency(record)
+    bounds = cycle_bounds(record, frequency)
+    kept = steady(record.displacement, bounds, 0.03)
+    if len(kept) < 3:
+        return None
+    st = stack(record, frequency, bounds, kept, {"x": record.displacement})
+    shift = int(np.argmin(st.channels["x"].mean(axis=0)))
+    if shift > st.samples // 2 and bounds[kept[0]][0] - (st.samples - shift) >= 0:
+        shift -= st.samples
+    content = json.loads(path.read_bytes())
+    assert content.get("actuator force units", "lb") == "lb"
+    data = np.asarray(content["data"], dtype=np.float64)
+    channels = {
+        "x": record.displacement,
+        "f": record.force,
+        "act1": data[:, 4] * LBF,
+        "act2": data[:, 5] * LBF,
+    }
+    st = stack(record, frequency, bounds, kept, channels, shift)
+    return {**st.channels, "step": np.array(st.step)}
+
+
+class _Branch(NamedTuple):
+    """One branch of a loop as the damper estimator reads it."""
+
+    travel: np.ndarray  # travel from the reversal, m
+    f: np.ndarray  # force, N
+    s: np.ndarray  # the crossings, m
+    c: float  # the lower line's intercept, m
+    d: float  # the lines' slope, m per unit alpha
+    b: float  # the backlash, m
+    j: int  # the step lies between crossings j - 1 and j
+    start: float  # the level before (N)
+    stop: float  # the level after (N)
+
+    @property
+    def alpha_b(self) -> float:
+        return float(0.5 * (damper.ALPHAS[self.j - 1] + damper.ALPHAS[self.j]))
+
+    @property
+    def level(self) -> float:
+        """The backlash level, N."""
+        return self.start + self.alpha_b * (self.stop - self.start)
+
+
+def _branches(x: np.ndarray, f: np.ndarray) -> tuple[_Branch, _Branch]:
+    """The rising and the falling branch of a cycle (average) x, f (M,)."""
+    parts, rise, fall = _levels(x, f)
+    out = []
+    for part, start, stop in ((parts[0], fall, rise), (parts[1], rise, fall)):
+        travel, fb = np.abs(x[part] - x[part][0]), f[part]
+        s = damper._crossings(travel, fb, start, stop)
+        assert s is not None
+        out.append(_Branch(travel, fb, s, *damper._step_fit(s), start, stop))
+    return out[0], out[1]
+
+
+def _own_slopes(branch: _Branch) -> tuple[float, float]:
+    """The backlash with each line's own slope (the median step on its side of the step
+    place), read as the distance between the lines at the step's level, and the loading
+    line's stiffness over the unloading line's."""
+    a, n = damper.ALPHAS, damper.N_CROSSINGS
+    lines, steps = [], []
+    for part in (slice(0, branch.j), slice(branch.j, n)):
+        d = float(np.median(np.diff(branch.s[part]))) * n
+        c = float(np.median(branch.s[part] - d * a[part]))
+        lines.append(c + d * branch.alpha_b)
+        steps.append(d)
+    return lines[1] - lines[0], steps[0] / steps[1]
+
+
+def _left_early(branch: _Branch, other: float) -> float:
+    """The part of the way from the backlash level (alpha_b) to the new slip level that the
+    force covers within the first half of the gap, taking the gap as long as ``other`` (the
+    other branch's reading) from the end of the unloading: 0 for a flat backlash level, 1
+    when the force reaches the new level there."""
+    gap_start = max(branch.c + branch.d * branch.alpha_b, 0.0)
+    window = (branch.travel >= gap_start) & (branch.travel <= gap_start + 0.5 * other)
+    delta = branch.stop - branch.start
+    progress = np.sign(delta) * (branch.f[window] - branch.start) / abs(delta)
+    return float((progress.max() - branch.alpha_b) / (1.0 - branch.alpha_b))
+
+
+def _delays(x: np.ndarray, f: np.ndarray, step: float) -> tuple[str, str]:
+    """The two branches' readings with the force delayed by -16 and +16 ms (whole samples,
+    circular on the cycle average), and the delays within +-40 ms at which the two readings
+    cross (ms; "none")."""
+    ks = np.arange(-round(0.04 / step), round(0.04 / step) + 1)
+    diff, at = [], {}
+    for k in ks:
+        rising, falling = _branches(x, np.roll(f, k))
+        diff.append(rising.b - falling.b)
+        at[int(k)] = f"{1e3 * rising.b:.1f}/{1e3 * falling.b:.1f}"
+    change = np.nonzero(np.diff(np.sign(diff)) != 0)[0]
+    k16 = round(0.016 / step)
+    return (
+        f"{at[-k16]} {at[k16]}",
+        ",".join(f"{1e3 * ks[i] * step:.0f}" for i in change) or "none",
+    )
+
+
+def _actuator_gap(branch: _Branch, load: np.ndarray) -> float:
+    """Travel from the end of the friction force's unloading (this branch's gap start) to
+    where the actuator force that loads on this branch (``load``, (M,) over the branch) is
+    first halfway from its level over the first millimetre of the gap to its level over the
+    branch's last 40 % (its slip level): the contact as that channel sees it, m."""
+    gap_start = max(branch.c + branch.d * branch.alpha_b, 0.0)
+    travel = branch.travel
+    base = float(np.median(load[(travel >= gap_start) & (travel <= gap_start + 1e-3)]))
+    plateau = float(np.median(load[travel >= (1.0 - damper.PLATEAU) * travel[-1]]))
+    past = np.nonzero(
+        (travel > gap_start)
+        & (np.sign(plateau - base) * (load - base) >= 0.5 * abs(plateau - base))
+    )[0]
+    return float(travel[past[0]] - gap_start) if past.size else float("nan")
+
+
+def evidence(folder: Path) -> None:
+    """Print, per accepted file, the numbers behind docs/identify.md's account of why two
+    branches of one loop read different gaps, one explanation a field: the per-cycle
+    readings and cycle means (cycles not steady?), each line's own slope (a softer
+    loading?), a delay of the force (a lag between the channels?), the backlash level and
+    how far the force leaves it early (the force in the gap?), and where the actuator force
+    sees the contact. Then the crossings of every branch that reads less than half the
+    other (the rule of the "not one gap" flag)."""
+    print(
+        "\nwhy branches differ, rising / falling branch: per-cycle b (mm) | cycle mean x (mm)"
+        " | own slopes: b (mm), k after / k before the gap | force delayed -16 ms, +16 ms: b"
+        " (mm); delays (ms) at which the branches read the same | backlash level (kN) | left"
+        " early | actuator load's mid-rise after the unloading (mm)"
+    )
+    early: dict[str, float] = {}
+    short: list[tuple[str, _Branch]] = []
+    for path in sorted(folder.glob("*.json")):
+        cycles = _cycles(path)
+        if cycles is None:
+            continue
+        xs, fs, step = cycles["x"], cycles["f"], float(cycles["step"])
+        per = [_branches(xx, ff) for xx, ff in zip(xs, fs, strict=True)]
+        x, f = xs.mean(axis=0), fs.mean(axis=0)
+        rising, falling = _branches(x, f)
+        parts = _parts(x)
+        # actuator 2 loads on the rising branch, actuator 1 on the falling one
+        act = (
+            _actuator_gap(rising, cycles["act2"].mean(axis=0)[parts[0]]),
+            _actuator_gap(falling, cycles["act1"].mean(axis=0)[parts[1]]),
+        )
+        left = (_left_early(rising, falling.b), _left_early(falling, rising.b))
+        early[path.stem] = max(left)
+        own = (_own_slopes(rising), _own_slopes(falling))
+        shifted, equal = _delays(x, f, step)
+        for name, mine, other in (("rising", rising, falling), ("falling", falling, rising)):
+            if other.b > damper.BRANCH_RATIO * mine.b:
+                short.append((f"{path.stem} {name}", mine))
+        cycle_b = " ".join(f"{1e3 * p[0].b:.1f}" for p in per) + " / "
+        cycle_b += " ".join(f"{1e3 * p[1].b:.1f}" for p in per)
+        print(
+            f"  {path.stem}: {cycle_b} | "
+            + " ".join(f"{1e3 * float(np.mean(xx)):.2f}" for xx in xs)
+            + f" | {1e3 * own[0][0]:.2f} / {1e3 * own[1][0]:.2f}, "
+            f"{own[0][1]:.2f} / {own[1][1]:.2f} | {shifted}; {equal}"
+            f" | {rising.level / 1e3:+.2f} / {falling.level / 1e3:+.2f}"
+            f" | {left[0]:.2f} / {left[1]:.2f} | {1e3 * act[0]:.2f} / {1e3 * act[1]:.2f}"
+        )
+    ranked = sorted(early.items(), key=lambda kv: -kv[1])
+    top = ", ".join(f"{k} {v:.2f}" for k, v in ranked[:4])
+    print(f"largest 'left early' (either branch): {top}")
+    for name, branch in short:
+        gap_start = max(branch.c + branch.d * branch.alpha_b, 0.0)
+        print(
+            f"{name} branch, the gap from {1e3 * gap_start:.2f} mm, crossings from alpha_b "
+            "(alpha: travel mm): "
+            + " ".join(
+                f"{a:.2f}: {1e3 * t:.2f}"
+                for a, t in zip(damper.ALPHAS[branch.j :], branch.s[branch.j :], strict=True)
+            )
+        )
+
+
 def diagnose(results: list[tuple[object, object]]) -> None:
     loops = {Path(i.source).stem: i.loop for _, i in results}  # type: ignore[attr-defined]
     tension = {k: int(re.search(r"(\d+)lbtension", k)[1]) for k in loops}  # type: ignore[index]
@@ -138,6 +334,7 @@ def diagnose(results: list[tuple[object, object]]) -> None:
     _set_resolution(48)
     fitted = {k: _fitted_slope_backlash(*loop) for k, loop in loops.items()}
     print(f"variant, slope fitted too (N = 48): {_misses(fitted, tension)}")
+    evidence(Path(next(iter(results))[1].source).parent)  # type: ignore[attr-defined]
     # the estimator's cost: one call per cycle average (each file: the model choice and
     # one per jackknife replicate)
     start = time.process_time()
@@ -150,8 +347,11 @@ def diagnose(results: list[tuple[object, object]]) -> None:
 
 def main() -> None:
     args = [a for a in sys.argv[1:] if a != "--diagnose"]
-    folder = Path(args[0]) if args else ROOT.parent.parent / "shared/data/brfd"
-    results, failures = identify_files([str(p) for p in sorted(folder.glob("*.json"))])
+    folder = Path(args[0]) if args else ROOT.parent / "shared" / "data" / "brfd"
+    files = sorted(folder.glob("*.json"))
+    if not files:  # a table of nothing would read as "0 outside 15 %"
+        sys.exit(f"no BRFD records (*.json) in {folder}: pass the folder as the first argument")
+    results, failures = identify_files([str(p) for p in files])
     if "--diagnose" in sys.argv:
         diagnose(results)  # type: ignore[arg-type]
         return

@@ -71,17 +71,17 @@ def backbone_table() -> None:
     nm = nonlinear_modes(PAPER, 1, amplitudes, harmonics=15, damping_ratio=zeta)
     a = nm.x_max - PAPER.compression_gap
     e = dissipation.viscous(PAPER, a, zeta)
-    loss = e / (4 * math.pi * PAPER.potential_energy(nm.x_max))
+    exact = dissipation.energies(PAPER, a, damping_ratio=zeta).loss_factor / 2
     print(
-        "\n| A (um) | zeta EPMC | E_diss / (4 pi E_max) | E per cycle EPMC / dissipation.viscous |"
+        "\n| A (um) | damping_ratio | E_diss / (4 pi E_max), dissipation | epmc_damping_ratio "
+        "| E per cycle / dissipation.viscous |"
     )
-    print("|---|---|---|---|")
+    print("|---|---|---|---|---|")
     for i in range(a.size):
         print(
-            f"| {a[i] * 1e6:.4g} | {nm.damping_ratio[i]:.4f} | {loss[i]:.4f} | "
-            f"{nm.energy_per_cycle[i] / e[i]:.5f} |"
+            f"| {a[i] * 1e6:.4g} | {nm.damping_ratio[i]:.5f} | {exact[i]:.5f} | "
+            f"{nm.epmc_damping_ratio[i]:.5f} | {nm.energy_per_cycle[i] / e[i]:.5f} |"
         )
-
 
 if __name__ == "__main__":
     convergence_table()

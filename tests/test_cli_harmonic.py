@@ -49,16 +49,26 @@ def test_modes_json_netcdf_and_plot(tmp_path: Path, capsys: pytest.CaptureFixtur
     code, text, err = run([*args, "--out", str(out), "--plot", str(png), "--json"], capsys)
     assert code == 0, err
     data = json.loads(text)
-    assert set(data) == {"amplitude_m", "frequency_hz", "damping_ratio", "energy_per_cycle_j"}
+    assert set(data) == {
+        "amplitude_m",
+        "frequency_hz",
+        "damping_ratio",
+        "energy_per_cycle_j",
+        "epmc_damping_ratio",
+    }
     assert data["amplitude_m"][0] == pytest.approx(0.3e-3)
     assert data["amplitude_m"][-1] == pytest.approx(3e-3)
     # free-play 200 Hz, contact 400 Hz: the mode lies between and rises with amplitude
     assert all(200.0 < f < 400.0 for f in data["frequency_hz"])
     assert data["frequency_hz"] == sorted(data["frequency_hz"])
-    # c_v fixed: zeta = c_v / (2 m w) falls as w rises
+    # c_v fixed: EPMC's zeta = c_v / (2 m w) falls as w rises (one mass: xi = c_v / m);
+    # the energy ratio E_diss / (4 pi E_max) lies above it, the motion not a sinusoid
     c_v = 2 * 0.014434 * math.sqrt(4.7374e6)
-    for f, z in zip(data["frequency_hz"], data["damping_ratio"], strict=True):
+    for f, z, z_e in zip(
+        data["frequency_hz"], data["epmc_damping_ratio"], data["damping_ratio"], strict=True
+    ):
         assert z == pytest.approx(c_v / (2 * 2 * math.pi * f), rel=1e-6)
+        assert z_e > z
     assert png.stat().st_size > 0
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert ds["frequency"].attrs["units"] == "Hz"
@@ -75,6 +85,13 @@ def test_modes_json_netcdf_and_plot(tmp_path: Path, capsys: pytest.CaptureFixtur
         (["modes", "--amplitude", "1um..1mm", "--mode", "2"], "a Joint has only mode 1"),
         (["modes", "--amplitude", "1um..1mm", "--harmonics", "0"], "harmonics must be"),
         (["modes", "--amplitude", "1kg..1mm"], "--amplitude"),
+        (["modes", "--amplitude", "1mm..10um"], "runs downwards; write it from the smaller"),
+        (["modes", "--amplitude", "1um..1mm", "--samples", "29"], "at least 2 (2H + 1) = 30"),
+        (
+            ["frf", "--from", "10Hz", "--to", "20Hz", "--method", "harmonic", "--samples", "8"],
+            "--samples 8 is too few for --harmonics 7",
+        ),
+        (["frf", "--from", "10Hz", "--to", "20Hz", "--samples", "64"], "--method harmonic"),
         (["frf", "--from", "10Hz", "--to", "20Hz", "--harmonics", "5"], "--method harmonic"),
         (
             ["frf", "--from", "10Hz", "--to", "20Hz", "--method", "harmonic", "--harmonics", "0"],
@@ -144,6 +161,7 @@ def test_frf_of_a_structure_study(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert max(data["x_max_m"][0]) > 1e-4  # the joints open and close: nonlinear here
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert ds["x_max"].dims == ("point", "dof")
+        assert list(ds["dof"].values) == ["n1x", "n2x", "n3x"]  # the DOF names, as in --json
         assert ds.attrs["method"] == "harmonic"
     # the default method (exact shooting of one joint) cannot do a structure: one line
     code, _, err = run([*args[:-2], "--out", str(tmp_path / "y.nc")], capsys)
@@ -156,15 +174,26 @@ def test_frf_of_a_structure_study(tmp_path: Path, capsys: pytest.CaptureFixture[
 def test_modes_of_a_structure_study(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Mode 1 of the chain lies between its all-open (21.36 Hz) and all-closed (67.56 Hz)
     linear modes (MODEL.md 5.2) and stiffens with amplitude."""
+    import xarray as xr
+
     study, out, png = _chain_study(tmp_path), tmp_path / "m.nc", tmp_path / "m.png"
     args = ["modes", str(study), "--amplitude", "0.2mm..20mm", "--points", "4", "--harmonics", "5"]
     code, text, err = run([*args, "--out", str(out), "--plot", str(png), "--json"], capsys)
     assert code == 0, err
     data = json.loads(text)
-    assert set(data) == {"amplitude_m", "frequency_hz", "damping_ratio", "energy_per_cycle_j"}
+    assert set(data) == {
+        "amplitude_m",
+        "frequency_hz",
+        "damping_ratio",
+        "energy_per_cycle_j",
+        "epmc_damping_ratio",
+    }
     assert all(21.36 < f < 67.57 for f in data["frequency_hz"])
     assert data["frequency_hz"] == sorted(data["frequency_hz"])
     assert png.stat().st_size > 0
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds["x_max"].dims == ("amplitude", "dof")
+        assert list(ds["dof"].values) == ["n1x", "n2x", "n3x"]
     code, _, err = run([*args, "--mode", "4", "--out", str(tmp_path / "n.nc")], capsys)
     assert code == 2
     assert "modes 1 to 3" in err
@@ -234,3 +263,66 @@ def test_frf_warns_where_the_orbit_is_not_the_exact_motion(
     assert "untrusted:" in text
     (line,) = err.strip().splitlines()
     assert "not to be trusted; raise --harmonics" in line
+
+
+def test_samples_reach_harmonic_balance(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--samples is the API's samples: the same numbers as a direct call with it, and not
+    those of the default (the AFT grid changes the aliasing, so the result moves a little)."""
+    import numpy as np
+
+    from clearjoint.harmonic import frequency_response, nonlinear_modes
+    from clearjoint.simulate.study import load_study
+
+    study = load_study(EXAMPLE)
+    joint = study.joint
+    amplitudes = ["--amplitude", "0.3mm..3mm", "--points", "3", "--harmonics", "5"]
+    out = ["--out", str(tmp_path / "m.nc"), "--json"]
+    code, text, err = run(["modes", str(EXAMPLE), *amplitudes, "--samples", "22", *out], capsys)
+    assert code == 0, err
+    got = json.loads(text)["frequency_hz"]
+    kwargs = {"harmonics": 5, "damping_ratio": study.damping_ratio}
+    a = np.geomspace(0.3e-3, 3e-3, 3)
+    with_22 = nonlinear_modes(joint, 1, a, samples=22, **kwargs).frequency / (2 * math.pi)
+    default = nonlinear_modes(joint, 1, a, **kwargs).frequency / (2 * math.pi)
+    np.testing.assert_allclose(got, with_22, rtol=1e-12)
+    assert np.max(np.abs(with_22 / default - 1.0)) > 1e-6
+    chain_study = _chain_study(tmp_path)
+    args = ["frf", str(chain_study), "--from", "50Hz", "--to", "52Hz", "--method", "harmonic"]
+    code, text, err = run(
+        [*args, "--harmonics", "3", "--samples", "14", "--out", str(tmp_path / "f.nc"), "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import chain
+
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    s = chain([1.0] * 3, [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+    direct = frequency_response(
+        s, [0.0, 0.0, 40.0], 2 * math.pi * 50, 2 * math.pi * 52, harmonics=3, samples=14
+    )
+    np.testing.assert_allclose(json.loads(text)["x_max_m"], direct.x_max, rtol=1e-9, atol=1e-15)
+
+
+def test_frf_without_an_orbit_at_the_start_says_so_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The example mast at 20 N, H = 15 in small: the start's force continuation (which the
+    chain needs at 800 rad/s) held to 10 points, so it gives up; progress lines, then one
+    error line saying what to do, exit 2 (the mast itself: 67 s, docs/harmonic.md)."""
+    from clearjoint.harmonic import response
+
+    monkeypatch.setattr(response, "START_POINTS", (10, 10))
+    study, out = _chain_study(tmp_path), tmp_path / "frf.nc"
+    start = f"{800 / (2 * math.pi)}Hz"
+    args = ["frf", str(study), "--from", start, "--to", "130Hz", "--method", "harmonic"]
+    code, _, err = run([*args, "--out", str(out)], capsys)
+    assert code == 2
+    *progress, last = err.strip().splitlines()
+    assert progress
+    assert progress[0].startswith("clearjoint frf: start at 127.324 Hz: Newton from the linear")
+    assert last.startswith(f"clearjoint frf: error: {study}: no harmonic-balance orbit at 127.324")
+    assert "lower [excitation] force_amplitude" in last
+    assert f"clearjoint structure {study} respond" in last
+    assert "Traceback" not in err
+    assert not out.exists()

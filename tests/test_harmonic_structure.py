@@ -76,6 +76,7 @@ def test_first_nonlinear_mode_lies_between_the_linear_bounds(three_links: Struct
     assert nm.converged.all()
     assert nm.x_max.shape == (6, 3)
     assert nm.reference_dof == three_links.dof_names[2]
+    assert list(nm.to_xarray()["dof"].values) == list(three_links.dof_names)
     w_open = three_links.modes("open").omega[0]
     w_closed = three_links.modes("closed").omega[0]
     assert np.all(nm.frequency > w_open)
@@ -83,6 +84,24 @@ def test_first_nonlinear_mode_lies_between_the_linear_bounds(three_links: Struct
     assert np.all(np.diff(nm.frequency) > 0.0)  # the joints stiffen with amplitude
     assert nm.frequency[-1] == pytest.approx(w_closed, rel=0.02)
     assert np.all(nm.damping_ratio > 0.0)
+
+
+def test_damping_ratio_tends_to_the_closed_linear_modal_ratio(three_links: Structure) -> None:
+    """Far above the clearance the mode is the closed linear one, so both damping ratios
+    (E_diss / (4 pi E_max) and EPMC's xi / (2 w)) tend to phi^T C phi / (2 w phi^T M phi),
+    the gap falling like c / a (measured: 2.9e-2, 8.8e-3, 2.7e-3, 8.6e-4 for the energy
+    ratio at a = 63, 200, 632, 2000 clearances)."""
+    closed = three_links.modes("closed")
+    phi, w = closed.shapes[:, 0], float(closed.omega[0])
+    c, m = three_links.damping_matrix(), np.diag(three_links.mass_diagonal())
+    modal = float(phi @ c @ phi / (2.0 * w * phi @ m @ phi))
+    nm = nonlinear_modes(three_links, 1, 1e-4 * np.geomspace(63.25, 2000.0, 4), harmonics=7)
+    assert nm.converged.all()
+    gap = nm.damping_ratio / modal - 1.0
+    assert np.all(gap > 0.0)
+    assert gap[-1] < 1.5e-3
+    assert np.all(gap[1:] < gap[:-1] / 2.5)  # about 1 / a: 3.16-fold per step
+    np.testing.assert_allclose(nm.epmc_damping_ratio[-1], modal, rtol=1e-3)
 
 
 def test_bad_structure_input(three_links: Structure) -> None:
@@ -103,7 +122,15 @@ def test_first_nonlinear_mode_is_the_free_decay_backbone() -> None:
     give amplitude, frequency and damping ratio. They agree with the EPMC curve at the
     same peak amplitude (half peak-to-peak of the reference DOF) within 1e-3 in
     frequency (measured 2e-4 at the start to 6e-4 at the end, always above) and 20 % in
-    damping ratio. They differ because the decay is no periodic orbit: its amplitude
+    EPMC's damping ratio xi / (2 w) (per cycle the decay's ratio scatters +-8 %).
+
+    Which damping ratio a decay measures: along a slowly decaying backbone the energy
+    E(a) falls by E_diss a cycle, so zeta_decay = -(1/w) d ln a / dt =
+    E_diss / (2 pi s E_max) = damping_ratio * 2 / s, s = d ln E_max / d ln a (2 for a
+    linear mode; 2.12 to 2.19 here, the joints stiffening). Measured, the mean over the
+    cycles of zeta_decay over that prediction is 1.013 (over damping_ratio 0.943, over
+    xi / (2 w) 0.978: for V ~ |x|^n, EPMC's ratio is (n + 2) / 4 times the decay's).
+    They differ because the decay is no periodic orbit: its amplitude
     falls within each cycle (about 1 % per cycle here) while the backbone steepens, and
     its peaks measure a cycle of a shrinking motion; EPMC makes the motion periodic with
     an artificial mass-proportional negative damping -xi M u', which slightly changes
@@ -127,9 +154,16 @@ def test_first_nonlinear_mode_is_the_free_decay_backbone() -> None:
     assert np.all(np.diff(peak) > 0.0)
     w_epmc = np.interp(a, peak, nm.frequency)
     np.testing.assert_array_less(np.abs(w / w_epmc - 1.0), 1e-3)
-    z_epmc = np.interp(a, peak, nm.damping_ratio)
+    z_epmc = np.interp(a, peak, nm.epmc_damping_ratio)
     ok = np.isfinite(zeta)
     np.testing.assert_allclose(zeta[ok], z_epmc[ok], rtol=0.2)
+    # the energy balance of the decay: zeta_decay = damping_ratio * 2 / s
+    e_max = nm.energy_per_cycle / (4.0 * math.pi * nm.damping_ratio)
+    s_slope = np.gradient(np.log(e_max), np.log(peak))
+    predicted = np.interp(a, peak, nm.damping_ratio * 2.0 / s_slope)
+    assert np.all((s_slope > 2.05) & (s_slope < 2.3))
+    assert np.mean(zeta[ok] / predicted[ok]) == pytest.approx(1.0, abs=0.03)
+    np.testing.assert_allclose(zeta[ok], predicted[ok], rtol=0.15)
     # the backbone is nonlinear here: 1 % of frequency over the stretch compared
     assert w[0] / w[-1] > 1.01
 
@@ -214,7 +248,11 @@ def test_first_nonlinear_mode_of_a_small_mast_is_its_free_decay_backbone() -> No
     gap = w / np.interp(a, peak, nm.frequency) - 1.0
     assert np.all(gap < 0.0)
     assert np.all(gap > -5e-3)
-    np.testing.assert_allclose(zeta, np.interp(a, peak, nm.damping_ratio), rtol=0.12)
+    # EPMC's xi / (2 w), as measured above; the energy ratio damping_ratio is within 2.5 %
+    # of the decay here (0.975-0.993), but by two biases cancelling: the decay's energy
+    # balance predicts damping_ratio * 2 / s (s = 2.10-2.27), which the decay exceeds by
+    # 3 % to 12 % as its decay speeds up (docs/harmonic.md)
+    np.testing.assert_allclose(zeta, np.interp(a, peak, nm.epmc_damping_ratio), rtol=0.12)
 
 
 def test_friction_in_a_structure_joint_is_carried_and_a_sticking_orbit_flagged() -> None:
@@ -236,3 +274,57 @@ def test_friction_in_a_structure_joint_is_carried_and_a_sticking_orbit_flagged()
         nonlinear_modes(s, 1, [1e-3])
     with pytest.raises(StructureError, match="friction"):
         time_response(s, np.array([0.0, 40.0]), 300.0, 0.01)
+
+
+def test_energy_per_cycle_of_a_small_mast_is_what_its_free_decay_loses() -> None:
+    """No amplitude reading and no projection: the exact free decay's mechanical energy
+    (structure.motion's own ledger: 0.5 v^T M v + 0.5 u^T K u + each joint law's V) lost
+    over each cycle, against EPMC's energy_per_cycle at the same total energy. The 2-bay
+    mast of the test above, released on the H = 15 EPMC orbit's state at 2.3 mm (so that
+    no other mode rings): measured 0.998 to 1.009 at H = 15 and 1.014 to 1.070 at H = 7,
+    the gap being H truncation (Rayleigh beta K damps each harmonic in proportion to its
+    frequency squared, so the harmonics H = 7 drops carry dissipation); on 10 bays see
+    docs/harmonic.md (python docs/harmonic_mast_decay.py)."""
+    from clearjoint.harmonic import aft
+    from clearjoint.structure import decay_backbone, free_decay, mast
+    from clearjoint.structure.motion import _Flow
+
+    j = ClearanceJoint(clearance=5e-5, compression_stiffness=5e7, gap_stiffness=1e5)
+    s = mast(2, joints=j, rayleigh=(0.0, 2e-5))
+    flow = _Flow(s, np.zeros(s.n_dof), 0.0)
+    closed = s.modes("closed")
+    ref = int(np.argmax(np.abs(closed.shapes[:, 0])))
+    period = 2.0 * math.pi / float(closed.omega[0])
+    tau = 2.0 * math.pi * np.arange(64) / 64
+    modes = {}
+    for h in (15, 7):
+        nm = nonlinear_modes(s, 1, np.geomspace(0.5e-3, 2.5e-3, 30), harmonics=h)
+        ok = nm.converged  # H = 15 misses 8 of the 30 (1.2 to 1.8 mm): left out
+        assert ok.sum() >= 20
+        basis = aft.Basis.make(h, 2 * (2 * h + 1))
+        states = [
+            (basis.evaluate(coef, tau), w * basis.evaluate(basis.derivative @ coef, tau))
+            for coef, w in zip(nm.harmonic_shapes[ok], nm.frequency[ok], strict=True)
+        ]
+        total = [
+            np.mean([flow.mechanical_energy(a, b) for a, b in zip(u, v, strict=True)])
+            for u, v in states
+        ]
+        assert np.all(np.diff(total) > 0.0)
+        modes[h] = (np.array(total), nm.energy_per_cycle[ok], states[-2])
+    u, v = modes[15][2]
+    motion = free_decay(s, (u[0], v[0]), 10 * period)
+    energy = np.array(
+        [flow.mechanical_energy(a, b) for a, b in zip(motion.u, motion.v, strict=True)]
+    )
+    bb = decay_backbone(motion, ref, mode=1)
+    half = math.pi / bb.omega
+    lost = np.interp(bb.time - half, motion.t, energy) - np.interp(bb.time + half, motion.t, energy)
+    middle = np.interp(bb.time, motion.t, energy)
+    ratios = {}
+    for h, (total, per_cycle, _) in modes.items():
+        inside = (middle > total[0]) & (middle < total[-1])
+        assert inside.sum() >= 6
+        ratios[h] = (lost / np.interp(middle, total, per_cycle))[inside]
+    assert np.all(np.abs(ratios[15] - 1.0) < 0.015)
+    assert np.mean(ratios[7]) > np.mean(ratios[15]) + 0.015  # H = 7 misses a few % of the loss

@@ -96,6 +96,7 @@ def friction_loop(
     frequency: float = 1.0,
     backlash_falling: float | None = None,
     ringing: float = 0.0,
+    gap_dip: float = 0.0,
 ) -> Record:
     """A rigid-plastic friction loop with backlash under imposed x = X sin(w t), exactly.
 
@@ -123,7 +124,9 @@ def friction_loop(
         if travel <= unload:
             value = level + state * stiffness * travel
         elif travel <= unload + gap:
-            value = 0.0
+            inside = (travel - unload) / (0.8 * gap)
+            value = -gap_dip * friction * np.sin(np.pi * inside) ** 2 if state < 0 else 0.0
+            value = value if inside < 1.0 else 0.0
         else:
             elastic = stiffness * (travel - unload - gap)
             if elastic >= 0.7 * friction:
@@ -158,6 +161,35 @@ def test_a_loop_whose_branches_show_different_backlash_is_doubtful() -> None:
     # the same rule on the two other branch ratios: 1.8 passes, 2.2 does not
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 1.8)).flag == "ok"
     assert identify(friction_loop(b, f_f, k, x_amp, backlash_falling=b / 2.2)).flag != "ok"
+
+
+def test_a_force_that_reaches_the_new_level_inside_the_gap_is_flagged() -> None:
+    """The two BRFD misses (docs/identify.md): on the falling branch the force leaves the
+    backlash level early in the gap and reaches the new slip level before the contact. The
+    crossings of the upper fractions then lie inside the gap: that branch reads short, the
+    rising one reads the gap, and the loop is flagged, not passed. A dip 80 % of the way
+    is one residual: the gap is read exactly (the loop flagged by its fit residual only)."""
+    b, f_f, k, x_amp = 4e-3, 1e4, 5e6, 20e-3
+    plain = friction_loop(b, f_f, k, x_amp)
+    for depth in (0.8, 1.0):
+        dip = friction_loop(b, f_f, k, x_amp, gap_dip=depth)
+        assert np.min(dip.force - plain.force) == pytest.approx(-depth * f_f, rel=1e-3)
+    partway = identify(friction_loop(b, f_f, k, x_amp, gap_dip=0.8))
+    # the gap is read; the dip is no part of the elastic-plastic model, so the loop's fit
+    # residual (identify/loopcheck.py) flags it, but not as a second gap
+    flag, reason = partway.flags["clearance_m"]
+    assert flag == "doubtful"
+    assert "fit residual" in reason
+    assert "not one gap" not in reason
+    assert partway.summary["clearance_m"] == pytest.approx(b, rel=0.01)
+    result = identify(friction_loop(b, f_f, k, x_amp, gap_dip=1.0))
+    assert result.model == "damper"
+    flag, reason = result.flags["clearance_m"]
+    assert flag == "doubtful"
+    assert "not one gap" in reason
+    rising, falling = (float(v) for v in re.findall(r"([\d.]+) mm on the", reason))
+    assert rising == pytest.approx(1e3 * b, rel=0.02)  # the branch without the dip
+    assert falling < 0.5e3 * b  # the dip's first crossings read as the gap's far end
 
 
 def test_backlash_is_the_distance_between_the_elastic_lines() -> None:
@@ -201,6 +233,27 @@ def test_exact_friction_loop_with_backlash() -> None:
     assert s["energy_per_cycle_j"] == pytest.approx(
         2 * f_f * (2 * x_amp - b - 2 * f_f / k), rel=0.01
     )
+
+
+def test_a_dampers_samples_are_staged_by_force_not_by_position() -> None:
+    """The loop figure colours samples by Identification.stage: on a damper, a sample on a
+    slip plateau is never "free-play", and one at zero force (in the gap) always is, at any
+    displacement (they used to be staged by the gap edges' positions)."""
+    friction = 1e4
+    record = friction_loop(4e-3, friction, 5e6, 20e-3)
+    result = identify(record)
+    assert result.model == "damper"
+    force = result.restoring_force
+    slipping = np.abs(force) > 0.9 * friction
+    assert np.all(result.stage[slipping] == np.sign(force[slipping]))
+    in_gap = (force == 0.0) & (record.time > 1.0)  # after the ramp in
+    assert np.all(result.stage[in_gap] == 0)
+    assert np.ptp(record.displacement[in_gap]) > 4e-3  # free play on both sides of zero
+    assert {name for name, _, _ in result.stage_runs(record.time)} == {
+        "free-play",
+        "compression",
+        "tension",
+    }
 
 
 @pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
@@ -285,11 +338,30 @@ def test_cli_writes_csv_and_netcdf_and_says_why_a_file_was_not_used(
         assert f"{key}_std" in table[0]
     assert len(list((tmp_path / "figures").glob("*.png"))) == 2 * len(files)
     assert main(["identify", *files, "--out", str(out), "--quiet"]) == 2  # no overwrite
+    capsys.readouterr()
+    # figures already there: nothing is written (not even the new table), the message names
+    # the option that chose them
+    other = tmp_path / "f2.csv"
+    figures = ["--figures", str(tmp_path / "figures")]
+    assert main(["identify", *files, "--out", str(other), "--quiet", *figures]) == 2
+    err = capsys.readouterr().err
+    assert "choose another --figures or pass --force" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not other.exists()
     nc = tmp_path / "results.nc"
     assert main(["identify", *files, "--out", str(nc), "--quiet"]) == 0
     with xr.open_dataset(nc, engine="h5netcdf") as data:
         assert data.sizes["file"] == len(files)
         assert "clearance_m_std" in data
+
+
+def test_identify_help_names_every_column_kind(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["identify", "--help"])
+    assert info.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for word in ("_std", "_se", "flag (ok, doubtful, rejected)", "flag_reason"):
+        assert word in text, word
 
 
 def test_cli_refuses_when_nothing_is_usable(
@@ -346,6 +418,42 @@ def test_one_percent_noise_on_every_channel_with_acceleration(
         assert s[key] == pytest.approx(truth[key], rel=0.02), key
     assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10)
     assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+@pytest.mark.parametrize(("frequency", "rate"), [(40.0, 12_010.0), (37.0, 12_000.0)])
+def test_a_period_that_is_not_a_whole_number_of_samples(
+    tmp_path: Path, frequency: float, rate: float
+) -> None:
+    """300.25 and 324.3 samples a period: the cycles are stacked by interpolation; the
+    targets hold as on a whole number (sample-by-sample fits on that stack gave the
+    friction 8-21 % low, flagged ok)."""
+    joint = TrueJoint(frequency_hz=frequency)
+    truth = steady_truth(joint)
+    for seed in (1, 3):
+        path = write_record(joint, tmp_path / f"{seed}.csv", noise=0.01, rate=rate, seed=seed)
+        s = identify(read_record(path)).summary
+        assert s["clearance_m"] == pytest.approx(truth["clearance_m"], rel=0.01), seed
+        for key in KEYS[1:]:
+            assert s[key] == pytest.approx(truth[key], rel=0.02), (seed, key)
+        assert s["friction_force_n"] == pytest.approx(truth["friction_force_n"], rel=0.10), seed
+        assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
+
+
+def test_an_interpolated_stack_fitted_sample_by_sample_is_doubtful(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]], tmp_path: Path
+) -> None:
+    """100 Hz at 12 010 Hz: a contact too short for the weak form on an interpolated stack
+    (the friction reads 16 % low without an acceleration channel): flagged, with the rate."""
+    joint, _ = independent[100.0]
+    path = write_record(joint, tmp_path / "r.csv", noise=0.01, rate=12_010.0, acceleration=False)
+    flags = identify(read_record(path)).flags
+    assert flags["friction_force_n"][0] == "doubtful"
+    flag, reason = flags["clearance_m"]  # its standard error is small: this is the reason
+    assert flag == "doubtful"
+    assert "120.10 samples a period" in reason
+    assert "interpolation" in reason
+    exact = write_record(joint, tmp_path / "e.csv", noise=0.0, rate=12_000.0)
+    assert "interpolation" not in identify(read_record(exact)).flags["clearance_m"][1]
 
 
 @pytest.mark.parametrize("frequency", [40.0, 100.0])
@@ -526,7 +634,8 @@ def test_batched_replicate_fits_equal_the_fits_one_by_one(
     import clearjoint.identify.core as core
 
     joint, _ = independent[40.0]
-    path = write_record(joint, tmp_path / "noisy.csv", noise=0.01, acceleration=True)
+    # 0.2 % noise: a quiet average, fitted sample by sample (at 1 % the weak form is used)
+    path = write_record(joint, tmp_path / "noisy.csv", noise=0.002, acceleration=True)
     t = np.arange(4000) / 2000.0
     x = 1e-4 * np.sin(2 * np.pi * 10.0 * t)
     v = 2e-3 * np.pi * np.cos(2 * np.pi * 10.0 * t)

@@ -280,6 +280,32 @@ def test_result_repr_plot_and_xarray(curve: FrequencyResponse) -> None:
     assert list(data["event_kind"].values).count("fold") == 2
 
 
+def test_repr_and_plot_show_event_kinds_beyond_the_exact_ones(curve: FrequencyResponse) -> None:
+    """Harmonic balance adds "neimark_sacker" and "untrusted" events: the repr counts them,
+    the plot marks a Neimark-Sacker point (the exact curve's own kinds are unchanged)."""
+    import dataclasses
+
+    import matplotlib
+
+    from clearjoint.periodic import ResponseEvent
+
+    matplotlib.use("Agg")
+    w = float(curve.omega[len(curve.omega) // 2])
+    extra = (
+        ResponseEvent("neimark_sacker", w, float(curve.force_amplitude[0]), 1e-3, "test"),
+        ResponseEvent("untrusted", w, float(curve.force_amplitude[0]), 1e-3, "test"),
+    )
+    marked = dataclasses.replace(curve, events=tuple(curve.events) + extra)
+    text = repr(marked)
+    assert "2 fold" in text
+    assert "1 neimark_sacker" in text
+    assert "1 untrusted" in text
+    assert "neimark_sacker" not in repr(curve)
+    labels = marked.plot().get_legend_handles_labels()[1]
+    assert "neimark_sacker" in labels
+    assert "neimark_sacker" not in curve.plot().get_legend_handles_labels()[1]
+
+
 def _study_losses() -> tuple[Joint, dict[str, object]]:
     """examples/study.toml's joint and losses, mapped as ``clearjoint frf`` maps them."""
     from clearjoint.simulate.study import load_study

@@ -167,6 +167,17 @@ def test_bad_records_name_the_file_and_the_problem(tmp_path: Path, body: str, wo
     assert str(path) in str(info.value)
 
 
+def test_a_record_of_two_cycles_is_refused_with_the_steady_cycle_rule(tmp_path: Path) -> None:
+    """The same sentence as the identification's refusals (clearjoint.identify.steady_rule)."""
+    from clearjoint.identify.cycles import STEADY_RULE
+
+    path = write_csv(tmp_path, CSV_MAGIC + '\n# frequency = "2 Hz"\n' + csv_body(UNIFORM))
+    with pytest.raises(RecordError) as info:
+        read_record(path)
+    assert str(info.value).endswith(STEADY_RULE)
+    assert "at least 3 steady cycles" in str(info.value)
+
+
 def test_resampling_is_offered_and_works(tmp_path: Path) -> None:
     times = [0.0, 0.011] + [0.011 + i / 100 for i in range(1, 60)]
     path = write_csv(tmp_path, csv_body(times))
@@ -254,10 +265,13 @@ def test_brfd_adapter_reads_all_31_files_in_si() -> None:
         assert np.max(np.abs(r.displacement)) == pytest.approx(r.displacement_amplitude, rel=0.25)
 
 
-@pytest.mark.skipif(not BRFD.exists(), reason="the shared BRFD data is not beside this clone")
 def test_brfd_adapter_refuses_a_wrong_matrix(tmp_path: Path) -> None:
-    path = tmp_path / "1Hz0lbtension1amplitude.json"
-    path.write_text(json.dumps({"data": [[0.0, 1.0]] * 20, "displacement units": "in"}))
+    # a shipped record's own content with one column dropped (runs on a fresh clone)
+    shipped = Path(__file__).resolve().parent / "data" / "brfd" / "2Hz0lbtension0.5amplitude.json"
+    content = json.loads(shipped.read_text())
+    content["data"] = [row[:5] for row in content["data"]]
+    path = tmp_path / shipped.name
+    path.write_text(json.dumps(content))
     with pytest.raises(RecordError, match="must have 6 columns"):
         read_brfd(path)
 

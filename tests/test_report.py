@@ -200,7 +200,9 @@ def test_names_moved_out_of_report_still_import() -> None:
         from clearjoint.report import no_such_name  # noqa: F401
 
 
-def test_report_tables_show_the_flags(reproduction: Path, tmp_path: Path) -> None:
+def test_report_tables_show_the_flags(
+    reproduction: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """A record set with one flagged record (force control, its mass removed): the table of
     identified tests shows its flag and reason beside the others' ``ok``."""
     from dataclasses import replace
@@ -219,6 +221,19 @@ def test_report_tables_show_the_flags(reproduction: Path, tmp_path: Path) -> Non
     out = tmp_path / "report"
     assert main(["report", "--records", str(folder), "--out", str(out)]) == 0
     page = (out / "report.html").read_text()
+    # the missing mass is a warning on stderr and on the page, saying how to add it
+    err = capsys.readouterr().err
+    warned = [line for line in err.splitlines() if "warning" in line]
+    assert len(warned) == 1
+    assert "no-mass" in warned[0]
+    assert "without a mass" in warned[0]
+    assert "# mass = " in warned[0]
+    warnings = page[page.index("<h2>Warnings</h2>") :]
+    assert "no-mass" in warnings[: warnings.index("</ul>")]
+    assert "# mass = " in warnings[: warnings.index("</ul>")]
+    assert json.loads((out / "results.json").read_text())["warnings"] == [
+        line.split("warning: ", 1)[1] for line in warned
+    ]
     table = page[page.index("Identified tests") :]
     table = table[: table.index("</table>")]
     assert "<th>flag</th><th>flag reason</th>" in table

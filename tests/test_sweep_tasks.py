@@ -288,7 +288,9 @@ def test_the_committed_mast_tolerance_results_come_from_the_shipped_sweep_file()
     np.testing.assert_allclose(
         results.frequency_hz.values[s], mode.frequency / (2 * math.pi), rtol=1e-9
     )
-    np.testing.assert_allclose(results.damping_ratio.values[s], mode.damping_ratio, rtol=1e-7)
+    # committed when damping_ratio was EPMC's xi / (2 w), now epmc_damping_ratio (a rerun
+    # of the sweep, about 50 min, writes the energy ratio E_diss / (4 pi E_max) instead)
+    np.testing.assert_allclose(results.damping_ratio.values[s], mode.epmc_damping_ratio, rtol=1e-7)
 
 
 def test_periodic_orbit_of_a_joint_without_clearance_is_the_linear_oscillators(

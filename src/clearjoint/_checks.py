@@ -71,11 +71,16 @@ def _in(unit: str) -> str:
     return f" (in {unit})" if unit else ""
 
 
-def refuse_to_overwrite(paths: Iterable[Path], *, force: bool) -> None:
-    """Raise OutputExistsError naming every path that exists, unless ``force``."""
+def refuse_to_overwrite(paths: Iterable[Path], *, force: bool, option: str = "--out") -> None:
+    """Raise OutputExistsError naming every path that exists, unless ``force``.
+
+    ``option`` is the command-line option that chose those paths (named in the message).
+    """
     existing = [str(path) for path in paths if path.exists()]
     if existing and not force:
         named = ", ".join(existing[:3])
         if len(existing) > 3:
             named += f" and {len(existing) - 3} more"
-        raise OutputExistsError(f"will not overwrite {named}; choose another --out or pass --force")
+        raise OutputExistsError(
+            f"will not overwrite {named}; choose another {option} or pass --force"
+        )

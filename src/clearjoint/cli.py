@@ -11,7 +11,9 @@ exit code 2 and one line on stderr that says what is wrong and where.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import logging
 import math
 import os
 import sys
@@ -179,8 +181,10 @@ def _identify_parser(sub: Any) -> None:
         help="clearance, stiffness, friction and energy per cycle from test records",
         description=(
             "Identify every record (CSV, netCDF, BRFD JSON; recognised by content): one row "
-            "per file in --out (.csv or .nc) with each quantity's mean over the steady "
-            "cycles and its spread in a _std column; one line for every file not used."
+            "per file in --out (.csv or .nc) with each quantity's value over the steady "
+            "cycles, its spread over the cycles (_std) and its standard error (_se), then "
+            "a credibility flag (ok, doubtful, rejected) and flag_reason; one line for "
+            "every file not used."
         ),
     )
     p.add_argument("files", nargs="+", help="record files")
@@ -242,6 +246,30 @@ def _frf_parser(sub: Any) -> None:
         help="exact shooting (default) or harmonic balance (clearjoint.harmonic)",
     )
     p.add_argument("--harmonics", type=int, help="H with --method harmonic (default 7)")
+    _add_samples_option(p)
+
+
+def _add_samples_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--samples",
+        type=int,
+        help="harmonic balance: time samples per period, at least 2 (2H + 1) "
+        "(default 32 (2H + 1) rounded up to a power of two)",
+    )
+
+
+def _samples(args: argparse.Namespace, harmonics: int) -> int | None:
+    """--samples checked against --harmonics (aliasing) in CLI terms; None for the default."""
+    if args.samples is None:
+        return None
+    least = 2 * (2 * harmonics + 1)
+    if harmonics >= 1 and args.samples < least:
+        raise ParameterError(
+            f"--samples {args.samples} is too few for --harmonics {harmonics}: give at least "
+            f"2 (2H + 1) = {least} (fewer alias the joint law's higher harmonics onto the "
+            "kept ones), or leave --samples out for the default"
+        )
+    return int(args.samples)
 
 
 #: Figure formats ``--plot`` writes (matplotlib picks the format from the suffix).
@@ -355,6 +383,7 @@ def _modes_parser(sub: Any) -> None:
     )
     p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
     p.add_argument("--harmonics", type=int, default=7, help="H (default 7)")
+    _add_samples_option(p)
     p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
     _add_plot_option(p, force=False)
     p.add_argument("--json", action="store_true", help="print the mode as one JSON object")
@@ -712,6 +741,9 @@ def _run_identify(args: argparse.Namespace) -> int:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
     rows = [ident.row() for _, ident in results]
+    if args.figures:  # every output checked before any is written
+        targets = [t for _, ident in results for t in _figure_files(ident, Path(args.figures))]
+        refuse_to_overwrite(targets, force=args.force, option="--figures")
     _write_rows(rows, out)
     if args.figures:
         _identify_figures(results, Path(args.figures), force=args.force)
@@ -750,6 +782,12 @@ def _write_rows(rows: list[dict[str, Any]], out: Path) -> None:
     data.to_netcdf(out, engine="h5netcdf")
 
 
+def _figure_files(ident: Any, folder: Path) -> list[Path]:
+    """The two figures ``clearjoint identify --figures`` writes for one identification."""
+    stem = Path(ident.source).stem
+    return [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
+
+
 def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
     from clearjoint._checks import refuse_to_overwrite
     from clearjoint.figures import displacement_stages_figure, identified_loop_figure
@@ -757,8 +795,8 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     for record, ident in results:
         stem = Path(ident.source).stem
-        targets = [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
-        refuse_to_overwrite(targets, force=force)
+        targets = _figure_files(ident, folder)
+        refuse_to_overwrite(targets, force=force, option="--figures")
         first = ident.cycles[0]
         span = slice(first.start, ident.cycles[-1].stop)
         runs = ident.stage_runs(record.time)
@@ -888,6 +926,7 @@ def _run_report(args: argparse.Namespace) -> int:
         Path(args.out),
         force=args.force,
         progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+        warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
     )
     for path in written:
         print(f"wrote {path}")
@@ -940,9 +979,13 @@ def _run_frf(args: argparse.Namespace) -> int:
         from clearjoint import harmonic
 
         h = 7 if args.harmonics is None else args.harmonics
-        frequency_response = functools.partial(harmonic.frequency_response, harmonics=h)
+        frequency_response = functools.partial(
+            harmonic.frequency_response, harmonics=h, samples=_samples(args, h)
+        )
     elif args.harmonics is not None:
         raise ParameterError("--harmonics goes with --method harmonic; drop it or add that")
+    elif args.samples is not None:
+        raise ParameterError("--samples goes with --method harmonic; drop it or add that")
     if args.parameter == "force":
         frequency = (
             parse_quantity(args.frequency, "frequency", name="--frequency")
@@ -984,6 +1027,9 @@ def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Pa
     """Write the curve (--out, --plot) and print it (--json or a summary)."""
     data = curve.to_xarray()
     data.attrs["study"] = source
+    names = getattr(curve.settings.get("system"), "dof_names", None)
+    if names is not None and "dof" in data.dims:  # a structure: name its DOFs
+        data = data.assign_coords(dof=("dof", [str(name) for name in names]))
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     data.to_netcdf(args.out, engine="h5netcdf")
     _save_plot(curve, plot_path, quiet=True)
@@ -1109,6 +1155,7 @@ def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: 
     import math
 
     from clearjoint import harmonic
+    from clearjoint.harmonic.response import NoPeriodicResponse
     from clearjoint.units import parse_quantity
 
     if args.method != "harmonic":
@@ -1123,6 +1170,7 @@ def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: 
         )
     _structure_harmonic_check(study, "frf")
     h = 7 if args.harmonics is None else args.harmonics
+    samples = _samples(args, h)
     if args.parameter == "force":
         frequency = (
             parse_quantity(args.frequency, "frequency", name="--frequency")
@@ -1132,26 +1180,34 @@ def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: 
         if not (math.isfinite(frequency) and frequency > 0.0):
             raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
         pattern = study.force * (start / float(np.max(np.abs(study.force))))
-        return harmonic.frequency_response(
-            study.structure,
-            pattern,
-            2.0 * math.pi * frequency,
-            None,
-            harmonics=h,
-            parameter="force",
-            force_stop=stop,
-            max_points=args.max_points,
-        )
+        try:
+            return harmonic.frequency_response(
+                study.structure,
+                pattern,
+                2.0 * math.pi * frequency,
+                None,
+                harmonics=h,
+                samples=samples,
+                parameter="force",
+                force_stop=stop,
+                max_points=args.max_points,
+            )
+        except NoPeriodicResponse as exc:
+            raise _no_orbit(exc, study.source, start) from None
     if args.frequency:
         raise ParameterError("--frequency goes with --parameter force; drop it or add that")
-    return harmonic.frequency_response(
-        study.structure,
-        study.force,
-        2.0 * math.pi * start,
-        2.0 * math.pi * stop,
-        harmonics=h,
-        max_points=args.max_points,
-    )
+    try:
+        return harmonic.frequency_response(
+            study.structure,
+            study.force,
+            2.0 * math.pi * start,
+            2.0 * math.pi * stop,
+            harmonics=h,
+            samples=samples,
+            max_points=args.max_points,
+        )
+    except NoPeriodicResponse as exc:
+        raise _no_orbit(exc, study.source, float(np.max(np.abs(study.force)))) from None
 
 
 def _progress_bar(*columns: Any) -> Any:
@@ -1161,6 +1217,38 @@ def _progress_bar(*columns: Any) -> Any:
 
     return Progress(
         *columns, console=Console(stderr=True), transient=True, disable=not sys.stderr.isatty()
+    )
+
+
+@contextlib.contextmanager
+def _harmonic_progress(command: str) -> Any:
+    """Print clearjoint.harmonic's progress lines (its slow start) on stderr, one line each."""
+    logger = logging.getLogger("clearjoint.harmonic")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter(f"clearjoint {command}: %(message)s"))
+    level = logger.level
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
+
+
+def _no_orbit(exc: Any, source: str, force: float) -> ParameterError:
+    """The start found no harmonic-balance orbit: say so in CLI terms, with what to do."""
+    hz = exc.omega / (2.0 * math.pi)
+    reached = (
+        f"; following the force up from a small one reached only {exc.reached * force:.3g} N"
+        if exc.reached > 0.0
+        else ""
+    )
+    return ParameterError(
+        f"{source}: no harmonic-balance orbit at {hz:.6g} Hz and {force:.3g} N{reached}: at this "
+        "force the joints may rattle with no periodic orbit (docs/harmonic.md); lower "
+        "[excitation] force_amplitude, or start elsewhere (--from), or take the exact motion: "
+        f"clearjoint structure {source} respond"
     )
 
 
@@ -1286,6 +1374,11 @@ def _amplitude_range(text: str, points: int) -> Any:
         return np.array(values)
     if values[0] == values[1]:
         raise ParameterError(f"--amplitude range {text!r} has zero width; give two values")
+    if values[0] > values[1]:
+        raise ParameterError(
+            f"--amplitude range {text!r} runs downwards; write it from the smaller amplitude "
+            f"to the larger, {parts[1].strip()}..{parts[0].strip()}"
+        )
     return np.geomspace(values[0], values[1], points)
 
 
@@ -1300,9 +1393,12 @@ def _run_modes(args: argparse.Namespace) -> int:
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     amplitudes = _amplitude_range(args.amplitude, args.points)
+    samples = _samples(args, args.harmonics)
     if structure_study is not None:
         _structure_harmonic_check(study, "modes")
-        mode = nonlinear_modes(study.structure, args.mode, amplitudes, harmonics=args.harmonics)
+        mode = nonlinear_modes(
+            study.structure, args.mode, amplitudes, harmonics=args.harmonics, samples=samples
+        )
     else:
         _harmonic_losses(study, args.study, "modes")
         mode = nonlinear_modes(
@@ -1310,6 +1406,7 @@ def _run_modes(args: argparse.Namespace) -> int:
             args.mode,
             amplitudes,
             harmonics=args.harmonics,
+            samples=samples,
             damping_ratio=study.damping_ratio,
             friction=study.friction,
             restitution=study.restitution,
@@ -1338,6 +1435,7 @@ def _run_modes(args: argparse.Namespace) -> int:
                     "frequency_hz": finite(mode.frequency / (2 * math.pi)),
                     "damping_ratio": finite(mode.damping_ratio),
                     "energy_per_cycle_j": finite(mode.energy_per_cycle),
+                    "epmc_damping_ratio": finite(mode.epmc_damping_ratio),
                 }
             )
         )
@@ -1458,7 +1556,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "structure": _run_structure,
     }
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), _harmonic_progress(args.command):
             warnings.showwarning = _warning_printer(args.command)
             return runners[args.command](args)
     except BrokenPipeError:  # the reader stopped early (| head): not an error of ours

@@ -245,11 +245,12 @@ def _orbit(
 
 @dataclass(frozen=True)
 class ResponseEvent:
-    """A fold, period doubling or grazing found along a frequency-response curve.
+    """A fold, period doubling, grazing or other event found along a frequency-response curve.
 
     Attributes
     ----------
-    kind : {"fold", "period_doubling", "grazing"}
+    kind : {"fold", "period_doubling", "grazing", "neimark_sacker", "untrusted", ...}
+        The last two come from harmonic balance only (clearjoint.harmonic).
     omega : float
         rad/s.
     force_amplitude : float
@@ -327,6 +328,8 @@ class FrequencyResponse:
             f"{sum(e.kind == k for e in self.events)} {k}"
             for k in ("fold", "period_doubling", "grazing")
         )
+        others = sorted({e.kind for e in self.events} - {"fold", "period_doubling", "grazing"})
+        kinds += "".join(f", {sum(e.kind == k for e in self.events)} {k}" for k in others)
         f = self.omega / (2 * math.pi)
         if self.free_play is not None and self.free_play.any():
             kinds += f", {int(np.sum(self.free_play))} free play"
@@ -473,7 +476,12 @@ class FrequencyResponse:
         ax.plot([], [], "--", color="C3", label="unstable")
         if free.any():
             ax.plot([], [], ":", color="0.4", label="free play (centred; position not set)")
-        markers = {"fold": ("o", "k"), "period_doubling": ("s", "C2"), "grazing": ("^", "C1")}
+        markers = {
+            "fold": ("o", "k"),
+            "period_doubling": ("s", "C2"),
+            "grazing": ("^", "C1"),
+            "neimark_sacker": ("D", "C4"),
+        }
         for kind, (marker, color) in markers.items():
             chosen = [e for e in self.events if e.kind == kind]
             if chosen:

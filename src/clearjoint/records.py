@@ -167,9 +167,12 @@ class Record:
         if self.frequency_hz:
             cycles = (time[-1] - time[0]) * self.frequency_hz
             if cycles < MIN_CYCLES:
+                # the one steady-cycle rule, word for word as every identification path
+                # states it (imported here: clearjoint.identify imports this module)
+                from clearjoint.identify.cycles import STEADY_RULE
+
                 raise RecordError(
-                    f"{where}: spans {cycles:.2f} cycles at {self.frequency_hz:g} Hz; "
-                    f"a record needs at least {MIN_CYCLES}"
+                    f"{where}: spans {cycles:.2f} cycles at {self.frequency_hz:g} Hz; {STEADY_RULE}"
                 )
 
     @property

@@ -79,6 +79,8 @@ class Study:
     control: str = ""
     control_analysis: Analysis | None = None
     timing: Timing | None = None
+    #: warnings of the identification (a force-controlled record without a mass, ...)
+    warnings: list[str] = field(default_factory=list)
 
 
 def _png(fig: Figure) -> bytes:
@@ -367,7 +369,7 @@ details{{margin:0.4em 0}}summary{{cursor:pointer;font-weight:bold}}</style>
 <h1>{html.escape(study.title)}</h1>
 <p>{_items_inline(study.what_was_run)} Paper: Li et al., Shock and Vibration (2013),
 doi:10.1155/2013/583030; equations as rebuilt in MODEL.md.</p>
-<h2>Findings of the paper, against these data</h2>
+{_warnings_html(study.warnings)}<h2>Findings of the paper, against these data</h2>
 {findings_html(study.findings)}
 <p><small>Reproduced: the fitted slope has the paper's sign by more than two standard errors
 for every joint and side. Source "model": it also holds in the control ({
@@ -385,6 +387,14 @@ have their own figure and their own eq 19 and 20 (law "eq 19 slopes", key
 <h2>Tables</h2>{"".join(sections)}
 </body></html>
 """
+
+
+def _warnings_html(warnings: Sequence[str]) -> str:
+    """The identification's warnings as a list under their heading (empty if none)."""
+    if not warnings:
+        return ""
+    items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings)
+    return f'<h2>Warnings</h2>\n<ul class="warnings">{items}</ul>\n'
 
 
 def _items_inline(values: Sequence[str]) -> str:
@@ -432,6 +442,7 @@ def write_report(out_dir: Path, study: Study, *, force: bool = False) -> list[Pa
     failures = [line.replace(folder, "") for line in analysis.failures]
     payload: dict[str, Any] = {
         "what_was_run": study.what_was_run,
+        "warnings": study.warnings,
         "findings": [f.as_dict() for f in study.findings],
         "control": study.control,
         "tests": rows,

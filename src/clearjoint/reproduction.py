@@ -52,9 +52,17 @@ def _identified_clearances(analysis: Analysis) -> list[float]:
 
 
 def report_records(
-    folder: Path, out_dir: Path, *, force: bool = False, progress: Progress | None = None
+    folder: Path,
+    out_dir: Path,
+    *,
+    force: bool = False,
+    progress: Progress | None = None,
+    warn: Progress | None = None,
 ) -> list[Path]:
     """Identify every record in ``folder``, fit the laws and write the report to ``out_dir``.
+
+    The identification's warnings (a force-controlled record without a mass, with how to
+    add it) go to ``warn`` one line each, and onto the report's page and results.json.
 
     The findings' control is the same analysis with each side's contact slope frozen at
     its structure's median (no rig can be re-run without its installation effects).
@@ -74,6 +82,9 @@ def report_records(
         from clearjoint.identify import IdentificationError
 
         raise IdentificationError(f"{folder}: no record could be identified")
+    notes = [w for _, ident in results for w in ident.warnings]
+    for note in notes:
+        (warn or (lambda _m: None))(note)
     say("fitting the laws")
     analysis = analyse(results, failures)
     control = analyse(results, failures, frozen_slopes=True)
@@ -94,6 +105,7 @@ def report_records(
         records_folder=folder,
         control="the same records with each side's contact slope frozen at its median",
         control_analysis=control,
+        warnings=notes,
     )
     return write_report(Path(out_dir), study, force=force)
 

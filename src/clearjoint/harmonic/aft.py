@@ -17,9 +17,10 @@ crossing gap edges.
 Stability by Hill's method (Lazarus & Thomas, C. R. Mecanique 338, 2010): a
 perturbation e^(lambda t) s(t), s periodic, gives the quadratic eigenproblem
 (Delta_0 + lambda Delta_1 + lambda^2 Delta_2) s = 0 with Delta_0 the HB Jacobian,
-Delta_1 = I x C + 2 w D x M, Delta_2 = I x M; of its 2 N (2H + 1) eigenvalues the 2N
-with the smallest imaginary parts are kept, and the Floquet multipliers are
-exp(lambda T), T = 2 pi / w.
+Delta_1 = I x C + 2 w D x M, Delta_2 = I x M; :func:`hill_exponents` keeps the 2N of
+its 2 N (2H + 1) eigenvalues with the smallest imaginary parts, and the Floquet
+multipliers are exp(lambda T), T = 2 pi / w. That sorting fails when modes lie above
+H w / 2; the curves use the centroid sorting of :mod:`clearjoint.harmonic.hill`.
 """
 
 from __future__ import annotations
@@ -494,7 +495,8 @@ def hill_exponents(
     Linearises (Delta_0 + lambda Delta_1 + lambda^2 Delta_2) s = 0 to a standard
     eigenproblem of size 2 (2H + 1) N (M is diagonal and positive, so Delta_2 is
     inverted exactly) and keeps the 2N eigenvalues with the smallest abs(Im lambda)
-    (Lazarus & Thomas 2010).
+    (Lazarus & Thomas 2010). Kept as the reference sorting; the curves use
+    :func:`clearjoint.harmonic.hill.spectrum` (centroid sorting).
     """
     n = system.n_dof
     n_c = 2 * basis.harmonics + 1

@@ -6,8 +6,13 @@ the coefficients Q, w and xi, and two conditions close the system at a prescribe
 modal amplitude a: the fundamental cosine coefficient of the mode's reference DOF
 is a, its sine coefficient 0 (the phase). Then
 
-    natural frequency w(a),   damping ratio zeta(a) = xi / (2 w),
-    energy dissipated per cycle = xi * integral of u'^T M u' dt over one period.
+    natural frequency w(a),
+    energy dissipated per cycle E_diss = xi * integral of u'^T M u' dt over one period,
+    damping ratio zeta(a) = E_diss / (4 pi E_max),
+    EPMC's own ratio xi / (2 w).
+
+zeta is the loss factor of MODEL.md section 2 halved, E_max the largest potential
+energy over the orbit; EPMC's ratio equals it for sinusoidal motion only.
 
 For one joint without losses xi = 0 and w(a) is the paper's 2 pi / T(A) of
 section 1 (the dynamic stiffness is the backbone of the mode).
@@ -52,9 +57,15 @@ class NonlinearMode:
     frequency : (n,) ndarray
         Natural frequency w(a), rad/s.
     damping_ratio : (n,) ndarray
-        zeta(a) = xi / (2 w).
+        The energy-equivalent ratio zeta(a) = E_diss / (4 pi E_max): the loss factor
+        of MODEL.md section 2 halved, with E_diss = ``energy_per_cycle`` and E_max the
+        largest potential energy over the orbit (0.5 u^T K u plus every joint's
+        V(delta)); for one joint E_max = V(x_max), as :mod:`clearjoint.dissipation`.
     energy_per_cycle : (n,) ndarray
         Energy the losses dissipate per cycle, xi * integral u'^T M u' dt, J.
+    epmc_damping_ratio : (n,) ndarray
+        EPMC's xi / (2 w): equal to ``damping_ratio`` for a sinusoid, up to twice
+        smaller for a joint's near-triangular motion close to its gap (docs/harmonic.md).
     harmonic_shapes : ndarray
         The harmonic coefficients a_0, a_1, b_1, ..., a_H, b_H, m: (n, 2H + 1) for
         a Joint, (n, 2H + 1, N) for a Structure.
@@ -69,6 +80,9 @@ class NonlinearMode:
         H.
     reference_dof : str
         The DOF the amplitude is measured on.
+    dof_names : tuple of str
+        A Structure's DOF names (the ``dof`` coordinate of :meth:`to_xarray`); empty
+        for a Joint.
     """
 
     amplitude: FloatArray
@@ -79,9 +93,11 @@ class NonlinearMode:
     energy_per_cycle: FloatArray = field(repr=False)
     harmonic_shapes: FloatArray = field(repr=False)
     converged: NDArray[np.bool_] = field(repr=False)
+    epmc_damping_ratio: FloatArray = field(repr=False)
     mode: int = 1
     harmonics: int = 7
     reference_dof: str = "x"
+    dof_names: tuple[str, ...] = ()
 
     def __repr__(self) -> str:
         ok = self.converged
@@ -95,7 +111,9 @@ class NonlinearMode:
         )
 
     def plot(self, ax: Axes | None = None) -> Axes:
-        """Plot frequency (Hz, solid) and damping ratio (dashed, right axis) against amplitude.
+        """Plot frequency (Hz, solid) and both damping ratios (right axis) against amplitude.
+
+        ``damping_ratio`` dashed, ``epmc_damping_ratio`` dotted.
 
         Returns
         -------
@@ -114,8 +132,11 @@ class NonlinearMode:
             ax.set_xscale("log")
         if np.any(self.damping_ratio[self.converged] > 0.0):
             twin = ax.twinx()
-            twin.plot(a_um, self.damping_ratio, "--", color="C3", label="damping ratio")
-            twin.set_ylabel("damping ratio", color="C3")
+            twin.plot(
+                a_um, self.damping_ratio, "--", color="C3", label="damping ratio E/(4 pi E_max)"
+            )
+            twin.plot(a_um, self.epmc_damping_ratio, ":", color="C3", label="EPMC xi/(2 w)")
+            twin.set_ylabel("damping ratio (dashed; EPMC xi/(2 w) dotted)", color="C3")
         ax.set_title(f"nonlinear mode {self.mode} (EPMC, H = {self.harmonics})")
         return ax
 
@@ -125,12 +146,16 @@ class NonlinearMode:
 
         per = ("amplitude",) if self.x_max.ndim == 1 else ("amplitude", "dof")
         shape_dims = ("amplitude", "coefficient", "dof")[: self.harmonic_shapes.ndim]
+        coords: dict[str, Any] = {"amplitude": ("amplitude", self.amplitude, {"units": "m"})}
+        if self.x_max.ndim == 2 and len(self.dof_names) == self.x_max.shape[1]:
+            coords["dof"] = ("dof", list(self.dof_names))
         return xr.Dataset(
             {
                 "frequency": ("amplitude", self.frequency / (2.0 * math.pi), {"units": "Hz"}),
                 "omega": ("amplitude", self.frequency, {"units": "rad/s"}),
                 "damping_ratio": ("amplitude", self.damping_ratio, {"units": "1"}),
                 "energy_per_cycle": ("amplitude", self.energy_per_cycle, {"units": "J"}),
+                "epmc_damping_ratio": ("amplitude", self.epmc_damping_ratio, {"units": "1"}),
                 "x_max": (per, self.x_max, {"units": "m"}),
                 "x_min": (per, self.x_min, {"units": "m"}),
                 "harmonic_shapes": (
@@ -140,7 +165,7 @@ class NonlinearMode:
                 ),
                 "converged": ("amplitude", self.converged.astype(np.int8), {"units": "1 yes"}),
             },
-            coords={"amplitude": ("amplitude", self.amplitude, {"units": "m"})},
+            coords=coords,
             attrs={
                 "title": "clearjoint nonlinear mode (EPMC, harmonic balance)",
                 "mode": self.mode,
@@ -341,6 +366,11 @@ def _mode(
         weights[0] = 1.0
         mean_square = np.einsum("c,pcn,nm,pcm->p", weights, vel, model.mass, vel)
         energy[ok] = xi[ok] * mean_square * (2.0 * math.pi / omega[ok])
+    e_max = np.full(count, np.nan)
+    for k in ok.tolist():
+        e_max[k] = largest_potential_energy(model, basis, coef[k])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(e_max > 0.0, energy / (4.0 * math.pi * e_max), np.nan)
     shapes = coef
     if model.is_joint:
         x_max, x_min, shapes = x_max[:, 0], x_min[:, 0], coef[:, :, 0]
@@ -349,11 +379,69 @@ def _mode(
         x_max=x_max,
         x_min=x_min,
         frequency=omega,
-        damping_ratio=xi / (2.0 * omega),
+        damping_ratio=ratio,
         energy_per_cycle=energy,
         harmonic_shapes=shapes,
         converged=converged,
+        epmc_damping_ratio=xi / (2.0 * omega),
         mode=mode,
         harmonics=basis.harmonics,
         reference_dof=model.dof_names[ref],
+        dof_names=() if model.is_joint else tuple(model.dof_names),
     )
+
+
+def potential_energy(model: LinearSystem, u: FloatArray) -> FloatArray:
+    """Return the potential energy 0.5 u^T K u + sum_j V_j(b_j^T u) of states ``u`` (n, N), J.
+
+    V_j is the integral of joint j's piecewise-linear law (MODEL.md section 0) from 0:
+    0.5 k0 d^2 + 0.5 k_c max(d - g_c, 0)^2 + 0.5 k_t min(d + g_t, 0)^2; for a Joint
+    (K = 0, b = 1) this is ``Joint.potential_energy``. Returns shape (n,).
+    """
+    delta = u @ model.directions.T
+    joints = 0.5 * (
+        model.k0 * delta**2
+        + model.k_c * np.maximum(delta - model.g_c, 0.0) ** 2
+        + model.k_t * np.minimum(delta + model.g_t, 0.0) ** 2
+    )
+    linear = 0.5 * np.einsum("ti,ij,tj->t", u, model.stiffness, u)
+    return np.asarray(linear + joints.sum(axis=1), dtype=np.float64)
+
+
+def largest_potential_energy(
+    model: LinearSystem, basis: aft.Basis, coefficients: FloatArray, fine: int = 1024
+) -> float:
+    """Return E_max, the largest potential energy over one HB orbit, J.
+
+    Parameters
+    ----------
+    model : LinearSystem
+    basis : aft.Basis
+    coefficients : (2H + 1, N) ndarray
+        The orbit's harmonic coefficients, m.
+    fine : int
+        Phases of the first grid; the best one is then refined by a bounded scalar
+        search over its two neighbouring intervals (to 1e-12 rad).
+
+    Returns
+    -------
+    float
+        max over tau of :func:`potential_energy` (u(tau)).
+    """
+    from scipy.optimize import minimize_scalar
+
+    tau = 2.0 * math.pi * np.arange(fine) / fine
+    energy = potential_energy(model, basis.evaluate(coefficients, tau))
+    best = int(np.argmax(energy))
+    step = 2.0 * math.pi / fine
+
+    def negative(t: float) -> float:
+        return -float(potential_energy(model, basis.evaluate(coefficients, np.array([t])))[0])
+
+    found = minimize_scalar(
+        negative,
+        bounds=(tau[best] - step, tau[best] + step),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
+    return max(float(energy[best]), -float(found.fun))

@@ -4,21 +4,25 @@ The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the for
 amplitude) by the same continuation as the exact shooting of
 :mod:`clearjoint.periodic`, and returned as the same
 :class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
-kept. Stability: for one DOF with constant damping from Hill's infinite
-determinant (one determinant per point); for a Structure from the exact monodromy
-of the HB orbit's piecewise-linear linearisation (:mod:`clearjoint.harmonic.monodromy`,
-no exponent to pick out of Hill's truncated spectrum), integrated when its joints
-carry friction (:func:`~clearjoint.harmonic.monodromy.integrated_monodromy`); for a
-Joint with friction from the eigenvalues of Hill's quadratic eigenproblem; events are located as in
+kept. Stability (``stability``): for one DOF with constant damping from Hill's infinite
+determinant (one determinant per point); for a Joint with friction from Hill's quadratic
+eigenproblem with the centroid sorting (:mod:`clearjoint.harmonic.hill`); for a Structure
+by default from the exact monodromy of the HB orbit's piecewise-linear linearisation
+(:mod:`clearjoint.harmonic.monodromy`), integrated when its joints carry friction
+(:func:`~clearjoint.harmonic.monodromy.integrated_monodromy`), since Hill's truncated
+eigenproblem disagrees with it on stiff contact (docs/harmonic.md, "Stability");
+``stability="hill"`` asks for Hill's method anyway. Events are located as in
 :mod:`clearjoint.periodic`: folds where the parameter component of the tangent
 changes sign, period doublings where prod(1 + mu) changes sign (a multiplier
-through -1), grazings where a joint's extreme relative displacement crosses a gap
-edge.
+through -1), Neimark-Sacker crossings where the largest modulus among the complex
+multipliers crosses 1, grazings where a joint's extreme relative displacement crosses a
+gap edge.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 from typing import Any, Literal
 
@@ -28,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import _checks
 from clearjoint.continuation import ContinuationSettings, continue_branch
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.harmonic import aft, check, monodromy, solve
+from clearjoint.harmonic import aft, check, hill, monodromy, solve
 from clearjoint.harmonic.solve import (
     TOLERANCE,
     SparseResidual,
@@ -48,6 +52,35 @@ from clearjoint.periodic import FrequencyResponse, ResponseEvent, _parameter_ran
 
 FloatArray = NDArray[np.float64]
 
+#: Progress of slow steps (the start's force continuation), at INFO; ``clearjoint frf``
+#: prints it on stderr.
+LOGGER = logging.getLogger("clearjoint.harmonic")
+
+#: The start's force continuation takes at most this many unknown-points (points times
+#: unknowns), between ``START_POINTS`` (40 and 2000) points: a 40-DOF structure at H = 15
+#: (1240 unknowns, about 1 s and 6 evaluations a point on 2 busy cores) gives up after 40.
+START_BUDGET = 50_000
+START_POINTS = (40, 2000)
+
+
+class NoPeriodicResponse(HarmonicError):
+    """No HB solution was found at the start of a curve (the message says how far the
+    force continuation got and what to try).
+
+    Attributes
+    ----------
+    omega : float
+        The start frequency, rad/s.
+    reached : float
+        The fraction of the force the start's force continuation reached (0 if it was
+        not tried).
+    """
+
+    def __init__(self, message: str, omega: float, reached: float) -> None:
+        super().__init__(message)
+        self.omega = omega
+        self.reached = reached
+
 
 def frequency_response(
     system: Any,
@@ -66,6 +99,7 @@ def frequency_response(
     max_step: float = 0.02,
     friction_regularization: float | None = None,
     check_points: int = 5,
+    stability: Literal["hill", "monodromy"] | None = None,
 ) -> FrequencyResponse:
     """Return the frequency-response curve by harmonic balance and continuation (MODEL.md 5.3).
 
@@ -122,6 +156,19 @@ def frequency_response(
         is not to be trusted), and the whole check is in ``settings["orbit_check"]``.
         0 skips the check; it is skipped (no ``"orbit_check"``) when a joint has
         friction, which the exact structure motion does not carry.
+    stability : {"hill", "monodromy"}, optional
+        How the Floquet multipliers are found. ``"hill"``: Hill's method (the
+        infinite determinant for one DOF without friction, else the quadratic
+        eigenproblem with centroid sorting, :func:`clearjoint.harmonic.hill.spectrum`;
+        a point where it finds fewer than 2N resolved exponents gets NaN multipliers
+        and an ``"untrusted"`` event; for a Structure each point is also checked
+        against the exact monodromy of its orbit, and one whose verdict differs gets
+        an ``"untrusted"`` event; ``settings["hill_defect"]`` holds each point's
+        shift defect). ``"monodromy"``: the exact monodromy of the HB orbit's
+        linearisation (:mod:`clearjoint.harmonic.monodromy`). Default: ``"hill"`` for
+        a Joint, ``"monodromy"`` for a Structure (on a 2-bay mast with stiff contact
+        Hill's method at H = 7 and 15 gives the other verdict at several points;
+        docs/harmonic.md, "Stability").
 
     Returns
     -------
@@ -158,6 +205,10 @@ def frequency_response(
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
     if isinstance(check_points, bool) or not isinstance(check_points, int) or check_points < 0:
         raise ParameterError(f"check_points must be an integer >= 0, got {check_points!r}")
+    if stability not in (None, "hill", "monodromy"):
+        raise ParameterError(
+            f"stability must be 'hill' or 'monodromy' (or None for the default), got {stability!r}"
+        )
     basis = aft.Basis.make(h, n_t)
     k_ref = model.reference_stiffness
 
@@ -227,6 +278,7 @@ def frequency_response(
         "samples": n_t,
         "damping_ratio": damping_ratio,
         "force_pattern": unit_force,
+        "stability": stability or ("hill" if model.is_joint else "monodromy"),
     }
     response = _response(
         model,
@@ -317,11 +369,13 @@ def _start_plain(
         jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
         return ev.residual / k_ref, jac / k_ref
 
+    hz = omega / (2.0 * math.pi)
     for stiffness in (model.open_stiffness(), model.closed_stiffness()):
         guess = linear_guess(model, basis, omega, force, stiffness)
         found = newton(function, guess, max(scale, float(np.max(np.abs(guess)))))
         if found is not None:
             return found[0]
+    reached = 0.0
     # Homotopy: from a force small enough for the open (all joints in free-play) linear
     # response to stay inside every gap, follow the solution up to the full force.
     open_guess = linear_guess(model, basis, omega, force, model.open_stiffness())
@@ -330,8 +384,29 @@ def _start_plain(
     room = np.minimum(model.g_c, model.g_t)
     if reach.size and np.all(np.isfinite(reach)) and np.max(reach) > 0.0 and np.all(room > 0):
         fraction = min(0.5 * float(np.min(room / np.maximum(reach, 1e-300))), 0.5)
+        peak = float(np.max(np.abs(force)))
+        points = int(np.clip(START_BUDGET // open_guess.size, *START_POINTS))
+        LOGGER.info(
+            "start at %.6g Hz: Newton from the linear responses found no orbit; following "
+            "the force up from %.3g N to %.3g N (at most %d points)",
+            hz,
+            fraction * peak,
+            peak,
+            points,
+        )
+        calls = [0, fraction]
 
         def residual(u: FloatArray, lam: float) -> tuple[FloatArray, Any, FloatArray, None]:
+            calls[0] += 1
+            calls[1] = max(calls[1], lam)
+            if calls[0] % 25 == 0:
+                LOGGER.info(
+                    "start at %.6g Hz: force continuation at %.3g N of %.3g N (%d evaluations)",
+                    hz,
+                    lam * peak,
+                    peak,
+                    calls[0],
+                )
             ev = aft.evaluate(model, basis, u, omega, lam * force, jacobian=sparse is None)
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * basis.harmonics + 1, -1)[2] = -force
@@ -350,7 +425,7 @@ def _start_plain(
                     step=0.01,
                     min_step=1e-7,
                     max_step=0.1,
-                    max_points=2000,
+                    max_points=points,
                     tolerance=TOLERANCE,
                     chord_parameter=sparse is not None,  # the sparse corrector and tangent
                 ),
@@ -359,9 +434,22 @@ def _start_plain(
             branch = None
         if branch is not None and branch.reason == "reached":
             return np.asarray(branch.u[-1], dtype=np.float64)
-    raise HarmonicError(
+        reached = float(calls[1]) if branch is None else float(np.max(branch.lam))
+        raise NoPeriodicResponse(
+            f"harmonic balance found no periodic response at omega_start = {omega!r} rad/s "
+            f"({hz:.6g} Hz): Newton from the linear responses failed and the force "
+            f"continuation reached only {reached * peak:.3g} N of {peak:.3g} N"
+            + ("" if branch is None else f" ({branch.reason} after {len(branch.lam)} points)")
+            + "; at this force there may be no periodic orbit (the joints may rattle): start "
+            "at a lower force or another frequency, or use the exact time response",
+            omega,
+            reached,
+        )
+    raise NoPeriodicResponse(
         f"harmonic balance found no periodic response at omega_start = {omega!r} rad/s; "
-        "start the curve at another frequency"
+        "start the curve at another frequency",
+        omega,
+        reached,
     )
 
 
@@ -380,6 +468,7 @@ def _response(
 ) -> FrequencyResponse:
     n_pts = lam.size
     n, n_c = model.n_dof, 2 * basis.harmonics + 1
+    by_hill = settings["stability"] == "hill"
     omega = lam.copy() if parameter == "omega" else np.full(n_pts, w0)
     peak = float(np.max(np.abs(pattern)))
     force = lam.copy() if parameter == "force" else np.full(n_pts, peak)
@@ -391,10 +480,13 @@ def _response(
     rel = np.einsum("pcn,jn->cpj", coef, b).reshape(n_c, -1)
     d_max, d_min = (v.reshape(n_pts, b.shape[0]) for v in basis.extremes(rel))
     multipliers = np.empty((n_pts, 2 * n), dtype=np.complex128)
-    determinant = n == 1 and model.friction_force is None
+    determinant = by_hill and n == 1 and model.friction_force is None
     jacobians = np.empty((n_pts, n_c, n_c)) if determinant else None
+    defect = np.zeros(n_pts)
+    unresolved: list[int] = []
+    disagree: list[tuple[int, float, float]] = []
     for i in range(n_pts):
-        if not model.is_joint:  # a structure: the monodromy of the orbit's linearisation
+        if not by_hill:  # the exact monodromy of the orbit's linearisation
             multipliers[i] = monodromy.multipliers(model, basis, coef[i], float(omega[i]))
             continue
         ev = evaluations[i] if i < len(evaluations) else None
@@ -404,16 +496,53 @@ def _response(
         if jacobians is not None:  # one DOF, constant damping: Hill's determinant
             jacobians[i] = ev.jacobian
             continue
-        lam_i = aft.hill_exponents(model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent)
-        multipliers[i] = aft.hill_multipliers(lam_i, float(omega[i]))
+        try:
+            found = hill.spectrum(model, basis, ev.jacobian, float(omega[i]), ev.velocity_tangent)
+        except HarmonicError:  # fewer than 2N resolved exponents: no verdict
+            multipliers[i] = np.nan
+            defect[i] = np.inf
+            unresolved.append(i)
+            continue
+        multipliers[i] = found.multipliers
+        defect[i] = found.defect
+        if not model.is_joint:  # cross-check against the exact monodromy of the same orbit
+            exact = float(np.max(np.abs(monodromy.multipliers(model, basis, coef[i], omega[i]))))
+            mine = float(np.max(np.abs(found.multipliers)))
+            if (mine < 1.0) != (exact < 1.0):
+                disagree.append((i, mine, exact))
     if jacobians is not None:
         multipliers[:] = aft.hill_determinant_multipliers(model, basis, jacobians, omega)
+    if by_hill:
+        settings["hill_defect"] = defect
     stable = np.max(np.abs(multipliers), axis=1) < 1.0
     amplitude = 0.5 * (x_max - x_min)
     x0 = coef[:, 0, :] + coef[:, 1::2, :].sum(axis=1)
     v0 = omega[:, None] * np.einsum("c,pcn->pn", _velocity_row(basis), coef)
     initial = np.concatenate((x0, v0), axis=1)
     events = _events(model, lam, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1))
+    events += [
+        ResponseEvent(
+            "untrusted",
+            float(omega[i]),
+            float(force[i]),
+            float(np.max(amplitude[i])),
+            f"Hill's eigenproblem at H = {basis.harmonics} resolves fewer than the 2N = {2 * n} "
+            "exponents: no stability verdict here; raise harmonics or use stability='monodromy'",
+        )
+        for i in unresolved
+    ]
+    events += [
+        ResponseEvent(
+            "untrusted",
+            float(omega[i]),
+            float(force[i]),
+            float(np.max(amplitude[i])),
+            f"Hill's largest multiplier {mine:.4g} and the exact monodromy's {exact:.4g} of the "
+            "same orbit give other verdicts (the perturbation needs more harmonics than "
+            "the orbit); use stability='monodromy'",
+        )
+        for i, mine, exact in disagree
+    ]
     if model.is_joint:
         x_max, x_min, amplitude, coef_out = x_max[:, 0], x_min[:, 0], amplitude[:, 0], coef[:, :, 0]
     else:
@@ -494,6 +623,20 @@ def _turning_points(lam: FloatArray, tolerance: float) -> list[int]:
     return points
 
 
+#: A multiplier counts as one of a complex pair when abs(Im mu) exceeds this fraction of abs(mu).
+COMPLEX_PAIR = 1e-3
+
+
+def _complex_pair_test(multipliers: NDArray[np.complex128]) -> FloatArray:
+    """Largest abs(mu) - 1 over each point's complex multipliers (NaN where it has none):
+    its sign change between two points with as many complex multipliers is a
+    Neimark-Sacker crossing (a complex pair through the unit circle)."""
+    mag = np.abs(multipliers)
+    pair = np.abs(multipliers.imag) > COMPLEX_PAIR * mag
+    top = np.max(np.where(pair, mag, -np.inf), axis=1)
+    return np.where(np.isfinite(top), top - 1.0, np.nan)
+
+
 def _events(
     model: LinearSystem,
     lam: FloatArray,
@@ -504,10 +647,11 @@ def _events(
     force: FloatArray,
     amplitude: FloatArray,
 ) -> list[ResponseEvent]:
-    """Folds, period doublings and grazings between successive points.
+    """Folds, period doublings, Neimark-Sacker crossings and grazings between successive points.
 
-    Period doublings and grazings are located linearly between the points where
-    their test function changes sign. Folds are the points where the parameter
+    Period doublings, Neimark-Sacker crossings (:func:`_complex_pair_test`) and
+    grazings are located linearly between the points where their test function
+    changes sign. Folds are the points where the parameter
     turns back by more than ``FOLD_TOLERANCE`` of its largest value: the sampled
     law makes the HB branch zigzag by about 1e-4 of the parameter where it is
     nearly flat at a fold (each sample crossing a gap edge is a tiny kink), and
@@ -523,13 +667,23 @@ def _events(
             np.prod(1.0 + multipliers, axis=1).real,
             "a multiplier passes -1: a period-2 branch is born here (not followed)",
         ),
+        (
+            "neimark_sacker",
+            _complex_pair_test(multipliers),
+            "a complex pair of multipliers crosses the unit circle: a quasi-periodic "
+            "motion (torus) is born here (not followed)",
+        ),
     ]
     for j in range(model.directions.shape[0]):
         name = "" if model.is_joint else f" of joint {j}"
         tests.append(("grazing", d_max[:, j] - model.g_c[j], f"touches the compression edge{name}"))
         tests.append(("grazing", -model.g_t[j] - d_min[:, j], f"touches the tension edge{name}"))
+    mag = np.abs(multipliers)
+    pairs = np.sum(np.abs(multipliers.imag) > COMPLEX_PAIR * mag, axis=1)
     for kind, g, note in tests:
         for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
+            if kind == "neimark_sacker" and pairs[i] != pairs[i + 1]:
+                continue  # a pair met the real axis in between: not a crossing of one pair
             frac = float(g[i] / (g[i] - g[i + 1]))
 
             def lerp(a: FloatArray, i: int = int(i), frac: float = frac) -> float:

@@ -22,6 +22,21 @@ from clearjoint.identify.segments import STAGE_COMPRESSION, STAGE_FREE, STAGE_TE
 #: its friction force (:meth:`Identification.stage_runs`).
 DAMPER_FREE_PLAY_FRACTION = 0.2
 
+
+def damper_stages(force: FloatArray, friction: float) -> NDArray[np.int8]:
+    """A damper's stage per sample (n,), from its restoring force ``force`` (n,), N.
+
+    Free play (0) where abs(F) is below ``DAMPER_FREE_PLAY_FRACTION`` of ``friction``,
+    compression (1) above it, tension (-1) below its negative: a damper plays free after
+    each reversal, wherever the displacement is.
+    """
+    level = DAMPER_FREE_PLAY_FRACTION * friction
+    stage = np.full(force.shape, STAGE_FREE, dtype=np.int8)
+    stage[force > level] = STAGE_COMPRESSION
+    stage[force < -level] = STAGE_TENSION
+    return stage
+
+
 if TYPE_CHECKING:
     import pandas as pd
     import xarray as xr
@@ -248,18 +263,15 @@ class Identification:
     def stage_runs(self, time: FloatArray) -> list[tuple[str, float, float]]:
         """The stages as (name, start, end) runs over the record's time, for figures.
 
-        A clearance joint's stages follow the displacement (inside the gap edges or
-        beyond). A friction damper with backlash plays free after each reversal, not at
-        the zero crossings: its stages follow the restoring force, free play where
-        abs(F) is below ``DAMPER_FREE_PLAY_FRACTION`` of the identified friction force,
-        compression where F is above it and tension below its negative.
+        The runs of :attr:`stage`: a clearance joint's stages follow the displacement
+        (inside the gap edges or beyond). A friction damper with backlash plays free after
+        each reversal, not at the zero crossings: its stages follow the restoring force,
+        free play where abs(F) is below ``DAMPER_FREE_PLAY_FRACTION`` of the identified
+        friction force, compression where F is above it and tension below its negative.
         """
         stage = self.stage
         if self.model == "damper":
-            force = self.restoring_force
-            level = DAMPER_FREE_PLAY_FRACTION * self.summary["friction_force_n"]
-            beyond = np.where(force < -level, STAGE_TENSION, STAGE_FREE)
-            stage = np.where(force > level, STAGE_COMPRESSION, beyond)
+            stage = damper_stages(self.restoring_force, self.summary["friction_force_n"])
         names = {
             STAGE_FREE: "free-play",
             STAGE_COMPRESSION: "compression",

@@ -1,0 +1,53 @@
+"""The start of a harmonic-balance curve (harmonic.response._start): its force continuation
+has a limit, reports progress, and ends in one clear error when it finds no orbit."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+
+from clearjoint import ClearanceJoint
+from clearjoint.harmonic import HarmonicError, frequency_response, response
+from clearjoint.structure import Structure, chain
+
+FORCE = np.array([0.0, 0.0, 40.0])
+#: At 800 rad/s Newton from the linear responses misses this chain's orbit; the start's
+#: force continuation reaches it in 45 points (measured).
+OMEGA = 800.0
+
+
+@pytest.fixture(scope="module")
+def three_links() -> Structure:
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+
+
+def test_the_force_continuation_reports_progress_and_finds_the_start(
+    three_links: Structure, caplog: pytest.LogCaptureFixture
+) -> None:
+    with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
+        curve = frequency_response(three_links, FORCE, OMEGA, 810.0, max_points=3, check_points=0)
+    assert curve.force_amplitude[0] == pytest.approx(40.0)
+    lines = [r.getMessage() for r in caplog.records if r.name == "clearjoint.harmonic"]
+    assert "following the force up" in lines[0]
+    assert "at most 1111 points" in lines[0]  # START_BUDGET // 45 unknowns
+    assert any("force continuation at" in line for line in lines[1:])
+
+
+def test_a_start_past_the_limit_is_one_clear_error(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(response, "START_POINTS", (10, 10))
+    with pytest.raises(response.NoPeriodicResponse) as info:
+        frequency_response(three_links, FORCE, OMEGA, 810.0, max_points=3, check_points=0)
+    error = info.value
+    assert isinstance(error, HarmonicError)
+    assert error.omega == OMEGA
+    assert 0.0 < error.reached < 1.0
+    message = str(error)
+    assert "\n" not in message
+    assert "max_points after 10 points" in message
+    assert f"reached only {error.reached * 40:.3g} N of 40 N" in message
+    assert "start at a lower force" in message
