@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from clearjoint import Joint
+from clearjoint import ClearjointError, Joint
 from clearjoint.harmonic import frequency_response
 
 JOINT = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_stiffness=1.0)
@@ -307,6 +307,45 @@ def example_mast(bays: int) -> tuple[Any, np.ndarray]:
 MAST_SIZES = "5:7,10:7,20:7,40:7,10:3,10:15"
 
 
+def _curve_lines(
+    fr: Any,
+    bays: int,
+    h: int,
+    s: Any,
+    unknowns: int,
+    took: float,
+    points: int,
+    asked: int,
+    summary: list[str],
+) -> float:
+    """Print one mast curve's lines (--mast-sizes) and add its summary; its s a point."""
+    f_open = float(s.modes("open").omega[0])
+    f_closed = float(s.modes("closed").omega[0])
+    hz = fr.omega / (2 * math.pi)
+    per_point = took / fr.omega.size
+    print(
+        f"  {bays:2d} bays ({s.n_dof} DOF, {unknowns} unknowns), H = {h:2d}: curve "
+        f"{fr.omega.size} points in {took:8.1f} s ({took / fr.omega.size:.3f} s/point), "
+        f"{hz.min():.3f} to {hz.max():.3f} Hz (open {f_open / (2 * math.pi):.3f}, closed "
+        f"{f_closed / (2 * math.pi):.3f}), {int(np.sum(~fr.stable))} unstable, "
+        f"load {os.getloadavg()[0]:.2f}",
+        flush=True,
+    )
+    ended = (
+        f"all {points} points asked"
+        if fr.omega.size == points
+        else f"{fr.omega.size} of {points} points: {fr.stop_reason}"
+    )
+    if points < asked:
+        ended += f", capped from {asked}"
+    print(f"      curve stop: {fr.stop_reason} ({ended})", flush=True)
+    summary.append(
+        f"{bays:2d} bays, H = {h:2d}: curve {fr.omega.size} points {took:.1f} s "
+        f"({took / fr.omega.size:.3f} s/point; {ended})"
+    )
+    return per_point
+
+
 def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
     """The example mast's cost against bays and H: the frequency response (``points``
     points from 0.8 times the open first mode, the study's force pattern scaled to
@@ -330,38 +369,24 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
         f_closed = float(s.modes("closed").omega[0])
         unknowns = (2 * h + 1) * s.n_dof
         start = time.perf_counter()
-        fr = frequency_response(
-            s,
-            force,
-            0.8 * f_open,
-            1.2 * f_closed,
-            harmonics=h,
-            max_points=points,
-            max_step=MAST_MAX_STEP,
-        )
-        took = time.perf_counter() - start
-        hz = fr.omega / (2 * math.pi)
-        per_point = took / fr.omega.size
-        print(
-            f"  {bays:2d} bays ({s.n_dof} DOF, {unknowns} unknowns), H = {h:2d}: curve "
-            f"{fr.omega.size} points in {took:8.1f} s ({took / fr.omega.size:.3f} s/point), "
-            f"{hz.min():.3f} to {hz.max():.3f} Hz (open {f_open / (2 * math.pi):.3f}, closed "
-            f"{f_closed / (2 * math.pi):.3f}), {int(np.sum(~fr.stable))} unstable, "
-            f"load {os.getloadavg()[0]:.2f}",
-            flush=True,
-        )
-        ended = (
-            f"all {points} points asked"
-            if fr.omega.size == points
-            else f"{fr.omega.size} of {points} points: {fr.stop_reason}"
-        )
-        if points < asked:
-            ended += f", capped from {asked}"
-        print(f"      curve stop: {fr.stop_reason} ({ended})", flush=True)
-        summary.append(
-            f"{bays:2d} bays, H = {h:2d}: curve {fr.omega.size} points {took:.1f} s "
-            f"({took / fr.omega.size:.3f} s/point; {ended})"
-        )
+        try:
+            fr = frequency_response(
+                s,
+                force,
+                0.8 * f_open,
+                1.2 * f_closed,
+                harmonics=h,
+                max_points=points,
+                max_step=MAST_MAX_STEP,
+            )
+        except ClearjointError as error:  # no start found (e.g. the start's budget): say so
+            took = time.perf_counter() - start
+            print(f"  {bays:2d} bays, H = {h:2d}: no curve after {took:.1f} s: {error}")
+            summary.append(f"{bays:2d} bays, H = {h:2d}: no curve ({took:.1f} s): {error}")
+            fr = None
+        if fr is not None:
+            took = time.perf_counter() - start
+            per_point = _curve_lines(fr, bays, h, s, unknowns, took, points, asked, summary)
         amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
         start = time.perf_counter()
         nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
@@ -374,7 +399,7 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
             flush=True,
         )
         summary[-1] += f"; mode 50 amplitudes {took:.1f} s ({int(nm.converged.sum())} converged)"
-        if points < asked:
+        if points < asked and fr is not None:
             summary[-1] += (
                 f"; capped at {points} of {asked} points: {asked} would take about "
                 f"{asked * per_point / 60:.0f} min at its {per_point:.1f} s a point"
