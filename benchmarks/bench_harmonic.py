@@ -15,6 +15,15 @@ are shared and threaded BLAS on 25 x 25 matrices only adds waiting.
 
 It also prints the peak, both folds, and how the time grows with H.
 
+    python benchmarks/bench_harmonic.py --issue --pyharm /work/venv-pyharm/bin/python
+
+runs the issue's whole speed section in one run (docs/harmonic.md, "Speed"): pyHarm's
+case and its ratio, then the example mast's 300-point curve and 50-amplitude first mode
+at 10 bays, H = 7, and the same for 5, 20, 40 bays (H = 7) and H = 3, 15 (10 bays), each
+curve's stop reason said; the 40-bay curve is capped at 20 points (ISSUE_SIZES), with
+the time 300 would take. ``--old-src OLD/src`` times the 10-bay curve with another src
+tree and this one in turn (a before/after ratio in one run).
+
     python benchmarks/bench_harmonic.py --mast [--mast-points 300]
 
 times the planar mast (clearjoint.structure.mast, hinge joints ClearanceJoint(1e-4, 1e8,
@@ -45,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from clearjoint import Joint
+from clearjoint import ClearjointError, Joint
 from clearjoint.harmonic import frequency_response
 
 JOINT = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_stiffness=1.0)
@@ -298,7 +307,46 @@ def example_mast(bays: int) -> tuple[Any, np.ndarray]:
 MAST_SIZES = "5:7,10:7,20:7,40:7,10:3,10:15"
 
 
-def mast_sizes(sizes: str, points: int, force_n: float) -> None:
+def _curve_lines(
+    fr: Any,
+    bays: int,
+    h: int,
+    s: Any,
+    unknowns: int,
+    took: float,
+    points: int,
+    asked: int,
+    summary: list[str],
+) -> float:
+    """Print one mast curve's lines (--mast-sizes) and add its summary; its s a point."""
+    f_open = float(s.modes("open").omega[0])
+    f_closed = float(s.modes("closed").omega[0])
+    hz = fr.omega / (2 * math.pi)
+    per_point = took / fr.omega.size
+    print(
+        f"  {bays:2d} bays ({s.n_dof} DOF, {unknowns} unknowns), H = {h:2d}: curve "
+        f"{fr.omega.size} points in {took:8.1f} s ({took / fr.omega.size:.3f} s/point), "
+        f"{hz.min():.3f} to {hz.max():.3f} Hz (open {f_open / (2 * math.pi):.3f}, closed "
+        f"{f_closed / (2 * math.pi):.3f}), {int(np.sum(~fr.stable))} unstable, "
+        f"load {os.getloadavg()[0]:.2f}",
+        flush=True,
+    )
+    ended = (
+        f"all {points} points asked"
+        if fr.omega.size == points
+        else f"{fr.omega.size} of {points} points: {fr.stop_reason}"
+    )
+    if points < asked:
+        ended += f", capped from {asked}"
+    print(f"      curve stop: {fr.stop_reason} ({ended})", flush=True)
+    summary.append(
+        f"{bays:2d} bays, H = {h:2d}: curve {fr.omega.size} points {took:.1f} s "
+        f"({took / fr.omega.size:.3f} s/point; {ended})"
+    )
+    return per_point
+
+
+def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
     """The example mast's cost against bays and H: the frequency response (``points``
     points from 0.8 times the open first mode, the study's force pattern scaled to
     ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes), one line each."""
@@ -310,33 +358,35 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> None:
         f"{MAST_MAX_STEP}; modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
     )
     print(f"  load before: {os.getloadavg()[0]:.2f} (1-min average)")
+    summary: list[str] = []
     for item in sizes.split(","):
-        bays, h = (int(v) for v in item.split(":"))
+        bays, h, *cap = (int(v) for v in item.split(":"))
+        asked = points
+        points = min(points, cap[0]) if cap else points
         s, pattern = example_mast(bays)
         force = pattern * (force_n / float(np.max(np.abs(pattern))))
         f_open = float(s.modes("open").omega[0])
         f_closed = float(s.modes("closed").omega[0])
         unknowns = (2 * h + 1) * s.n_dof
         start = time.perf_counter()
-        fr = frequency_response(
-            s,
-            force,
-            0.8 * f_open,
-            1.2 * f_closed,
-            harmonics=h,
-            max_points=points,
-            max_step=MAST_MAX_STEP,
-        )
-        took = time.perf_counter() - start
-        hz = fr.omega / (2 * math.pi)
-        print(
-            f"  {bays:2d} bays ({s.n_dof} DOF, {unknowns} unknowns), H = {h:2d}: curve "
-            f"{fr.omega.size} points in {took:8.1f} s ({took / fr.omega.size:.3f} s/point), "
-            f"{hz.min():.3f} to {hz.max():.3f} Hz (open {f_open / (2 * math.pi):.3f}, closed "
-            f"{f_closed / (2 * math.pi):.3f}), {int(np.sum(~fr.stable))} unstable, "
-            f"load {os.getloadavg()[0]:.2f}",
-            flush=True,
-        )
+        try:
+            fr = frequency_response(
+                s,
+                force,
+                0.8 * f_open,
+                1.2 * f_closed,
+                harmonics=h,
+                max_points=points,
+                max_step=MAST_MAX_STEP,
+            )
+        except ClearjointError as error:  # no start found (e.g. the start's budget): say so
+            took = time.perf_counter() - start
+            print(f"  {bays:2d} bays, H = {h:2d}: no curve after {took:.1f} s: {error}")
+            summary.append(f"{bays:2d} bays, H = {h:2d}: no curve ({took:.1f} s): {error}")
+            fr = None
+        if fr is not None:
+            took = time.perf_counter() - start
+            per_point = _curve_lines(fr, bays, h, s, unknowns, took, points, asked, summary)
         amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
         start = time.perf_counter()
         nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
@@ -348,6 +398,14 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> None:
             f"{int(nm.converged.sum())}/50 converged, {span}, load {os.getloadavg()[0]:.2f}",
             flush=True,
         )
+        summary[-1] += f"; mode 50 amplitudes {took:.1f} s ({int(nm.converged.sum())} converged)"
+        if points < asked and fr is not None:
+            summary[-1] += (
+                f"; capped at {points} of {asked} points: {asked} would take about "
+                f"{asked * per_point / 60:.0f} min at its {per_point:.1f} s a point"
+            )
+        points = asked
+    return summary
 
 
 def mast_decay(bays: int, beta: float, cycles: int) -> None:
@@ -631,6 +689,140 @@ def samples_error() -> None:
         print(f"  H = {h}: " + ", ".join(row))
 
 
+def pyharm_part(python: str | None) -> float | None:
+    """pyHarm's SDOF clearance case, H = 12: our curve, pyHarm's, and the ratio (or None)."""
+    print(f"pyHarm SDOF clearance case, H = {H}, omega 0.05 to 1.8 rad/s")
+    first, second, curve = ours(H, 512, PYHARM_MAX_STEP)
+    print(
+        f"clearjoint.harmonic (N_t = 512, as pyHarm): {curve.omega.size} points, "  # type: ignore[attr-defined]
+        f"first call {first:.3f} s, best of {REPEATS - 1} more {second:.3f} s"
+    )
+    print(describe("  clearjoint", curve.omega, curve.amplitude))  # type: ignore[attr-defined]
+    for e in curve.events:  # type: ignore[attr-defined]
+        print(f"  {e.kind}: omega = {e.omega:.4f} rad/s, X = {e.amplitude:.4f}")
+    if python:
+        ph = pyharm(python, H)
+        if not ph:
+            print(
+                f"pyHarm did not finish within {PYHARM_TIMEOUT} s "
+                "(it sometimes stalls after the fold)"
+            )
+            return None
+        om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])
+        print(
+            f"pyHarm (nti = 512): {ph['points']} points, first call {ph['first_s']:.3f} s, "
+            f"best of {REPEATS - 1} more {ph['best_s']:.3f} s"
+        )
+        print(describe("  pyHarm", om, amp))
+        # the load of the shared machine drifts: time ours again after pyHarm and compare
+        # with the slower of our two best times (the ratio that favours pyHarm)
+        _, again, _ = ours(H, 512, PYHARM_MAX_STEP)
+        print(f"clearjoint.harmonic again after pyHarm: best of {REPEATS - 1} {again:.3f} s")
+        second = max(second, again)
+        ratio = float(ph["best_s"]) / second  # type: ignore[arg-type]
+        per_point = (float(ph["best_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
+            second / curve.omega.size  # type: ignore[attr-defined]
+        )
+        print(f"ratio pyHarm / clearjoint (whole curve, best warm call): {ratio:.2f}x")
+        print(f"ratio per point: {per_point:.2f}x")
+    else:
+        print("pyHarm not run (give --pyharm PYTHON to compare)")
+        return None
+    return ratio
+
+
+#: The issue's sizes, the 10-bay H = 7 mast first (the issue's mast part), then the growth
+#: (BAYS:H[:most points]): the 40-bay curve capped at 20 points, since its stability (the
+#: monodromy's 320 x 320 matrix exponentials, about 250 a point) costs about 10 s a point.
+ISSUE_SIZES = "10:7,5:7,20:7,10:3,10:15,40:7:20"
+#: The start's force homotopy may take this many points at least in --issue (see there).
+ISSUE_START_POINTS = 200
+
+
+def issue_run(python: str | None, points: int) -> None:
+    """The issue's speed section in one run: pyHarm's case, then the mast and its growth."""
+    started = time.perf_counter()
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    ratio = pyharm_part(python)
+    print(flush=True)
+    from clearjoint.harmonic import response
+
+    # the start's force homotopy stops after START_BUDGET // unknowns points (at least
+    # START_POINTS[0] = 40): the 40-bay mast's start needs 102 (measured), so these runs
+    # allow up to ISSUE_START_POINTS; said here, since a user's default would refuse it
+    floor, top = response.START_POINTS
+    response.START_POINTS = (max(floor, ISSUE_START_POINTS), max(top, ISSUE_START_POINTS))
+    print(
+        f"the start's force homotopy allowed {response.START_POINTS[0]} points at least "
+        f"(harmonic.response.START_POINTS, default {floor}): the 40-bay start needs about 100"
+    )
+    summary = mast_sizes(ISSUE_SIZES, points, MAST_FORCE_N)
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    print("summary (one run):")
+    shown = "not run" if ratio is None else f"{ratio:.2f}x (target 10x)"
+    print(f"  pyHarm's SDOF case, H = {H}, whole curve: pyHarm / clearjoint {shown}")
+    for line in summary:
+        print(f"  mast {line}")
+    print(f"  whole run {time.perf_counter() - started:.0f} s", flush=True)
+
+
+def one_curve(bays: int, points: int) -> None:
+    """Time one mast curve (as --mast-sizes) after a 2-point warm-up; print it as JSON."""
+    import clearjoint
+
+    s, pattern = example_mast(bays)
+    force = pattern * (MAST_FORCE_N / float(np.max(np.abs(pattern))))
+    f_open = float(s.modes("open").omega[0])
+    f_closed = float(s.modes("closed").omega[0])
+    options: dict[str, Any] = {"harmonics": 7, "max_step": MAST_MAX_STEP}
+    frequency_response(s, force, 0.8 * f_open, 1.2 * f_closed, max_points=2, **options)
+    wall, cpu = time.perf_counter(), time.process_time()
+    fr = frequency_response(s, force, 0.8 * f_open, 1.2 * f_closed, max_points=points, **options)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    print(
+        json.dumps(
+            {
+                "src": str(Path(clearjoint.__file__).parents[1]),
+                "points": int(fr.omega.size),
+                "wall": wall,
+                "cpu": cpu,
+                "unstable": int(np.sum(~fr.stable)),
+                "omega": fr.omega.tolist(),
+            }
+        )
+    )
+
+
+def old_against_new(old_src: str, bays: int, points: int) -> None:
+    """The same mast curve timed with another clearjoint src tree and this one, in turn."""
+    runs = {}
+    for src in (old_src, str(Path(__file__).resolve().parents[1] / "src")):
+        env = dict(os.environ, PYTHONPATH=src)
+        done = subprocess.run(
+            [sys.executable, __file__, "--one-curve", f"{bays}:{points}"],
+            capture_output=True,
+            text=True,
+            check=True,
+            env=env,
+        )
+        runs[src] = json.loads(done.stdout.strip().splitlines()[-1])
+        r = runs[src]
+        print(
+            f"  {r['src']}: {r['points']} points, {r['wall']:.1f} s wall, {r['cpu']:.1f} s CPU, "
+            f"{r['unstable']} unstable",
+            flush=True,
+        )
+    old, new = runs.values()
+    same = min(len(old["omega"]), len(new["omega"]))
+    gap = np.abs(np.array(old["omega"][:same]) - np.array(new["omega"][:same]))
+    first = int(np.argmax(gap > 1e-9 * np.array(old["omega"][:same])))
+    print(
+        f"{bays} bays, H = 7, {points} points: old / this tree {old['wall'] / new['wall']:.2f}x "
+        f"wall, {old['cpu'] / new['cpu']:.2f}x CPU; the points agree in w to 1e-9 up to "
+        f"point {first if gap.max() > 0 else same}"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
@@ -659,7 +851,28 @@ def main() -> None:
     parser.add_argument("--mast-shoot", type=float, metavar="N", help="exact orbit near HB at N")
     parser.add_argument("--at", default="0.9,1.28", help="Hz list for --mast-orders/--mast-shoot")
     parser.add_argument("--hill-sorting", action="store_true", help="Hill's exponent picks")
+    parser.add_argument(
+        "--issue",
+        action="store_true",
+        help="the issue's speed section in one run: pyHarm's case (with --pyharm), the 10-bay "
+        f"mast (H = 7, --mast-points points, 50 amplitudes) and its growth ({ISSUE_SIZES})",
+    )
+    parser.add_argument(
+        "--old-src",
+        help="time the 10-bay mast's curve (--mast-points) with another clearjoint src tree "
+        "(e.g. main's: git archive main src | tar -x -C OLD) and with this one, in turn",
+    )
+    parser.add_argument("--one-curve", help=argparse.SUPPRESS)  # BAYS:POINTS, for --old-src
     args = parser.parse_args()
+    if args.one_curve:
+        one_curve(*(int(v) for v in args.one_curve.split(":")))
+        return
+    if args.old_src:
+        old_against_new(args.old_src, 10, args.mast_points)
+        return
+    if args.issue:
+        issue_run(args.pyharm, args.mast_points)
+        return
     if args.hill_sorting:
         hill_sorting()
         return
@@ -689,42 +902,7 @@ def main() -> None:
     if args.mast:
         mast_benchmarks(args.mast_points)
         return
-    print(f"pyHarm SDOF clearance case, H = {H}, omega 0.05 to 1.8 rad/s")
-    first, second, curve = ours(H, 512, PYHARM_MAX_STEP)
-    print(
-        f"clearjoint.harmonic (N_t = 512, as pyHarm): {curve.omega.size} points, "  # type: ignore[attr-defined]
-        f"first call {first:.3f} s, best of {REPEATS - 1} more {second:.3f} s"
-    )
-    print(describe("  clearjoint", curve.omega, curve.amplitude))  # type: ignore[attr-defined]
-    for e in curve.events:  # type: ignore[attr-defined]
-        print(f"  {e.kind}: omega = {e.omega:.4f} rad/s, X = {e.amplitude:.4f}")
-    if args.pyharm:
-        ph = pyharm(args.pyharm, H)
-        if not ph:
-            print(
-                f"pyHarm did not finish within {PYHARM_TIMEOUT} s "
-                "(it sometimes stalls after the fold)"
-            )
-            return
-        om, amp = np.array(ph["omega"]), np.array(ph["amplitude"])
-        print(
-            f"pyHarm (nti = 512): {ph['points']} points, first call {ph['first_s']:.3f} s, "
-            f"best of {REPEATS - 1} more {ph['best_s']:.3f} s"
-        )
-        print(describe("  pyHarm", om, amp))
-        # the load of the shared machine drifts: time ours again after pyHarm and compare
-        # with the slower of our two best times (the ratio that favours pyHarm)
-        _, again, _ = ours(H, 512, PYHARM_MAX_STEP)
-        print(f"clearjoint.harmonic again after pyHarm: best of {REPEATS - 1} {again:.3f} s")
-        second = max(second, again)
-        ratio = float(ph["best_s"]) / second  # type: ignore[arg-type]
-        per_point = (float(ph["best_s"]) / float(ph["points"])) / (  # type: ignore[arg-type]
-            second / curve.omega.size  # type: ignore[attr-defined]
-        )
-        print(f"ratio pyHarm / clearjoint (whole curve, best warm call): {ratio:.2f}x")
-        print(f"ratio per point: {per_point:.2f}x")
-    else:
-        print("pyHarm not run (give --pyharm PYTHON to compare)")
+    pyharm_part(args.pyharm)
     print("growth with H (default N_t = 32 (2H + 1) rounded up to a power of two):")
     for h in (3, 7, 12, 15, 31):
         _, warm, c = ours(h, None, PYHARM_MAX_STEP)

@@ -162,3 +162,25 @@ def test_a_step_past_the_end_with_no_point_there_is_not_called_reached() -> None
     assert branch.reason.startswith("passed the end of the range (lambda = 1)")
     assert f"ends at lambda = {branch.lam[-1]:.10g}" in branch.reason
     assert np.max(np.abs(branch.u[:, 0] - branch.lam)) < 1e-9
+
+
+def test_sparse_tangent_is_the_dense_one() -> None:
+    """A scipy sparse [dR/du, dR/dlam] (from a residual's own corrector) gets its null
+    vector by a sparse LU: the same unit tangent, same orientation, as the dense solve;
+    and the null vector it finds is one (a t = 0)."""
+    import scipy.sparse
+
+    from clearjoint import continuation as cont
+
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(40, 41)) * (rng.random((40, 41)) < 0.2)
+    a[np.arange(40), np.arange(40)] += 5.0
+    previous = rng.normal(size=41)
+    dense = cont._tangent(a, previous)
+    sparse = cont._tangent(scipy.sparse.csr_matrix(a), previous)
+    np.testing.assert_allclose(sparse, dense, rtol=0.0, atol=1e-13)
+    assert abs(float(np.linalg.norm(sparse)) - 1.0) < 1e-14
+    assert float(sparse @ previous) > 0.0
+    assert float(np.max(np.abs(a @ sparse))) < 1e-12
+    flipped = cont._tangent(scipy.sparse.csr_matrix(a), -previous)
+    np.testing.assert_allclose(flipped, -dense, rtol=0.0, atol=1e-13)

@@ -255,11 +255,45 @@ def _tangent_solve(a: FloatArray, previous: FloatArray, t: FloatArray) -> bool:
     return True
 
 
-def _tangent(a: FloatArray, previous: FloatArray) -> FloatArray:
-    """Unit null vector of the (d, d+1) matrix ``a``, oriented along ``previous``."""
+def _tangent(a: Any, previous: FloatArray) -> FloatArray:
+    """Unit null vector of the (d, d+1) matrix ``a``, oriented along ``previous``.
+
+    ``a`` is dense, or a scipy sparse matrix when a residual's own corrector returns
+    one (a structure's harmonic balance): then :func:`_sparse_tangent`.
+    """
+    if not isinstance(a, np.ndarray):
+        return _sparse_tangent(a, previous)
     t = np.empty(a.shape[1])
     if not _tangent_solve(np.ascontiguousarray(a, dtype=np.float64), previous, t):
         _, _, vt = np.linalg.svd(a)
+        t = vt[-1] / np.linalg.norm(vt[-1])
+    unit: FloatArray = np.asarray(t, dtype=np.float64)
+    return unit if float(unit @ previous) >= 0.0 else np.asarray(-unit, dtype=np.float64)
+
+
+def _sparse_tangent(a: Any, previous: FloatArray) -> FloatArray:
+    """:func:`_tangent` for a scipy sparse ``a``: [a; previous] t = e_last by a sparse LU.
+
+    The same bordered system as the dense route, factored by scipy's splu (SuperLU);
+    a singular one falls back to the dense SVD, as there.
+    """
+    import scipy.sparse
+    import scipy.sparse.linalg
+
+    d = a.shape[0]
+    matrix = scipy.sparse.vstack((a, scipy.sparse.csr_matrix(previous[None, :])), format="csc")
+    rhs = np.zeros(d + 1)
+    rhs[d] = 1.0
+    t: FloatArray | None = None
+    try:
+        solved = np.asarray(scipy.sparse.linalg.splu(matrix).solve(rhs), dtype=np.float64)
+        norm = float(np.linalg.norm(solved))
+        if norm > 0.0 and math.isfinite(norm):
+            t = solved / norm
+    except RuntimeError:  # "Factor is exactly singular"
+        pass
+    if t is None:
+        _, _, vt = np.linalg.svd(a.toarray())
         t = vt[-1] / np.linalg.norm(vt[-1])
     unit: FloatArray = np.asarray(t, dtype=np.float64)
     return unit if float(unit @ previous) >= 0.0 else np.asarray(-unit, dtype=np.float64)

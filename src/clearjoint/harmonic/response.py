@@ -223,24 +223,27 @@ def frequency_response(
     # a structure's stability comes from the monodromy, not from the evaluation: do not
     # keep one per point (each holds a dense Jacobian: 46 MB at 40 bays, H = 7)
     keep = model.is_joint
+    # a large structure: its Jacobian assembled sparse, and the corrector's bordered solves
+    # and the tangent by sparse LU (continuation hands them to the residual's own corrector
+    # when chord_parameter is set)
+    sparse = not model.is_joint and q0.size > solve.SPARSE_ABOVE
+    sparse_jacobian = solve.SparseJacobian(model, basis) if sparse else None
 
-    def residual(
-        u: FloatArray, lam: float
-    ) -> tuple[FloatArray, FloatArray, FloatArray, aft.Evaluation | None]:
+    def residual(u: FloatArray, lam: float) -> tuple[FloatArray, Any, FloatArray, Any]:
         if not lam > 0.0:
             raise HarmonicError(f"the parameter left the positive range ({lam!r})")
         w, f = at(lam)
-        ev = aft.evaluate(model, basis, u, w, f)
+        ev = aft.evaluate(model, basis, u, w, f, jacobian=sparse_jacobian is None)
         if parameter == "omega":
             d_lam = ev.d_omega
         else:
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * h + 1, -1)[2] = -unit_force
+        if sparse_jacobian is not None:
+            jac = sparse_jacobian(ev, w, model.damping) * (1.0 / k_ref)
+            return ev.residual / k_ref, jac, d_lam / k_ref, None
         return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, ev if keep else None
 
-    # a large structure: the corrector's bordered solves by sparse LU (continuation hands
-    # them to the residual's own corrector when chord_parameter is set)
-    sparse = not model.is_joint and q0.size > solve.SPARSE_ABOVE
     # one DOF in w: the whole corrector compiled (one call per correction)
     compiled = (
         parameter == "omega"
@@ -355,10 +358,16 @@ def _start_plain(
     """Solve HB at the start: Newton from the open and the closed linear responses, else a
     continuation in the force from a level where the open linear response fits the gaps."""
     scale = 0.5 * scale_length(model)
+    # a large structure: the Jacobian assembled sparse for Newton and the homotopy below
+    n_u = (2 * basis.harmonics + 1) * model.n_dof
+    sparse = (
+        None if model.is_joint or n_u <= solve.SPARSE_ABOVE else solve.SparseJacobian(model, basis)
+    )
 
-    def function(q: FloatArray) -> tuple[FloatArray, FloatArray]:
-        ev = aft.evaluate(model, basis, q, omega, force)
-        return ev.residual / k_ref, ev.jacobian / k_ref
+    def function(q: FloatArray) -> tuple[FloatArray, Any]:
+        ev = aft.evaluate(model, basis, q, omega, force, jacobian=sparse is None)
+        jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
+        return ev.residual / k_ref, jac / k_ref
 
     hz = omega / (2.0 * math.pi)
     for stiffness in (model.open_stiffness(), model.closed_stiffness()):
@@ -387,7 +396,7 @@ def _start_plain(
         )
         calls = [0, fraction]
 
-        def residual(u: FloatArray, lam: float) -> tuple[FloatArray, FloatArray, FloatArray, None]:
+        def residual(u: FloatArray, lam: float) -> tuple[FloatArray, Any, FloatArray, None]:
             calls[0] += 1
             calls[1] = max(calls[1], lam)
             if calls[0] % 25 == 0:
@@ -398,21 +407,27 @@ def _start_plain(
                     peak,
                     calls[0],
                 )
-            ev = aft.evaluate(model, basis, u, omega, lam * force)
+            ev = aft.evaluate(model, basis, u, omega, lam * force, jacobian=sparse is None)
             d_lam = np.zeros_like(ev.residual)
             d_lam.reshape(2 * basis.harmonics + 1, -1)[2] = -force
-            return ev.residual / k_ref, ev.jacobian / k_ref, d_lam / k_ref, None
+            jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
+            return ev.residual / k_ref, jac / k_ref, d_lam / k_ref, None
 
         try:
             branch = continue_branch(
-                residual,
+                residual if sparse is None else SparseResidual(residual),
                 fraction * open_guess,
                 fraction,
                 1.0,
                 u_scale=np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess))))),
                 lam_scale=1.0,
                 settings=ContinuationSettings(
-                    step=0.01, min_step=1e-7, max_step=0.1, max_points=points, tolerance=TOLERANCE
+                    step=0.01,
+                    min_step=1e-7,
+                    max_step=0.1,
+                    max_points=points,
+                    tolerance=TOLERANCE,
+                    chord_parameter=sparse is not None,  # the sparse corrector and tangent
                 ),
             )
         except ClearjointError:

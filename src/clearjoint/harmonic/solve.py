@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from clearjoint.harmonic.aft import Basis
+from clearjoint.harmonic.aft import Basis, Evaluation, _scatter
 from clearjoint.harmonic.system import LinearSystem
 
 FloatArray = NDArray[np.float64]
@@ -29,12 +29,14 @@ TOLERANCE = 1e-11
 SPARSE_ABOVE = 400
 
 
-def linear_solve(jacobian: FloatArray, rhs: FloatArray) -> FloatArray:
+def linear_solve(jacobian: Any, rhs: FloatArray) -> FloatArray:
     """Solve jacobian x = rhs: dense LU, or sparse LU above :data:`SPARSE_ABOVE` unknowns.
 
-    A singular matrix falls back to least squares (dense) in both cases.
+    ``jacobian`` is a dense array or a scipy sparse matrix (:class:`SparseJacobian`),
+    which is always factored sparse. A singular matrix falls back to least squares
+    (dense) in both cases.
     """
-    if jacobian.shape[0] > SPARSE_ABOVE:
+    if not isinstance(jacobian, np.ndarray) or jacobian.shape[0] > SPARSE_ABOVE:
         import scipy.sparse
         import scipy.sparse.linalg
 
@@ -50,7 +52,98 @@ def linear_solve(jacobian: FloatArray, rhs: FloatArray) -> FloatArray:
             return np.asarray(np.linalg.solve(jacobian, rhs), dtype=np.float64)
         except np.linalg.LinAlgError:
             pass
-    return np.asarray(np.linalg.lstsq(jacobian, rhs, rcond=None)[0], dtype=np.float64)
+    dense = jacobian if isinstance(jacobian, np.ndarray) else jacobian.toarray()
+    return np.asarray(np.linalg.lstsq(dense, rhs, rcond=None)[0], dtype=np.float64)
+
+
+class SparseJacobian:
+    """The HB Jacobian dR/dq of a structure assembled sparse (CSR), never dense.
+
+    The same sum as :func:`clearjoint.harmonic.aft.evaluate`'s dense Jacobian
+    (MODEL.md 5.3): I x K - diag((h w)^2) x M + w D x C_eff on the diagonal and the
+    derivative's blocks, plus sum over joints of G_j x b_j b_j^T. Its pattern (where an
+    entry can be non-zero: K, M, C and each joint's DOFs) is found once; each call only
+    adds the values into it, so a (2H + 1) N square matrix is never formed.
+
+    Parameters
+    ----------
+    system : LinearSystem
+    basis : Basis
+    """
+
+    def __init__(self, system: LinearSystem, basis: Basis) -> None:
+        import scipy.sparse
+
+        self.system, self.basis = system, basis
+        n, n_c = system.n_dof, 2 * basis.harmonics + 1
+        self.size = n * n_c
+        m, k, c = system.mass, system.stiffness, system.damping
+        r_mk, c_mk = np.nonzero((k != 0.0) | (m != 0.0))
+        # EPMC's damping C - xi M: the pattern of C and M
+        r_c, c_c = np.nonzero((c != 0.0) | (m != 0.0))
+        self._mk = (r_mk, c_mk)
+        self._cm = (r_c, c_c)
+        d_rows, d_cols = np.nonzero(basis.derivative)
+        self._d_values = basis.derivative[d_rows, d_cols]
+        blocks = np.arange(n_c)
+        rows = [(blocks[:, None] * n + r_mk).ravel(), (d_rows[:, None] * n + r_c).ravel()]
+        cols = [(blocks[:, None] * n + c_mk).ravel(), (d_cols[:, None] * n + c_c).ravel()]
+        self._joints = system.directions.shape[0] > 0
+        if self._joints:
+            index, self._weights = _scatter(
+                n_c, system.directions.shape, system.directions.tobytes()
+            )
+            rows.append(index // self.size)
+            cols.append(index % self.size)
+        row, col = np.concatenate(rows), np.concatenate(cols)
+        # each entry's place among the matrix's unique (row, col) pairs, in CSR order
+        flat = row * self.size + col
+        unique, self._where = np.unique(flat, return_inverse=True)
+        self._nnz = unique.size
+        pattern = scipy.sparse.csr_matrix(
+            (np.ones(unique.size), (unique // self.size, unique % self.size)),
+            shape=(self.size, self.size),
+        )
+        pattern.sort_indices()
+        self._indices, self._indptr = pattern.indices, pattern.indptr
+
+    def __call__(self, evaluation: Evaluation, omega: float, damping: FloatArray) -> Any:
+        """dR/dq at the point ``evaluation`` was taken, N/m, as a scipy CSR matrix.
+
+        Parameters
+        ----------
+        evaluation : Evaluation
+            :func:`clearjoint.harmonic.aft.evaluate` at (q, w) (its Jacobian may be
+            skipped): the joints' sampled tangents.
+        omega : float
+            w, rad/s.
+        damping : (N, N) ndarray
+            The damping matrix the residual used (C, or C - xi M for EPMC), N s/m.
+
+        Returns
+        -------
+        ((2H + 1) N, (2H + 1) N) scipy.sparse.csr_matrix
+        """
+        import scipy.sparse
+
+        system, basis = self.system, self.basis
+        w2h2 = (omega * basis.order) ** 2
+        r_mk, c_mk = self._mk
+        r_c, c_c = self._cm
+        diagonal = system.stiffness[r_mk, c_mk] - w2h2[:, None] * system.mass[r_mk, c_mk]
+        coupling = (omega * self._d_values)[:, None] * damping[r_c, c_c]
+        values = [diagonal.ravel(), coupling.ravel()]
+        if self._joints:
+            blocks = basis.products(evaluation.tangent)  # (n_j, 2H + 1, 2H + 1): P diag(k_j) E
+            if evaluation.velocity_tangent is not None:
+                blocks = blocks + omega * (
+                    basis.products(evaluation.velocity_tangent) @ basis.derivative
+                )
+            values.append((blocks[:, :, None, :, None] * self._weights).ravel())
+        data = np.bincount(self._where, weights=np.concatenate(values), minlength=self._nnz)
+        return scipy.sparse.csr_matrix(
+            (data, self._indices, self._indptr), shape=(self.size, self.size)
+        )
 
 
 def linear_guess(
@@ -71,7 +164,7 @@ def linear_guess(
 
 
 def newton(
-    function: Callable[[FloatArray], tuple[FloatArray, FloatArray]],
+    function: Callable[[FloatArray], tuple[FloatArray, Any]],
     q0: FloatArray,
     scale: float,
     *,
@@ -79,6 +172,8 @@ def newton(
     residual: Callable[[FloatArray], FloatArray] | None = None,
 ) -> tuple[FloatArray, int] | None:
     """Damped Newton on a dimensionless residual: ``function(q) -> (R, dR/dq)``.
+
+    dR/dq dense or scipy sparse (:func:`linear_solve`).
 
     Steps are halved (up to 12 times) until max abs(R) falls; ``scale`` (m) makes q
     dimensionless in the convergence test. ``residual(q) -> R``, if given, is used
@@ -121,26 +216,30 @@ class SparseResidual:
     (rows scaled by the unknowns' sizes, converged when every scaled residual is below
     the tolerance) but factors the bordered matrix [[dR/du, dR/dlam], [t^T or e_lam]]
     by a sparse LU (scipy's splu) instead of a dense solve: a structure's HB Jacobian
-    is mostly zero blocks.
+    is mostly zero blocks. The scaled [dR/du, dR/dlam] it returns is sparse too, so the
+    continuation's tangent is a sparse solve as well (``continuation._tangent``).
 
     Parameters
     ----------
     function : callable
         function(u, lam) -> (R (d,), dR/du (d, d), dR/dlam (d,), data), as
-        :data:`clearjoint.continuation.Residual`.
+        :data:`clearjoint.continuation.Residual`; dR/du a scipy sparse matrix (see
+        :class:`SparseJacobian`) or a dense array.
     """
 
     def __init__(
         self,
-        function: Callable[[FloatArray, float], tuple[FloatArray, FloatArray, FloatArray, object]],
+        function: Callable[[FloatArray, float], tuple[FloatArray, Any, FloatArray, object]],
     ) -> None:
         self.function = function
 
     def __call__(
         self, u: FloatArray, lam: float, want_lambda: bool = True
     ) -> tuple[FloatArray, FloatArray, FloatArray, object]:
-        """R, dR/du, dR/dlam and the data at (u, lam) (``want_lambda`` is accepted, unused)."""
-        return self.function(u, lam)
+        """R, dR/du (dense), dR/dlam and the data at (u, lam) (``want_lambda`` unused)."""
+        r, jac_u, r_lam, data = self.function(u, lam)
+        dense = jac_u if isinstance(jac_u, np.ndarray) else jac_u.toarray()
+        return r, np.asarray(dense, dtype=np.float64), r_lam, data
 
     def corrector(
         self,
@@ -149,7 +248,7 @@ class SparseResidual:
         scale: FloatArray,
         settings: Any,
         fixed_lambda: bool,
-    ) -> tuple[FloatArray, FloatArray, object, int] | None:
+    ) -> tuple[FloatArray, Any, object, int] | None:
         """Newton on [R(y); t . (y - y0)] = 0 (or R at fixed lambda), sparse; None if it fails.
 
         Parameters
@@ -167,7 +266,8 @@ class SparseResidual:
         Returns
         -------
         tuple or None
-            (y (d + 1,), the scaled [dR/du, dR/dlam] (d, d + 1), data, iterations).
+            (y (d + 1,), the scaled [dR/du, dR/dlam] (d, d + 1) as a scipy CSR matrix,
+            data, iterations).
         """
         import scipy.sparse
         import scipy.sparse.linalg
@@ -179,18 +279,25 @@ class SparseResidual:
         u_scale = scale[:d]
         border = np.zeros(d + 1)
         border[d] = 1.0
-        last_row = border if fixed_lambda else tangent
+        last_row = scipy.sparse.csr_matrix((border if fixed_lambda else tangent)[None, :])
+        rows = scipy.sparse.diags(1.0 / u_scale)
+        columns = scipy.sparse.diags(u_scale)
         for iteration in range(settings.max_iterations + 1):
             try:
                 r, jac_u, r_lam, data = self.function(y[:d] * u_scale, float(y[d] * scale[d]))
             except ClearjointError:
                 return None
-            a = np.empty((d, d + 1))
-            a[:, :d] = jac_u * (u_scale / u_scale[:, None])
-            a[:, d] = r_lam * (scale[d] / u_scale)
+            # rows scaled by the unknowns' sizes, columns by the scaled unknowns
+            a = scipy.sparse.hstack(
+                (
+                    rows @ scipy.sparse.csr_matrix(jac_u) @ columns,
+                    scipy.sparse.csr_matrix((r_lam * (scale[d] / u_scale))[:, None]),
+                ),
+                format="csr",
+            )
             rs = r / u_scale
             size = float(np.max(np.abs(rs)))
-            if not math.isfinite(size) or not np.all(np.isfinite(a)):
+            if not math.isfinite(size) or not np.all(np.isfinite(a.data)):
                 return None
             if size <= settings.tolerance:
                 return y, a, data, iteration
@@ -199,9 +306,7 @@ class SparseResidual:
             rhs = np.empty(d + 1)
             rhs[:d] = -rs
             rhs[d] = 0.0 if fixed_lambda else -float(tangent @ (y - y0))
-            matrix = scipy.sparse.vstack(
-                (scipy.sparse.csr_matrix(a), scipy.sparse.csr_matrix(last_row[None, :]))
-            ).tocsc()
+            matrix = scipy.sparse.vstack((a, last_row), format="csc")
             try:
                 dy = scipy.sparse.linalg.splu(matrix).solve(rhs)
             except RuntimeError:  # "Factor is exactly singular"

@@ -1,0 +1,116 @@
+"""The sparse algebra of harmonic balance on structures (harmonic/solve.py, MODEL.md 5.3)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint import ClearanceJoint, Friction
+from clearjoint import continuation as cont
+from clearjoint.harmonic import aft, frequency_response, solve
+from clearjoint.harmonic.system import from_structure
+from clearjoint.structure import Structure, chain, mast
+
+FORCE = np.array([0.0, 0.0, 40.0])
+
+
+@pytest.fixture(scope="module")
+def three_links() -> Structure:
+    """Three 1 kg masses on 1 MN/m links, each with a 0.1 mm joint, dashpots across."""
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
+
+
+def _friction_chain() -> Structure:
+    rub = Friction(coefficient=0.2, lateral_load=100.0)
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5, friction=rub)
+    return chain([1.0, 1.0], [math.inf, math.inf], [j, j], dampers=[5.0, 5.0])
+
+
+def _small_mast() -> Structure:
+    joint = ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6)
+    return mast(2, joints=joint, rayleigh=(0.0, 2e-6))
+
+
+@pytest.mark.parametrize("case", ["chain", "friction", "mast", "epmc"])
+def test_sparse_jacobian_is_the_dense_one(three_links: Structure, case: str) -> None:
+    """The sparse assembly sums the same terms as aft.evaluate's dense one (block writes
+    and a scatter into a dense array): equal at a random point in and out of contact."""
+    structure = {"chain": three_links, "epmc": three_links}.get(case)
+    if case == "friction":
+        structure = _friction_chain()
+    elif case == "mast":
+        structure = _small_mast()
+    assert structure is not None
+    model = from_structure(structure, 1e-3 if case == "friction" else 0.0)
+    basis = aft.Basis.make(4, 64)
+    xi = 3.0 if case == "epmc" else 0.0
+    rng = np.random.default_rng(7)
+    q = rng.normal(scale=2e-4, size=9 * model.n_dof)  # gaps of 1e-4: some samples in contact
+    ev = aft.evaluate(model, basis, q, 350.0, np.ones(model.n_dof), negative_damping=xi)
+    assert np.ptp(ev.tangent) > 0.0  # the joints' tangents change within the period
+    sparse = solve.SparseJacobian(model, basis)(ev, 350.0, model.damping - xi * model.mass)
+    dense = ev.jacobian
+    assert sparse.shape == dense.shape
+    np.testing.assert_allclose(sparse.toarray(), dense, rtol=0.0, atol=1e-13 * np.abs(dense).max())
+    if case == "mast":
+        assert sparse.nnz < 0.5 * dense.size  # it is sparse
+
+
+def test_sparse_and_dense_tangents_follow_the_same_branch(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Above solve.SPARSE_ABOVE unknowns the Jacobian, the corrector and the continuation
+    tangent are sparse; the same curve through the resonance as the dense route."""
+    dense = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
+    calls: list[int] = []
+    original = cont._sparse_tangent
+
+    def counted(a: object, previous: np.ndarray) -> np.ndarray:
+        calls.append(1)
+        return original(a, previous)
+
+    monkeypatch.setattr(cont, "_sparse_tangent", counted)
+    again = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
+    assert not calls  # 33 unknowns: the dense route
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    sparse = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
+    assert len(calls) >= 24  # a sparse tangent at every point
+    assert np.array_equal(again.omega, dense.omega)
+    assert sparse.omega.size == dense.omega.size == 25
+    np.testing.assert_allclose(sparse.omega, dense.omega, rtol=1e-10)
+    size = float(np.abs(dense.coefficients).max())  # type: ignore[arg-type]
+    np.testing.assert_allclose(sparse.coefficients, dense.coefficients, rtol=0.0, atol=1e-10 * size)
+    assert np.array_equal(sparse.stable, dense.stable)
+
+
+def test_sparse_start_homotopy_is_the_dense_one(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When Newton from the linear guesses fails, the start follows the force up from a
+    level inside the gaps; above SPARSE_ABOVE by the sparse corrector and tangent: the
+    same orbit as the dense continuation, and one that solves HB."""
+    from clearjoint.harmonic import response
+
+    model = from_structure(three_links)
+    basis = aft.Basis.make(5, 128)
+    k_ref = model.reference_stiffness
+    monkeypatch.setattr(response, "newton", lambda *args, **kwargs: None)
+    dense = response._start_plain(model, basis, 400.0, FORCE, k_ref)
+    calls: list[int] = []
+    original = cont._sparse_tangent
+
+    def counted(a: object, previous: np.ndarray) -> np.ndarray:
+        calls.append(1)
+        return original(a, previous)
+
+    monkeypatch.setattr(cont, "_sparse_tangent", counted)
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    sparse = response._start_plain(model, basis, 400.0, FORCE, k_ref)
+    assert calls
+    size = float(np.abs(dense).max())
+    np.testing.assert_allclose(sparse, dense, rtol=0.0, atol=1e-10 * size)
+    ev = aft.evaluate(model, basis, sparse, 400.0, FORCE)
+    assert float(np.abs(ev.residual).max()) < 1e-9 * k_ref * size
