@@ -735,8 +735,6 @@ def pyharm_part(python: str | None) -> float | None:
 #: (BAYS:H[:most points]): the 40-bay curve capped at 20 points, since its stability (the
 #: monodromy's 320 x 320 matrix exponentials, about 250 a point) costs about 10 s a point.
 ISSUE_SIZES = "10:7,5:7,20:7,10:3,10:15,40:7:20"
-#: The start's force homotopy may take this many points at least in --issue (see there).
-ISSUE_START_POINTS = 200
 
 
 def issue_run(python: str | None, points: int) -> None:
@@ -745,17 +743,6 @@ def issue_run(python: str | None, points: int) -> None:
     print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
     ratio = pyharm_part(python)
     print(flush=True)
-    from clearjoint.harmonic import response
-
-    # the start's force homotopy stops after START_BUDGET // unknowns points (at least
-    # START_POINTS[0] = 40): the 40-bay mast's start needs 102 (measured), so these runs
-    # allow up to ISSUE_START_POINTS; said here, since a user's default would refuse it
-    floor, top = response.START_POINTS
-    response.START_POINTS = (max(floor, ISSUE_START_POINTS), max(top, ISSUE_START_POINTS))
-    print(
-        f"the start's force homotopy allowed {response.START_POINTS[0]} points at least "
-        f"(harmonic.response.START_POINTS, default {floor}): the 40-bay start needs about 100"
-    )
     summary = mast_sizes(ISSUE_SIZES, points, MAST_FORCE_N)
     print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
     print("summary (one run):")

@@ -309,7 +309,7 @@ def test_frf_without_an_orbit_at_the_start_says_so_in_one_line(
 ) -> None:
     """The example mast at 20 N, H = 15 in small: the start's force continuation (which the
     chain needs at 800 rad/s) held to 10 points, so it gives up; progress lines, then one
-    error line saying what to do, exit 2 (the mast itself: 67 s, docs/harmonic.md)."""
+    error line saying what to do, exit 2 (the mast itself: about 60 s, docs/harmonic.md)."""
     from clearjoint.harmonic import response
 
     monkeypatch.setattr(response, "START_POINTS", (10, 10))

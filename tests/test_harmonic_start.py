@@ -32,7 +32,7 @@ def test_the_force_continuation_reports_progress_and_finds_the_start(
     assert curve.force_amplitude[0] == pytest.approx(40.0)
     lines = [r.getMessage() for r in caplog.records if r.name == "clearjoint.harmonic"]
     assert "following the force up" in lines[0]
-    assert "at most 1111 points" in lines[0]  # START_BUDGET // 45 unknowns
+    assert "at most 2000 points" in lines[0]  # START_BUDGET // 45 unknowns, capped
     assert any("force continuation at" in line for line in lines[1:])
 
 

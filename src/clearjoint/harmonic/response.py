@@ -57,9 +57,11 @@ FloatArray = NDArray[np.float64]
 LOGGER = logging.getLogger("clearjoint.harmonic")
 
 #: The start's force continuation takes at most this many unknown-points (points times
-#: unknowns), between ``START_POINTS`` (40 and 2000) points: a 40-DOF structure at H = 15
-#: (1240 unknowns, about 1 s and 6 evaluations a point on 2 busy cores) gives up after 40.
-START_BUDGET = 50_000
+#: unknowns), between ``START_POINTS`` (40 and 2000) points. On the sparse path (above
+#: solve.SPARSE_ABOVE unknowns) a 160-DOF mast at H = 7 (2400 unknowns) gets 200 points
+#: (its start needs about 100), and the example mast at 20 N and H = 15 (1240 unknowns, 387
+#: points, no orbit to reach) gives up after about 60 s on 2 cores (docs/harmonic.md).
+START_BUDGET = 480_000
 START_POINTS = (40, 2000)
 
 
