@@ -650,9 +650,8 @@ def _flags(
             f"fit residual {residual:.3g} N is {residual / noise:.1f} times the noise floor "
             f"{noise:.3g} N of the cycle average"
         )
-        for q in fitted:
-            if flags[q][0] == "ok":
-                flags[q] = ("doubtful", reason)
+        for q in fitted:  # beside any other doubt: a model that misses the loop says why
+            _doubt(flags, q, reason)
     if mass_missing:
         reason = f"force control without a mass: m = {mass:.4g} kg estimated from the record"
         for q in fitted:  # the issue's own rule: shown beside any other doubt
