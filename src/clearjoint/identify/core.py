@@ -27,8 +27,8 @@ MODEL.md section 3. The steps:
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
    exceeds a quarter of it, a fit residual above the noise floor (the weak form's
-   equation residual; the damper model's residual on the loop,
-   :mod:`clearjoint.identify.loopcheck`), a force-controlled
+   equation residual; the damper model's residual on the loop and the joint's or the
+   line's per-sample fit's, :mod:`clearjoint.identify.loopcheck`), a force-controlled
    record without a mass (then estimated from the record, with a warning), or a damper
    whose backlash reads more than twice as long on one branch as on the other.
 """

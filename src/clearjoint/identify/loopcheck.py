@@ -1,4 +1,8 @@
-"""How well the damper model describes the measured loop: its rms residual.
+"""How well the fitted model describes the measured loop: its residual.
+
+The per-sample fits of a clearance joint and of a line (MODEL.md section 3, "the stages";
+:mod:`clearjoint.identify.segments`) are read against the cycle average by
+:func:`sample_fit_residual`; the damper's below.
 
 MODEL.md section 3 (the friction damper with backlash, elastic-plastic with a gap).
 Along the travel s from a branch's reversal the model force is
