@@ -5,6 +5,8 @@
     python docs/identify_bias.py --cycles       # 6, 10, 24 cycles at 40 Hz, 12 kHz
     python docs/identify_bias.py --brfd-residuals  # the damper fit residual / noise floor
     python docs/identify_bias.py --bouc-wen     # the same on a smooth loop with no gap
+    python docs/identify_bias.py --rig-residuals DIR  # every model's residual / noise floor
+        # on the records of DIR (e.g. the default campaign: clearjoint rig --out DIR)
 
 1 % noise on every channel, with an acceleration channel, seeds 1-5. Errors in % of the
 simulator's own truth; the friction's standard error (in % of the truth) and its flag.
@@ -16,6 +18,7 @@ import argparse
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
@@ -59,8 +62,9 @@ def _short(reason: str) -> str:
     return f" ({reason.split(':')[0]})"
 
 
-def _brfd_residuals() -> None:
-    """Each BRFD file's damper fit residual over its noise floor (flagged above 3)."""
+def _brfd_residuals(folder: Path | None = None, pattern: str = "*.json") -> None:
+    """Each file's fit residual over its noise floor (flagged above 3): the BRFD files'
+    damper fit by default, or the records of ``folder`` (any model), with the model."""
     import re
 
     import clearjoint.identify.core as core
@@ -68,19 +72,58 @@ def _brfd_residuals() -> None:
 
     factor = core.RESIDUAL_FACTOR
     core.RESIDUAL_FACTOR = 0.0  # every residual then shows in the reasons, with its ratio
-    folder = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
+    if folder is None:
+        folder = Path(__file__).resolve().parents[2] / "shared" / "data" / "brfd"
     ratios = []
-    for path in sorted(folder.glob("*.json")):
+    for path in sorted(folder.glob(pattern)):
         try:
             result = identify(read_record(path))
         except IdentificationError:
             continue
         found = re.search(r"fit residual \S+ N is ([0-9.]+) times", result.flag_reason)
         if found:
-            ratios.append((float(found.group(1)), path.name))
+            ratios.append((float(found.group(1)), f"{path.name} ({result.model})"))
     core.RESIDUAL_FACTOR = factor
     for ratio, name in sorted(ratios):
         print(f"{ratio:4.1f}  {name}{'  (flagged)' if ratio > factor else ''}")
+
+
+def _bouc_wen_forced(bouc_wen: Any) -> None:
+    """The Bouc-Wen loops forced into the line's fit (no damper) and into the joint's
+    sample-by-sample fit (stage windows at 70-100 % of the stroke each way and the middle
+    half, the weak form held off), as tests/test_identify_loopcheck.py forces them."""
+    import numpy as np
+
+    import clearjoint.identify.core as core
+
+    saved = {
+        k: getattr(core, k) for k in ("_damper_fit", "_windows", "_joint_fit", "MIN_EQUATIONS")
+    }
+    fit = core._joint_fit
+
+    def windows(x: Any, y: Any, n: int) -> list[tuple[bool, float, float]]:
+        a, m = 0.5 * float(np.ptp(x)), 0.5 * float(x.max() + x.min())
+        return [
+            (True, m - a, m - 0.7 * a),
+            (False, m - 0.5 * a, m + 0.5 * a),
+            (True, m + 0.7 * a, m + a),
+        ]
+
+    try:
+        core._damper_fit = lambda *args: None  # type: ignore[assignment]
+        for path in ("line", "joint"):
+            if path == "joint":
+                core._windows = windows  # type: ignore[assignment]
+                core._joint_fit = lambda x, r, v, p, w, compete=True: fit(x, r, v, p, w, False)  # type: ignore[assignment]
+                core.MIN_EQUATIONS = 10**9
+            for noise, seed in ((0.0, 0), (0.01, 1), (0.01, 2), (0.01, 3), (0.01, 4)):
+                result = identify(bouc_wen(noise, seed))
+                reason = result.flags["friction_force_n"][1]
+                head = f"forced into the {path} fit, noise {noise:.0%} seed {seed}"
+                print(f"{head}: {result.model}, {reason}")
+    finally:
+        for k, v in saved.items():
+            setattr(core, k, v)
 
 
 def main() -> None:
@@ -95,6 +138,9 @@ def main() -> None:
         help="each BRFD file's damper-model residual over its noise floor (../shared/data/brfd)",
     )
     parser.add_argument("--bouc-wen", action="store_true", help="Bouc-Wen loops, no gap")
+    parser.add_argument(
+        "--rig-residuals", type=Path, default=None, help="each rig record's (*.nc) residual"
+    )
     args = parser.parse_args()
     if args.bouc_wen:
         from test_identify_loopcheck import bouc_wen
@@ -102,15 +148,23 @@ def main() -> None:
         for noise, seed in ((0.0, 0), (0.01, 1), (0.01, 2), (0.01, 3), (0.01, 4)):
             result = identify(bouc_wen(noise, seed))
             print(f"noise {noise:.0%} seed {seed}: {result.model}, {result.flag_reason}")
+        _bouc_wen_forced(bouc_wen)
     if args.brfd_residuals:
         _brfd_residuals()
+    if args.rig_residuals is not None:
+        _brfd_residuals(args.rig_residuals, "*.nc")
     head = " | ".join(name for _, name in KEYS)
     folder = Path(tempfile.mkdtemp())
     if args.off_grid:
         print(f"| f (Hz) @ rate (samples a period) | seed | {head} | friction SE | flag |")
         print("|---|---|---|---|---|---|---|---|")
-        for frequency, rate in ((40.0, 12_000.0), (40.0, 12_010.0), (40.0, 11_990.0),
-                                (40.0, 12_030.0), (37.0, 12_000.0)):
+        for frequency, rate in (
+            (40.0, 12_000.0),
+            (40.0, 12_010.0),
+            (40.0, 11_990.0),
+            (40.0, 12_030.0),
+            (37.0, 12_000.0),
+        ):
             label = f"{frequency:g} @ {rate:g} ({rate / frequency:.2f})"
             _row(label, frequency, rate, 24, folder)
     if args.cycles is not None:

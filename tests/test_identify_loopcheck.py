@@ -1,22 +1,29 @@
-"""clearjoint.identify.loopcheck: the damper model's residual on the measured loop.
+"""clearjoint.identify.loopcheck: the fitted model's residual on the measured loop.
 
 An exact elastic-plastic loop with a gap (tests/test_identify.friction_loop, built by
 stepping the law, not by the model's formula) leaves a residual near zero; a smooth
 Bouc-Wen hysteresis with no gap at all (another law, integrated here) leaves one far above
-the noise floor and is flagged, on every quantity the damper fit gives.
+the noise floor and is flagged, on every quantity the damper fit gives. The same loop
+forced into the joint's sample-by-sample fit or the line's is flagged there too, while
+records of a joint from the independent simulator (tests/independent_joint.py: solve_ivp,
+a tanh friction law) fitted sample by sample keep ``ok``.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+import clearjoint.identify.core as core
 from clearjoint.identify import identify
 from clearjoint.identify.core import _branches_of
 from clearjoint.identify.cycles import cycle_bounds, excitation_frequency, stack, steady
 from clearjoint.identify.damper import _damper_fit
 from clearjoint.identify.loopcheck import damper_residual
-from clearjoint.records import Record
+from clearjoint.records import Record, read_record
+from independent_joint import TrueJoint, write_record
 from test_identify import friction_loop
 
 
@@ -76,3 +83,94 @@ def test_a_smooth_loop_with_no_gap_is_not_called_ok(noise: float, seed: int) -> 
     assert flag == "doubtful"
     assert "fit residual" in reason
     assert "fit residual" in result.flag_reason
+
+
+def _spy_residual(monkeypatch: pytest.MonkeyPatch) -> list[float]:
+    """Record every residual of a per-sample fit (a joint's or a line's) identify takes."""
+    seen: list[float] = []
+    original = core.sample_fit_residual
+
+    def spy(*args: object) -> float:
+        value = original(*args)  # type: ignore[arg-type]
+        seen.append(value)
+        return value
+
+    monkeypatch.setattr(core, "sample_fit_residual", spy)
+    return seen
+
+
+def _no_damper(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(core, "_damper_fit", lambda *args: None)
+
+
+@pytest.mark.parametrize(("noise", "seed"), [(0.0, 0), (0.01, 1)])
+def test_a_smooth_loop_forced_into_the_line_path_is_flagged(
+    monkeypatch: pytest.MonkeyPatch, noise: float, seed: int
+) -> None:
+    _no_damper(monkeypatch)
+    seen = _spy_residual(monkeypatch)
+    result = identify(bouc_wen(noise, seed))
+    assert result.model == "line"
+    assert len(seen) == 1
+    assert seen[0] > 0.1 * float(np.std(bouc_wen(0.0, 0).force))
+    for q in ("compression_stiffness_n_per_m", "friction_force_n", "dynamic_stiffness_n_per_m"):
+        flag, reason = result.flags[q]
+        assert flag == "doubtful", q
+        assert "fit residual" in reason
+        assert "times the noise floor" in reason
+
+
+@pytest.mark.parametrize(("noise", "seed"), [(0.0, 0), (0.01, 1)])
+def test_a_smooth_loop_forced_into_the_joint_path_is_flagged(
+    monkeypatch: pytest.MonkeyPatch, noise: float, seed: int
+) -> None:
+    """The Bouc-Wen loop read as tension, free play and compression (stage windows at
+    70-100 % of the stroke each way and the middle half) by the joint's per-sample fit (the
+    weak form, which would take this record, held off as for a contact too short for it)."""
+    _no_damper(monkeypatch)
+    fit = core._joint_fit
+
+    def windows(x: np.ndarray, y: np.ndarray, n: int) -> list[tuple[bool, float, float]]:
+        a, m = 0.5 * float(np.ptp(x)), 0.5 * float(x.max() + x.min())
+        return [
+            (True, m - a, m - 0.7 * a),
+            (False, m - 0.5 * a, m + 0.5 * a),
+            (True, m + 0.7 * a, m + a),
+        ]
+
+    monkeypatch.setattr(core, "_windows", windows)
+    monkeypatch.setattr(
+        core, "_joint_fit", lambda x, r, v, parts, w, compete=True: fit(x, r, v, parts, w, False)
+    )
+    seen = _spy_residual(monkeypatch)
+    monkeypatch.setattr(core, "MIN_EQUATIONS", 10**9)
+    result = identify(bouc_wen(noise, seed))
+    assert result.model == "joint"
+    assert len(seen) == 1  # the sample-by-sample fit, not the weak form
+    for q in ("compression_stiffness_n_per_m", "friction_force_n", "clearance_m"):
+        flag, reason = result.flags[q]
+        assert flag in ("doubtful", "rejected"), q
+        if flag == "doubtful":
+            assert "fit residual" in reason, q
+    assert "fit residual" in result.flag_reason
+
+
+@pytest.mark.parametrize(("frequency", "noise"), [(40.0, 0.0), (100.0, 0.0), (100.0, 0.002)])
+def test_an_independent_joint_fitted_sample_by_sample_keeps_ok(
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    frequency: float,
+    noise: float,
+) -> None:
+    """The independent simulator's joint (another friction law, no rig), with acceleration:
+    the sample-by-sample fit's residual stays under the flag and every value is ``ok``
+    (at 1 % noise the displacement's noise, times the contact stiffness, enters the
+    residual but not the force's noise floor: docs/identify.md, Flags)."""
+    seen = _spy_residual(monkeypatch)
+    path = write_record(
+        TrueJoint(frequency_hz=frequency), tmp_path / "r.csv", noise=noise, cycles=12
+    )
+    result = identify(read_record(path))
+    assert result.model == "joint"
+    assert len(seen) == 1  # the sample-by-sample path
+    assert {flag for flag, _ in result.flags.values()} == {"ok"}

@@ -56,9 +56,9 @@ def test_identify_step_prints_what_the_page_says_and_finds_the_clearances(
     files = sorted(str(path) for path in LAB.glob("*.csv"))
     assert main(["identify", *files, "--out", str(out), "--quiet"]) == 0
     printed = capsys.readouterr().out
-    assert "identified 6 of 6 records (5 flagged, see the flag and flag_reason columns)" in printed
+    assert "identified 6 of 6 records (6 flagged, see the flag and flag_reason columns)" in printed
     page = (ROOT / "docs" / "tutorial" / "csv-to-report.md").read_text(encoding="utf-8")
-    assert "identified 6 of 6 records (5 flagged, see the flag and flag_reason columns)" in page
+    assert "identified 6 of 6 records (6 flagged, see the flag and flag_reason columns)" in page
     rows = read_rows(out)
     assert len(rows) == 6
     for row in rows:

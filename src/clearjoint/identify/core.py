@@ -27,8 +27,8 @@ MODEL.md section 3. The steps:
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
    exceeds a quarter of it, a fit residual above the noise floor (the weak form's
-   equation residual; the damper model's residual on the loop,
-   :mod:`clearjoint.identify.loopcheck`), a force-controlled
+   equation residual; the damper model's residual on the loop and the joint's or the
+   line's per-sample fit's, :mod:`clearjoint.identify.loopcheck`), a force-controlled
    record without a mass (then estimated from the record, with a warning), or a damper
    whose backlash reads more than twice as long on one branch as on the other.
 """
@@ -59,11 +59,13 @@ from clearjoint.identify.cycles import (
     steady_rule,
 )
 from clearjoint.identify.damper import BRANCH_RATIO, _damper_fit
-from clearjoint.identify.loopcheck import damper_residual
+from clearjoint.identify.loopcheck import NO_STAGE, damper_residual, sample_fit_residual
 from clearjoint.identify.result import QUANTITIES, CycleResult, Identification, damper_stages
 from clearjoint.identify.segments import (
     STAGE_COMPRESSION,
+    STAGE_FREE,
     STAGE_TENSION,
+    Window,
     _Fit,
     _is_joint,
     _joint_fit,
@@ -235,6 +237,23 @@ def _branches_of(m: int, x: FloatArray) -> tuple[slice, slice] | None:
     if top < 8 or m - top < 8:
         return None
     return slice(0, top + 1), slice(top, m)
+
+
+def _window_stages(
+    x: FloatArray, parts: tuple[slice, slice], windows: tuple[list[Window], list[Window]]
+) -> NDArray[np.int8]:
+    """The stage of each sample of the average as the joint's per-sample fit had it: the
+    stage of the window of its branch it lies in, ``NO_STAGE`` in none, (M,)."""
+    stage = np.full(x.size, NO_STAGE, dtype=np.int8)
+    for part, branch in zip(parts, windows, strict=True):
+        xb = x[part]
+        own = np.full(xb.size, NO_STAGE, dtype=np.int8)
+        for code, (_, low, high) in zip(
+            (STAGE_TENSION, STAGE_FREE, STAGE_COMPRESSION), branch, strict=True
+        ):
+            own[(xb >= low) & (xb <= high)] = code
+        stage[part] = np.where(own != NO_STAGE, own, stage[part])
+    return stage
 
 
 def _noise_floor(stacked: FloatArray) -> float:
@@ -433,6 +452,9 @@ def _identify_stack(
                     for xr_, rr_, vr_ in zip(reps_x, reps_r, reps_v, strict=True)
                 ]
             fits = [fit or first_fit for fit in batch]
+            residual = sample_fit_residual(
+                reps_x[0], reps_r[0], reps_v[0], fits[0], _window_stages(x, parts, windows)
+            )
         elif model == "damper":
             assert head_damper is not None
             residual = damper_residual(x, f, parts, head_damper)
@@ -451,6 +473,7 @@ def _identify_stack(
                     for xr_, rr_, vr_ in zip(reps_x, reps_r, reps_v, strict=True)
                 ]
             )
+            residual = sample_fit_residual(reps_x[0], reps_r[0], reps_v[0], fits[0])
         masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     values = [
         _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
@@ -516,8 +539,7 @@ def _identify_stack(
             "stack smoothed by about a sample (friction may read low)"
         )
         for q in (*CREDIBLE, "clearance_m"):
-            if flags[q][0] == "ok":
-                flags[q] = ("doubtful", reason)
+            _doubt(flags, q, reason)  # beside the residual's doubt, which it often explains
     if model == "damper":
         b_rise, b_fall = fits[0].backlash_branches
         low, high = min(b_rise, b_fall), max(b_rise, b_fall)
@@ -628,9 +650,8 @@ def _flags(
             f"fit residual {residual:.3g} N is {residual / noise:.1f} times the noise floor "
             f"{noise:.3g} N of the cycle average"
         )
-        for q in fitted:
-            if flags[q][0] == "ok":
-                flags[q] = ("doubtful", reason)
+        for q in fitted:  # beside any other doubt: a model that misses the loop says why
+            _doubt(flags, q, reason)
     if mass_missing:
         reason = f"force control without a mass: m = {mass:.4g} kg estimated from the record"
         for q in fitted:  # the issue's own rule: shown beside any other doubt

@@ -1,4 +1,8 @@
-"""How well the damper model describes the measured loop: its rms residual.
+"""How well the fitted model describes the measured loop: its residual.
+
+The per-sample fits of a clearance joint and of a line (MODEL.md section 3, "the stages";
+:mod:`clearjoint.identify.segments`) are read against the cycle average by
+:func:`sample_fit_residual`; the damper's below.
 
 MODEL.md section 3 (the friction damper with backlash, elastic-plastic with a gap).
 Along the travel s from a branch's reversal the model force is
@@ -24,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.identify._stats import median
-from clearjoint.identify.segments import _Fit
+from clearjoint.identify.segments import STAGE_COMPRESSION, STAGE_TENSION, _Fit
 
 FloatArray = NDArray[np.float64]
 
@@ -33,6 +37,10 @@ PLACES = 64
 #: Samples of a branch the residual is read on at most (every k-th: an rms needs no more,
 #: and the BRFD's 2048-sample branches would otherwise cost half the identification).
 BRANCH_SAMPLES = 128
+#: A sample in no stage window (a joint's stage codes are -1, 0, 1).
+NO_STAGE = 2
+#: The median absolute deviation times this is the rms of Gaussian residuals.
+MAD_TO_RMS = 1.4826
 
 
 def _branch_residuals(
@@ -99,3 +107,54 @@ def damper_residual(x: FloatArray, f: FloatArray, parts: tuple[slice, slice], fi
         k = fit.k_compression if stop > start else fit.k_tension
         squared.append(_branch_residuals(np.abs(xb - xb[0]), fb, start, stop, k, max(b, 0.0)))
     return float(np.sqrt(np.mean(np.concatenate(squared))))
+
+
+def sample_fit_residual(
+    x: FloatArray,
+    r: FloatArray,
+    v: FloatArray,
+    fit: _Fit,
+    stage: NDArray[np.int8] | None = None,
+) -> float:
+    """Return the residual (N) of a per-sample fit (a joint's or a line's) on the average.
+
+    The model is the fit's own, its coefficients as fitted (the drag and the signed
+    friction with them): a joint's F = a_s + k_s x + c x' + F_f sgn x' on the samples in
+    a stage window, s that window's stage (the rows the fit was made on); a line's
+    F = a + k_c x (x > 0) + k_t x (x <= 0) + c x' + F_f sgn x' on every sample. The
+    residual is read as the fit reads it, robustly: 1.4826 times the median absolute
+    deviation (the rms of Gaussian residuals), so the few samples the biweight fit gives
+    no weight (the ringing right after an impact) do not count, while a model that
+    misses the loop's shape (a smooth hysteresis read as straight pieces) leaves it large.
+
+    Parameters
+    ----------
+    x, r, v : (M,) ndarray
+        The cycle average's displacement (m), restoring force (N) and velocity (m/s), as
+        the fit had them.
+    fit : _Fit
+        The joint's or the line's fit on that average.
+    stage : (M,) ndarray of int8, optional
+        A joint's stage per sample (``STAGE_TENSION``, ``STAGE_FREE``,
+        ``STAGE_COMPRESSION``; ``NO_STAGE`` outside every window); needed for a joint.
+
+    Returns
+    -------
+    float
+        The residual, N; NaN when the fit kept no coefficients (or a joint has no stages).
+    """
+    c = fit.coefficients
+    if len(c) == 8 and stage is not None:  # a joint: tension, free play, compression
+        rows = stage != NO_STAGE
+        s, xs, vs = stage[rows], x[rows], v[rows]
+        tension, compression = s == STAGE_TENSION, s == STAGE_COMPRESSION
+        intercept = np.where(compression, c[4], np.where(tension, c[0], c[2]))
+        slope = np.where(compression, c[5], np.where(tension, c[1], c[3]))
+        error = r[rows] - (intercept + slope * xs + c[6] * vs + c[7] * np.sign(vs))
+    elif len(c) == 5:  # a line
+        error = r - (c[0] + np.where(x > 0, c[1], c[2]) * x + c[3] * v + c[4] * np.sign(v))
+    else:
+        return math.nan
+    if error.size == 0:
+        return math.nan
+    return float(MAD_TO_RMS * np.median(np.abs(error - np.median(error))))

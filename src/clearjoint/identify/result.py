@@ -139,8 +139,9 @@ class Identification:
 
     @property
     def flag_reason(self) -> str:
-        """The reasons of every flag that is not ``ok``, each once, joined by "; "."""
-        reasons = [r for f, r in self.flags.values() if f != "ok" and r]
+        """The reasons of every flag that is not ``ok``, each once, joined by "; " (a
+        quantity's own reasons are joined so too: each is counted once over all)."""
+        reasons = [p for f, r in self.flags.values() if f != "ok" and r for p in r.split("; ")]
         return "; ".join(dict.fromkeys(reasons))
 
     def __repr__(self) -> str:

@@ -162,6 +162,10 @@ class _Fit:
     level_negative: float = math.nan
     #: the damper's backlash read on the rising and on the falling branch
     backlash_branches: tuple[float, float] = (math.nan, math.nan)
+    #: the per-sample fit's coefficients as fitted (the drag and the signed friction with
+    #: them), kept for its residual (:mod:`clearjoint.identify.loopcheck`): a joint's
+    #: (a_t, k_t, a_f, k_f, a_c, k_c, c, F_f), a line's (a, k_c, k_t, c, F_f)
+    coefficients: tuple[float, ...] = ()
 
 
 def _joint_fit(
@@ -214,7 +218,8 @@ def _joint_fit(
     upper = (a_f - a_c) / (k_c - k_f)
     lower = (a_f - a_t) / (k_t - k_f)
     lines = ((a_t, k_t), (a_f, k_f), (a_c, k_c))
-    return _Fit(upper, lower, k_c, k_t, max(k_f, 0.0), abs(friction), lines)
+    kept = tuple(float(c) for c in coef)
+    return _Fit(upper, lower, k_c, k_t, max(k_f, 0.0), abs(friction), lines, coefficients=kept)
 
 
 def _solve_batch(
@@ -301,6 +306,7 @@ def _joint_fits(
                 max(k_f, 0.0),
                 abs(friction),
                 lines,
+                coefficients=tuple(float(c) for c in row),
             )
         )
     return out
@@ -312,11 +318,23 @@ def _line_fits(x: FloatArray, f: FloatArray, v: FloatArray) -> list[_Fit] | None
     coef = _solve_batch(design, f, np.ones_like(x))
     if coef is None:
         return None
-    return [_Fit(0.0, 0.0, float(c[1]), float(c[2]), 0.0, abs(float(c[4]))) for c in coef]
+    return [
+        _Fit(
+            0.0,
+            0.0,
+            float(c[1]),
+            float(c[2]),
+            0.0,
+            abs(float(c[4])),
+            coefficients=tuple(float(v) for v in c),
+        )
+        for c in coef
+    ]
 
 
 def _line_fit(x: FloatArray, f: FloatArray, v: FloatArray) -> _Fit:
     """No clearance: F = a + k_c x (x > 0) + k_t x (x <= 0) + c x' + F_f sgn(x')."""
     design = np.column_stack((np.ones_like(x), x * (x > 0), x * (x <= 0), v, np.sign(v)))
     coef, _ = _solve(design, f)
-    return _Fit(0.0, 0.0, float(coef[1]), float(coef[2]), 0.0, abs(float(coef[4])))
+    kept = tuple(float(c) for c in coef)
+    return _Fit(0.0, 0.0, kept[1], kept[2], 0.0, abs(kept[4]), coefficients=kept)
