@@ -125,3 +125,54 @@ def test_bad_input(kwargs: dict[str, object], error: type, match: str) -> None:
     args.update(kwargs)
     with pytest.raises(error, match=match):
         nonlinear_modes(joint(), **args)  # type: ignore[arg-type]
+
+
+def _mast3() -> object:
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast
+
+    return mast(3, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), node_mass=0.5)
+
+
+def test_mode_converges_where_the_joints_start_to_close() -> None:
+    """A 3-bay mast, H = 7, over the range where its joints close (74 Hz -> 119 Hz).
+
+    Plain Newton from the neighbouring amplitude failed at 12 of 20 amplitudes of
+    10 um..3 mm; sub-stepping in log amplitude must reach every one, and the branch must
+    be the one a run at four times as many amplitudes follows. (At 0.3 mm, 54 Hz, the
+    coarse run lands on a neighbouring solution 0.2 % off the fine one: not tested.)
+    """
+    coarse = np.geomspace(4e-4, 3e-3, 8)
+    fine = np.geomspace(4e-4, 3e-3, 29)  # every 4th is a coarse amplitude
+    np.testing.assert_allclose(fine[::4], coarse, rtol=1e-14)
+    a = nonlinear_modes(_mast3(), 1, coarse, harmonics=7)
+    b = nonlinear_modes(_mast3(), 1, fine, harmonics=7)
+    assert a.converged.all()
+    assert b.converged.all()
+    assert a.note == ""
+    f = a.frequency / (2.0 * math.pi)
+    assert f[0] < 80.0  # nearly open at the bottom
+    assert f[-1] > 110.0  # nearly closed at the top
+    np.testing.assert_allclose(a.frequency, b.frequency[::4], rtol=1e-8)
+
+
+def test_no_contact_over_the_range_is_noted_with_where_contact_begins() -> None:
+    import scipy.linalg
+
+    from clearjoint.harmonic.system import build
+
+    nm = nonlinear_modes(_mast3(), 1, [1e-6, 1e-5], harmonics=3)
+    assert nm.converged.all()
+    assert "no joint reaches a gap edge over 1e-06..1e-05 m" in nm.note
+    reach = float(nm.note.rsplit("contact begins near ", 1)[1].split(" m")[0])
+    # independently: the open-pattern linear frequency holds just below, not just above
+    model = build(_mast3(), 0.0, None, 1.0)
+    w_open = math.sqrt(scipy.linalg.eigh(model.open_stiffness(), model.mass)[0][0])
+    # followed down from 1.1 x onset (alone, 1.01 x onset finds another HB solution, 11.8 Hz)
+    near = nonlinear_modes(_mast3(), 1, np.array([0.99, 1.01, 1.1]) * reach, harmonics=3)
+    assert near.converged.all()
+    assert near.frequency[0] == pytest.approx(w_open, rel=1e-9)
+    assert w_open * (1.0 + 1e-6) < near.frequency[1] < w_open * 1.01
+    assert "no joint reaches" not in near.note
+    below = nonlinear_modes(_mast3(), 1, [0.5 * reach, 0.99 * reach], harmonics=3)
+    assert "no joint reaches" in below.note

@@ -1416,13 +1416,8 @@ def _run_modes(args: argparse.Namespace) -> int:
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     data.to_netcdf(args.out, engine="h5netcdf")
     _save_plot(mode, plot_path, quiet=True)
-    missing = int((~mode.converged).sum())
-    if missing:
-        print(
-            f"clearjoint modes: warning: no mode found at {missing} of {mode.amplitude.size} "
-            "amplitudes (NaN there; e.g. a mass floating in its gap)",
-            file=sys.stderr,
-        )
+    for line in filter(None, mode.note.split("; ")):
+        print(f"clearjoint modes: warning: {line} (NaN where no mode)", file=sys.stderr)
 
     def finite(values: Any) -> list[float | None]:
         return [float(v) if math.isfinite(v) else None for v in values]
