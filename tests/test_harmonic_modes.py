@@ -176,3 +176,40 @@ def test_no_contact_over_the_range_is_noted_with_where_contact_begins() -> None:
     assert "no joint reaches" not in near.note
     below = nonlinear_modes(_mast3(), 1, [0.5 * reach, 0.99 * reach], harmonics=3)
     assert "no joint reaches" in below.note
+
+
+def _mast2() -> object:
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast
+
+    return mast(2, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), node_mass=0.5)
+
+
+def test_points_below_onset_the_branch_from_above_misses_are_the_open_mode() -> None:
+    """A 2-bay mast: from above, the branch jumps past contact onset (7.2e-5 m).
+
+    The amplitude below onset is reached up from the open-pattern linear mode, exact
+    there: its frequency is the open pattern's eigenfrequency, computed apart.
+    """
+    import scipy.linalg
+
+    from clearjoint.harmonic.system import build
+
+    nm = nonlinear_modes(_mast2(), 1, np.geomspace(3e-5, 3e-3, 6), harmonics=7)
+    assert nm.converged.all()
+    model = build(_mast2(), 0.0, None, 1.0)
+    w_open = math.sqrt(scipy.linalg.eigh(model.open_stiffness(), model.mass)[0][0])
+    assert nm.frequency[0] == pytest.approx(w_open, rel=1e-9)
+    assert nm.frequency[1] > w_open * 1.05  # above onset: contact stiffens it
+    assert "1 of 6 amplitudes (3e-05..3e-05 m) followed up from the open-pattern mode" in nm.note
+
+
+def test_a_point_no_step_reaches_is_flagged_with_the_reason() -> None:
+    """Between onset (7.2e-5 m) and 1e-4 m the 2-bay mast's H = 7 branch is not followed."""
+    nm = nonlinear_modes(_mast2(), 1, [8.18e-5, 1.1e-4, 3e-3], harmonics=7)
+    assert list(nm.converged) == [False, True, True]
+    assert math.isnan(nm.frequency[0])
+    assert "no mode at 1 of 3 amplitudes (8.18e-05..8.18e-05 m): Newton did not converge" in (
+        nm.note
+    )
+    assert "after 10 halvings" in nm.note

@@ -105,8 +105,10 @@ class NonlinearMode:
     note : str
         Empty, or one line per thing the user should know: how many amplitudes found
         no mode and why (Newton did not converge from the neighbouring amplitude after
-        :data:`MAX_HALVINGS` halvings of the step; w fell to 0), or that no joint reached
-        a gap edge over the whole range (with the amplitude where contact begins).
+        :data:`MAX_HALVINGS` halvings of the step; w fell to 0); how many were reached
+        instead up from the open-pattern mode below contact onset (the branch from
+        above did not reach them: the solutions there may not be unique); or that no
+        joint reached a gap edge over the whole range (with where contact begins).
     """
 
     amplitude: FloatArray
@@ -363,9 +365,29 @@ def nonlinear_modes(
         for i in np.flatnonzero(amps == a).tolist():
             if i not in results:
                 reasons[i] = "w fell below 1e-3 of the closed-pattern frequency (no mode)"
+    reach, phi, w_open = _open_mode(model, int(mode), ref)
+    upward: list[int] = []
+    if reasons and math.isfinite(reach) and w_open > _LOWEST * omega_lin:
+        # the open-pattern mode is exact below onset: follow the branch up from there
+        open_guess = _first_guess(model, basis, phi, omega_lin, n_u)
+        open_guess[n_u] = w_open / omega_lin
+        for i in sorted(reasons):
+            start = min(float(amps[i]), reach * (1.0 - 1e-9))
+            z = solve_at(start, open_guess)
+            path: Path = [] if z is None else [(start, z)]
+            if path and _walk(solve_at, path, float(amps[i]), same_mode):
+                results[i] = path[-1][1]
+                del reasons[i]
+                upward.append(i)
     note = _note(amps, reasons)
+    if upward:
+        at = amps[upward]
+        note = (note + "; " if note else "") + (
+            f"{at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) followed up "
+            f"from the open-pattern mode below contact onset ({reach:.3g} m): the branch from "
+            "above did not reach them"
+        )
     if not _any_contact(model, basis, amps, results):
-        reach = _contact_amplitude(model, int(mode), ref)
         note = (note + "; " if note else "") + (
             f"no joint reaches a gap edge over {amps[0]:.3g}..{amps[-1]:.3g} m (linear "
             "open-pattern motion everywhere)"
@@ -462,27 +484,28 @@ def _note(amps: FloatArray, reasons: dict[int, str]) -> str:
     return "; ".join(lines)
 
 
-def _contact_amplitude(model: LinearSystem, mode: int, ref: int) -> float:
-    """The modal amplitude at which the open-pattern linear mode first reaches a gap edge, m.
+def _open_mode(model: LinearSystem, mode: int, ref: int) -> tuple[float, FloatArray, float]:
+    """(contact onset a_c in m, shape phi with phi[ref] = 1, w in rad/s) of the open pattern.
 
     The linear mode ``mode`` of M and K + k0 (every joint in free-play), scaled to 1 on
     the reference DOF, gives each joint a relative displacement amplitude |b_j^T phi|;
-    contact begins at min_j min(g_c, g_t) / |b_j^T phi|. NaN if undefined.
+    contact begins at a_c = min_j min(g_c, g_t) / |b_j^T phi|. Below a_c it is an exact
+    nonlinear mode. a_c is NaN if undefined (no joint, or phi[ref] = 0).
     """
     import scipy.linalg
 
-    if model.directions.shape[0] == 0:
-        return math.nan
-    _, shapes = scipy.linalg.eigh(model.open_stiffness(), model.mass)
+    w2, shapes = scipy.linalg.eigh(model.open_stiffness(), model.mass)
     phi = shapes[:, mode - 1]
-    if not abs(phi[ref]) > 1e-9 * float(np.max(np.abs(phi))):
-        return math.nan
-    swing = np.abs(model.directions @ (phi / phi[ref]))
+    w = math.sqrt(max(float(w2[mode - 1]), 0.0))
+    if model.directions.shape[0] == 0 or not abs(phi[ref]) > 1e-9 * float(np.max(np.abs(phi))):
+        return math.nan, phi, w
+    phi = phi / phi[ref]
+    swing = np.abs(model.directions @ phi)
     edge = np.minimum(model.g_c, model.g_t)
     with np.errstate(divide="ignore"):
         at = np.where(swing > 0.0, edge / swing, np.inf)
     value = float(np.min(at))
-    return value if math.isfinite(value) else math.nan
+    return (value if math.isfinite(value) else math.nan), phi, w
 
 
 def _any_contact(
