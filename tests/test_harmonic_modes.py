@@ -213,3 +213,33 @@ def test_a_point_no_step_reaches_is_flagged_with_the_reason() -> None:
         nm.note
     )
     assert "after 10 halvings" in nm.note
+
+
+def test_harmonics_whose_arrays_exceed_the_memory_bound_are_refused() -> None:
+    """H = 3000 on one DOF: N_t = 262144 samples x 6001 coefficients = 11.7 GiB of basis."""
+    from clearjoint.harmonic.system import MEMORY_BOUND
+
+    with pytest.raises(HarmonicError, match=r"harmonics 3000 .* needs an array of 11\.7 GiB") as e:
+        nonlinear_modes(joint(), 1, [1e-3], harmonics=3000)
+    fits = int(str(e.value).rsplit("H <= ", 1)[1].split(" ")[0])
+    # the largest H whose default N_t (32 (2H + 1) rounded up to 2^k) basis fits 2 GiB
+    size = [8 * 2 ** math.ceil(math.log2(32 * (2 * h + 1))) * (2 * h + 1) for h in (fits, fits + 1)]
+    assert size[0] <= MEMORY_BOUND < size[1]
+
+
+def test_cli_refuses_huge_and_bad_harmonics_in_one_line(
+    tmp_path: object, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from pathlib import Path
+
+    from clearjoint.cli import main
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "frf.toml"
+    for h, message in (("3000", "harmonics 3000 with 1 DOF(s)"), ("0", "--harmonics must be")):
+        out = Path(str(tmp_path)) / "m.nc"
+        args = ["modes", str(example), "--amplitude", "1um..1mm", "--harmonics", h]
+        assert main([*args, "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert message in err
+        assert len(err.strip().splitlines()) == 1
+        assert not out.exists()

@@ -1393,6 +1393,8 @@ def _run_modes(args: argparse.Namespace) -> int:
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     amplitudes = _amplitude_range(args.amplitude, args.points)
+    if args.harmonics < 1:
+        raise ParameterError(f"--harmonics must be an integer >= 1, got {args.harmonics}")
     samples = _samples(args, args.harmonics)
     if structure_study is not None:
         _structure_harmonic_check(study, "modes")

@@ -31,7 +31,13 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint.errors import ParameterError, ParameterTypeError
 from clearjoint.harmonic import aft
 from clearjoint.harmonic.solve import newton
-from clearjoint.harmonic.system import HarmonicError, LinearSystem, build, scale_length
+from clearjoint.harmonic.system import (
+    HarmonicError,
+    LinearSystem,
+    build,
+    check_size,
+    scale_length,
+)
 from clearjoint.joint import Friction
 
 if TYPE_CHECKING:
@@ -281,7 +287,8 @@ def nonlinear_modes(
     ParameterError
         A mode the system does not have, an amplitude at or below zero.
     HarmonicError
-        Bad harmonics or samples, friction or restitution.
+        Bad harmonics or samples, arrays above ``system.MEMORY_BOUND`` (2 GiB),
+        friction or restitution.
     """
     h, n_t = aft.check_harmonics(harmonics, samples)
     if friction is not None and friction.force > 0.0:
@@ -295,6 +302,7 @@ def nonlinear_modes(
     amps = _amplitudes(
         np.geomspace(0.5 * length, 20.0 * length, 40) if amplitudes is None else amplitudes
     )
+    check_size(model.n_dof, h, lambda k: aft.check_harmonics(k, samples)[1])
     basis = aft.Basis.make(h, n_t)
     n, n_c = model.n_dof, 2 * h + 1
     n_u = n_c * n
