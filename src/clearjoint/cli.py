@@ -1419,7 +1419,7 @@ def _run_modes(args: argparse.Namespace) -> int:
     data.to_netcdf(args.out, engine="h5netcdf")
     _save_plot(mode, plot_path, quiet=True)
     for line in filter(None, mode.note.split("; ")):
-        print(f"clearjoint modes: warning: {line} (NaN where no mode)", file=sys.stderr)
+        print(f"clearjoint modes: warning: {line}", file=sys.stderr)
 
     def finite(values: Any) -> list[float | None]:
         return [float(v) if math.isfinite(v) else None for v in values]
