@@ -57,6 +57,9 @@ MAX_HALVINGS = 10
 #: times it.
 _ABOVE = 4
 
+#: Newton iterations a sub-step may take (a full step between two amplitudes: 80).
+_SUB_ITERATIONS = 20
+
 #: Consecutive solutions whose fundamental shapes have a MAC below this are another mode.
 _MAC = 0.5
 
@@ -309,7 +312,7 @@ def nonlinear_modes(
     k_ref = model.reference_stiffness
     zero_force = np.zeros(n)
 
-    def solve_at(a: float, guess: FloatArray) -> FloatArray | None:
+    def solve_at(a: float, guess: FloatArray, iterations: int = 80) -> FloatArray | None:
         w_scale = max(omega_lin, 1e-300)
 
         def function(z: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -337,7 +340,7 @@ def nonlinear_modes(
             r[n_u + 1] = z[2 * n + ref]
             return r
 
-        found = newton(function, guess, 1.0, residual=residual)
+        found = newton(function, guess, 1.0, residual=residual, max_iterations=iterations)
         if found is None:
             return None
         z = found[0]
@@ -405,7 +408,7 @@ def nonlinear_modes(
 
 
 def _march(
-    solve_at: Callable[[float, FloatArray], FloatArray | None],
+    solve_at: Callable[..., FloatArray | None],
     amps: FloatArray,
     guess: FloatArray,
     same_mode: Callable[[FloatArray, FloatArray], bool],
@@ -442,7 +445,7 @@ def _march(
 
 
 def _walk(
-    solve_at: Callable[[float, FloatArray], FloatArray | None],
+    solve_at: Callable[..., FloatArray | None],
     path: Path,
     target: float,
     same_mode: Callable[[FloatArray, FloatArray], bool],
@@ -467,7 +470,7 @@ def _walk(
             back = math.log(a_now / path[-2][0])
             if back != 0.0:
                 guess = z_now + (z_now - path[-2][1]) * (step / back)
-        z = solve_at(a, guess)
+        z = solve_at(a, guess, 80 if step == full else _SUB_ITERATIONS)
         if z is None or not same_mode(z_now, z):
             if abs(step) * 0.5 < least * (1.0 - 1e-9):
                 return False
