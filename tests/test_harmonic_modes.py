@@ -125,3 +125,121 @@ def test_bad_input(kwargs: dict[str, object], error: type, match: str) -> None:
     args.update(kwargs)
     with pytest.raises(error, match=match):
         nonlinear_modes(joint(), **args)  # type: ignore[arg-type]
+
+
+def _mast3() -> object:
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast
+
+    return mast(3, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), node_mass=0.5)
+
+
+def test_mode_converges_where_the_joints_start_to_close() -> None:
+    """A 3-bay mast, H = 7, over the range where its joints close (74 Hz -> 119 Hz).
+
+    Plain Newton from the neighbouring amplitude failed at 12 of 20 amplitudes of
+    10 um..3 mm; sub-stepping in log amplitude must reach every one, and the branch must
+    be the one a run at four times as many amplitudes follows. (At 0.3 mm, 54 Hz, the
+    coarse run lands on a neighbouring solution 0.2 % off the fine one: not tested.)
+    """
+    coarse = np.geomspace(4e-4, 3e-3, 8)
+    fine = np.geomspace(4e-4, 3e-3, 29)  # every 4th is a coarse amplitude
+    np.testing.assert_allclose(fine[::4], coarse, rtol=1e-14)
+    a = nonlinear_modes(_mast3(), 1, coarse, harmonics=7)
+    b = nonlinear_modes(_mast3(), 1, fine, harmonics=7)
+    assert a.converged.all()
+    assert b.converged.all()
+    assert a.note == ""
+    f = a.frequency / (2.0 * math.pi)
+    assert f[0] < 80.0  # nearly open at the bottom
+    assert f[-1] > 110.0  # nearly closed at the top
+    np.testing.assert_allclose(a.frequency, b.frequency[::4], rtol=1e-8)
+
+
+def test_no_contact_over_the_range_is_noted_with_where_contact_begins() -> None:
+    import scipy.linalg
+
+    from clearjoint.harmonic.system import build
+
+    nm = nonlinear_modes(_mast3(), 1, [1e-6, 1e-5], harmonics=3)
+    assert nm.converged.all()
+    assert "no joint reaches a gap edge over 1e-06..1e-05 m" in nm.note
+    reach = float(nm.note.rsplit("contact begins near ", 1)[1].split(" m")[0])
+    # independently: the open-pattern linear frequency holds just below, not just above
+    model = build(_mast3(), 0.0, None, 1.0)
+    w_open = math.sqrt(scipy.linalg.eigh(model.open_stiffness(), model.mass)[0][0])
+    # followed down from 1.1 x onset (alone, 1.01 x onset finds another HB solution, 11.8 Hz)
+    near = nonlinear_modes(_mast3(), 1, np.array([0.99, 1.01, 1.1]) * reach, harmonics=3)
+    assert near.converged.all()
+    assert near.frequency[0] == pytest.approx(w_open, rel=1e-9)
+    assert w_open * (1.0 + 1e-6) < near.frequency[1] < w_open * 1.01
+    assert "no joint reaches" not in near.note
+    below = nonlinear_modes(_mast3(), 1, [0.5 * reach, 0.99 * reach], harmonics=3)
+    assert "no joint reaches" in below.note
+
+
+def _mast2() -> object:
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast
+
+    return mast(2, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), node_mass=0.5)
+
+
+def test_points_below_onset_the_branch_from_above_misses_are_the_open_mode() -> None:
+    """A 2-bay mast: from above, the branch jumps past contact onset (7.2e-5 m).
+
+    The amplitude below onset is reached up from the open-pattern linear mode, exact
+    there: its frequency is the open pattern's eigenfrequency, computed apart.
+    """
+    import scipy.linalg
+
+    from clearjoint.harmonic.system import build
+
+    nm = nonlinear_modes(_mast2(), 1, np.geomspace(3e-5, 3e-3, 6), harmonics=7)
+    assert nm.converged.all()
+    model = build(_mast2(), 0.0, None, 1.0)
+    w_open = math.sqrt(scipy.linalg.eigh(model.open_stiffness(), model.mass)[0][0])
+    assert nm.frequency[0] == pytest.approx(w_open, rel=1e-9)
+    assert nm.frequency[1] > w_open * 1.05  # above onset: contact stiffens it
+    assert "1 of 6 amplitudes (3e-05..3e-05 m) followed up from the open-pattern mode" in nm.note
+
+
+def test_a_point_no_step_reaches_is_flagged_with_the_reason() -> None:
+    """Between onset (7.2e-5 m) and 1e-4 m the 2-bay mast's H = 7 branch is not followed."""
+    nm = nonlinear_modes(_mast2(), 1, [8.18e-5, 1.1e-4, 3e-3], harmonics=7)
+    assert list(nm.converged) == [False, True, True]
+    assert math.isnan(nm.frequency[0])
+    assert "no mode at 1 of 3 amplitudes (8.18e-05..8.18e-05 m): Newton did not converge" in (
+        nm.note
+    )
+    assert "after 10 halvings" in nm.note
+
+
+def test_harmonics_whose_arrays_exceed_the_memory_bound_are_refused() -> None:
+    """H = 3000 on one DOF: N_t = 262144 samples x 6001 coefficients = 11.7 GiB of basis."""
+    from clearjoint.harmonic.system import MEMORY_BOUND
+
+    with pytest.raises(HarmonicError, match=r"harmonics 3000 .* needs an array of 11\.7 GiB") as e:
+        nonlinear_modes(joint(), 1, [1e-3], harmonics=3000)
+    fits = int(str(e.value).rsplit("H <= ", 1)[1].split(" ")[0])
+    # the largest H whose default N_t (32 (2H + 1) rounded up to 2^k) basis fits 2 GiB
+    size = [8 * 2 ** math.ceil(math.log2(32 * (2 * h + 1))) * (2 * h + 1) for h in (fits, fits + 1)]
+    assert size[0] <= MEMORY_BOUND < size[1]
+
+
+def test_cli_refuses_huge_and_bad_harmonics_in_one_line(
+    tmp_path: object, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from pathlib import Path
+
+    from clearjoint.cli import main
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "frf.toml"
+    for h, message in (("3000", "harmonics 3000 with 1 DOF(s)"), ("0", "--harmonics must be")):
+        out = Path(str(tmp_path)) / "m.nc"
+        args = ["modes", str(example), "--amplitude", "1um..1mm", "--harmonics", h]
+        assert main([*args, "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert message in err
+        assert len(err.strip().splitlines()) == 1
+        assert not out.exists()

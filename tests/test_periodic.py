@@ -675,3 +675,40 @@ def test_an_undamped_start_at_a_whole_fraction_of_the_gap_frequency_gets_the_rig
         frequency_response(PYHARM, F0, 0.5, 1.8)
     assert "give gap_stiffness > 0" not in str(caught.value)
     assert "1.0 rad/s" in str(caught.value)  # sqrt(k0/m), the gap's natural frequency
+
+
+def test_structure_curve_plot_has_one_colour_and_label_per_dof() -> None:
+    """X of shape (n, N): each DOF its own colour, the 8 largest labelled, the rest grey."""
+    import matplotlib.colors
+
+    n, dofs = 6, 10
+    omega = np.linspace(10.0, 20.0, n)
+    amp = np.outer(np.ones(n), np.arange(1, dofs + 1) * 1e-4)  # DOF k moves (k + 1) x 0.1 mm
+    stable = np.array([True, True, False, False, True, True])
+    curve = FrequencyResponse(
+        omega=omega,
+        force_amplitude=np.ones(n),
+        x_max=amp,
+        x_min=-amp,
+        amplitude=amp,
+        stable=stable,
+        multipliers=np.zeros((n, 2), dtype=np.complex128),
+        initial_state=np.zeros((n, 2 * dofs)),
+        events=[],
+        parameter="omega",
+        stop_reason="reached",
+        settings={"dof_names": [f"n{k}x" for k in range(dofs)]},
+        method="harmonic",
+    )
+    ax = curve.plot()
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[:8] == [f"n{k}x" for k in range(9, 1, -1)]  # largest first
+    assert "other DOFs" in labels
+    drawn = [line for line in ax.get_lines() if len(line.get_xdata())]
+    assert len(drawn) == 3 * dofs  # stable, unstable, stable segments per DOF
+    top = {matplotlib.colors.to_hex(line.get_color()) for line in drawn[-3:]}
+    assert top == {matplotlib.colors.to_hex("C0")}  # DOF 9, the largest, in C0 throughout
+    styles = {line.get_linestyle() for line in drawn[-3:]}
+    assert styles == {"-", "--"}
+    colours = {matplotlib.colors.to_hex(line.get_color()) for line in drawn}
+    assert len(colours) == 9  # 8 own colours and the grey of the other two

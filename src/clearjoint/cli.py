@@ -1393,6 +1393,8 @@ def _run_modes(args: argparse.Namespace) -> int:
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     amplitudes = _amplitude_range(args.amplitude, args.points)
+    if args.harmonics < 1:
+        raise ParameterError(f"--harmonics must be an integer >= 1, got {args.harmonics}")
     samples = _samples(args, args.harmonics)
     if structure_study is not None:
         _structure_harmonic_check(study, "modes")
@@ -1416,13 +1418,8 @@ def _run_modes(args: argparse.Namespace) -> int:
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     data.to_netcdf(args.out, engine="h5netcdf")
     _save_plot(mode, plot_path, quiet=True)
-    missing = int((~mode.converged).sum())
-    if missing:
-        print(
-            f"clearjoint modes: warning: no mode found at {missing} of {mode.amplitude.size} "
-            "amplitudes (NaN there; e.g. a mass floating in its gap)",
-            file=sys.stderr,
-        )
+    for line in filter(None, mode.note.split("; ")):
+        print(f"clearjoint modes: warning: {line}", file=sys.stderr)
 
     def finite(values: Any) -> list[float | None]:
         return [float(v) if math.isfinite(v) else None for v in values]

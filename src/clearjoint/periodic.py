@@ -274,6 +274,10 @@ class ResponseEvent:
         )
 
 
+#: A Structure's curve labels the DOFs with the largest amplitude, this many (C0 to C7).
+_LABELLED = 8
+
+
 @dataclass(frozen=True)
 class FrequencyResponse:
     """A whole frequency-response curve of exact period-1 orbits, stable and unstable.
@@ -447,7 +451,10 @@ class FrequencyResponse:
     def plot(self, ax: Axes | None = None) -> Axes:
         """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.
 
-        Free-play orbits (``free_play``: a continuum inside the gap) are dotted grey.
+        Free-play orbits (``free_play``: a continuum inside the gap) are dotted grey. A
+        Structure's curve (X of shape (n, N)) draws one curve per DOF: the 8 that move
+        most in their own colours, labelled (``settings["dof_names"]`` or "DOF k"),
+        the others light grey.
 
         Returns
         -------
@@ -465,15 +472,35 @@ class FrequencyResponse:
         free = np.zeros(self.stable.size, dtype=bool) if self.free_play is None else self.free_play
         style = np.where(free, 2, self.stable.astype(int))  # 0 unstable, 1 stable, 2 free play
         looks = {0: ("--", "C3"), 1: ("-", "C0"), 2: (":", "0.4")}
-        start = 0
-        for i in range(1, style.size + 1):
-            if i == style.size or style[i] != style[start]:
-                end = min(i + 1, style.size)
-                line, color = looks[int(style[start])]
-                ax.plot(xs[start:end], ys[start:end], line, color=color, lw=1.5)
-                start = i
-        ax.plot([], [], "-", color="C0", label="stable")
-        ax.plot([], [], "--", color="C3", label="unstable")
+        columns = ys.reshape(ys.shape[0], -1)
+        per_dof = ys.ndim == 2  # a Structure by harmonic balance: one curve per DOF
+        names = list(self.settings.get("dof_names", [])) if per_dof else []
+        if len(names) != columns.shape[1]:
+            names = [f"DOF {k}" for k in range(columns.shape[1])]
+        # the _LABELLED DOFs that move most get their own colour and legend entry
+        peak = np.nan_to_num(np.nanmax(np.abs(columns), axis=0, initial=0.0))
+        labelled = np.argsort(-peak, kind="stable")[:_LABELLED].tolist()
+        for k in range(columns.shape[1]):
+            own = f"C{labelled.index(k)}" if k in labelled else "0.75"
+            start = 0
+            for i in range(1, style.size + 1):
+                if i == style.size or style[i] != style[start]:
+                    end = min(i + 1, style.size)
+                    line, color = looks[int(style[start])]
+                    if per_dof and style[start] != 2:
+                        color = own
+                    ax.plot(xs[start:end], columns[start:end, k], line, color=color, lw=1.5)
+                    start = i
+        if per_dof:
+            for k in labelled:
+                ax.plot([], [], "-", color=f"C{labelled.index(k)}", label=names[k])
+            if columns.shape[1] > len(labelled):
+                ax.plot([], [], "-", color="0.75", label="other DOFs")
+            ax.plot([], [], "-", color="k", label="stable (solid)")
+            ax.plot([], [], "--", color="k", label="unstable (dashed)")
+        else:
+            ax.plot([], [], "-", color="C0", label="stable")
+            ax.plot([], [], "--", color="C3", label="unstable")
         if free.any():
             ax.plot([], [], ":", color="0.4", label="free play (centred; position not set)")
         markers = {

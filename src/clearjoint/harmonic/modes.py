@@ -21,6 +21,7 @@ section 1 (the dynamic stiffness is the backbone of the mode).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -30,7 +31,13 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint.errors import ParameterError, ParameterTypeError
 from clearjoint.harmonic import aft
 from clearjoint.harmonic.solve import newton
-from clearjoint.harmonic.system import HarmonicError, LinearSystem, build, scale_length
+from clearjoint.harmonic.system import (
+    HarmonicError,
+    LinearSystem,
+    build,
+    check_size,
+    scale_length,
+)
 from clearjoint.joint import Friction
 
 if TYPE_CHECKING:
@@ -41,6 +48,27 @@ FloatArray = NDArray[np.float64]
 
 #: Solutions with w below this fraction of the closed-pattern frequency are not modes.
 _LOWEST = 1e-3
+
+#: Halvings of the step in log amplitude before an amplitude is given up: the last try
+#: starts 2^-10 of the way from the neighbouring converged amplitude.
+MAX_HALVINGS = 10
+
+#: If the closed-pattern guess fails at the largest amplitude, it is tried at up to 10^4
+#: times it.
+_ABOVE = 4
+
+#: Newton iterations a sub-step may take (a full step between two amplitudes: 80).
+_SUB_ITERATIONS = 20
+
+#: Consecutive solutions whose fundamental shapes have a MAC below this are another mode.
+_MAC = 0.5
+
+_NEWTON = (
+    f"Newton did not converge from the neighbouring converged amplitude after {MAX_HALVINGS} "
+    "halvings of the step in log amplitude (or converged to another mode)"
+)
+
+Path = list[tuple[float, FloatArray]]
 
 
 @dataclass(frozen=True)
@@ -83,6 +111,13 @@ class NonlinearMode:
     dof_names : tuple of str
         A Structure's DOF names (the ``dof`` coordinate of :meth:`to_xarray`); empty
         for a Joint.
+    note : str
+        Empty, or one line per thing the user should know: how many amplitudes found
+        no mode and why (Newton did not converge from the neighbouring amplitude after
+        :data:`MAX_HALVINGS` halvings of the step; w fell to 0); how many were reached
+        instead up from the open-pattern mode below contact onset (the branch from
+        above did not reach them: the solutions there may not be unique); or that no
+        joint reached a gap edge over the whole range (with where contact begins).
     """
 
     amplitude: FloatArray
@@ -98,6 +133,7 @@ class NonlinearMode:
     harmonics: int = 7
     reference_dof: str = "x"
     dof_names: tuple[str, ...] = ()
+    note: str = ""
 
     def __repr__(self) -> str:
         ok = self.converged
@@ -171,6 +207,7 @@ class NonlinearMode:
                 "mode": self.mode,
                 "harmonics": self.harmonics,
                 "reference_dof": self.reference_dof,
+                "note": self.note,
             },
         )
 
@@ -221,7 +258,9 @@ def nonlinear_modes(
 
     EPMC with harmonic balance: at each modal amplitude a, solve for Q, w and the
     negative damping xi that makes the free motion periodic. Amplitudes are solved
-    from the largest down, each from the one before.
+    from the largest down, each from the ones before (a secant predictor in log a);
+    where Newton fails the step is halved, up to :data:`MAX_HALVINGS` times, and an
+    amplitude still failing is flagged in ``converged`` and explained in ``note``.
 
     Parameters
     ----------
@@ -251,7 +290,8 @@ def nonlinear_modes(
     ParameterError
         A mode the system does not have, an amplitude at or below zero.
     HarmonicError
-        Bad harmonics or samples, friction or restitution.
+        Bad harmonics or samples, arrays above ``system.MEMORY_BOUND`` (2 GiB),
+        friction or restitution.
     """
     h, n_t = aft.check_harmonics(harmonics, samples)
     if friction is not None and friction.force > 0.0:
@@ -265,13 +305,14 @@ def nonlinear_modes(
     amps = _amplitudes(
         np.geomspace(0.5 * length, 20.0 * length, 40) if amplitudes is None else amplitudes
     )
+    check_size(model.n_dof, h, lambda k: aft.check_harmonics(k, samples)[1])
     basis = aft.Basis.make(h, n_t)
     n, n_c = model.n_dof, 2 * h + 1
     n_u = n_c * n
     k_ref = model.reference_stiffness
     zero_force = np.zeros(n)
 
-    def solve_at(a: float, guess: FloatArray) -> FloatArray | None:
+    def solve_at(a: float, guess: FloatArray, iterations: int = 80) -> FloatArray | None:
         w_scale = max(omega_lin, 1e-300)
 
         def function(z: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -299,25 +340,198 @@ def nonlinear_modes(
             r[n_u + 1] = z[2 * n + ref]
             return r
 
-        found = newton(function, guess, 1.0, residual=residual)
+        found = newton(function, guess, 1.0, residual=residual, max_iterations=iterations)
         if found is None:
             return None
         z = found[0]
-        # w -> 0 is no mode: a mass floating in a gap with no restoring force (k0 = 0)
-        if not (z[n_u] > _LOWEST and np.all(np.isfinite(z))):
+        if not np.all(np.isfinite(z)):
+            return None
+        if not z[n_u] > _LOWEST:
+            # w -> 0 is no mode: a mass floating in a gap with no restoring force (k0 = 0)
+            low.append(a)
             return None
         return z
 
+    # the stiffest pattern's mode bounds w from above (1 % margin for HB's own error)
+    import scipy.linalg
+
+    b = model.directions
+    stiffest = model.stiffness + (b.T * (model.k0 + np.maximum(model.k_c, model.k_t))) @ b
+    w2_top = float(scipy.linalg.eigh(stiffest, model.mass, eigvals_only=True)[int(mode) - 1])
+    w_top = 1.01 * math.sqrt(max(w2_top, 0.0)) / max(omega_lin, 1e-300)
+
+    def same_mode(before: FloatArray, after: FloatArray) -> bool:
+        """Not a jump to another mode: w under the bound, fundamental shapes alike (MAC)."""
+        if not after[n_u] <= w_top:
+            return False
+        one, two = before[n : 3 * n], after[n : 3 * n]
+        mac = float(one @ two) ** 2 / max(float(one @ one) * float(two @ two), 1e-300)
+        return mac >= _MAC
+
+    low: list[float] = []
+    results, reasons = _march(
+        solve_at, amps, _first_guess(model, basis, shape, omega_lin, n_u), same_mode
+    )
+    for a in low:
+        for i in np.flatnonzero(amps == a).tolist():
+            if i not in results:
+                reasons[i] = "w fell below 1e-3 of the closed-pattern frequency (no mode)"
+    reach, phi, w_open = _open_mode(model, int(mode), ref)
+    upward: list[int] = []
+    if reasons and math.isfinite(reach) and w_open > _LOWEST * omega_lin:
+        # the open-pattern mode is exact below onset: follow the branch up from there
+        open_guess = _first_guess(model, basis, phi, omega_lin, n_u)
+        open_guess[n_u] = w_open / omega_lin
+        for i in sorted(reasons):
+            start = min(float(amps[i]), reach * (1.0 - 1e-9))
+            z = solve_at(start, open_guess)
+            path: Path = [] if z is None else [(start, z)]
+            if path and _walk(solve_at, path, float(amps[i]), same_mode):
+                results[i] = path[-1][1]
+                del reasons[i]
+                upward.append(i)
+    note = _note(amps, reasons)
+    if upward:
+        at = amps[upward]
+        note = (note + "; " if note else "") + (
+            f"{at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) followed up "
+            f"from the open-pattern mode below contact onset ({reach:.3g} m): the branch from "
+            "above did not reach them"
+        )
+    if not _any_contact(model, basis, amps, results):
+        note = (note + "; " if note else "") + (
+            f"no joint reaches a gap edge over {amps[0]:.3g}..{amps[-1]:.3g} m (linear "
+            "open-pattern motion everywhere)"
+            + (f": contact begins near {reach:.3g} m" if math.isfinite(reach) else "")
+        )
+    return _mode(model, basis, amps, results, int(mode), ref, omega_lin, note)
+
+
+def _march(
+    solve_at: Callable[..., FloatArray | None],
+    amps: FloatArray,
+    guess: FloatArray,
+    same_mode: Callable[[FloatArray, FloatArray], bool],
+) -> tuple[dict[int, FloatArray], dict[int, str]]:
+    """Solve the amplitudes from the largest down, sub-stepping where Newton fails.
+
+    The closed-pattern mode is the first guess at the largest amplitude, or if Newton
+    fails there at 10, 100, ... 10^4 times it, from where the branch is followed down.
+    Each next amplitude starts from a secant predictor in log a on the last two
+    converged solutions; when Newton fails the step is halved, up to
+    :data:`MAX_HALVINGS` times, and after a success doubled again. A solution
+    ``same_mode(previous, new)`` refuses (a jump to another mode) counts as a failure.
+    Returns (solutions by index, reasons by index of the failed ones); a solution
+    depends only on the amplitudes at and above it.
+    """
     results: dict[int, FloatArray] = {}
-    guess = _first_guess(model, basis, shape, omega_lin, n_u)
-    for i in range(amps.size - 1, -1, -1):
-        z = solve_at(float(amps[i]), guess)
-        if z is None and i == amps.size - 1:
-            continue
+    reasons: dict[int, str] = {}
+    start = float(amps[-1])
+    path: Path = []
+    for k in range(_ABOVE + 1):
+        z = solve_at(start * 10.0**k, guess)
         if z is not None:
-            results[i] = z
-            guess = z
-    return _mode(model, basis, amps, results, int(mode), ref, omega_lin)
+            path.append((start * 10.0**k, z))
+            break
+    if not path:
+        why = f"no mode from the closed-pattern mode at {start:.3g} m nor at up to 10^{_ABOVE} x it"
+        return results, dict.fromkeys(range(amps.size), why)
+    for i in range(amps.size - 1, -1, -1):
+        if _walk(solve_at, path, float(amps[i]), same_mode):
+            results[i] = path[-1][1]
+        else:
+            reasons[i] = _NEWTON
+    return results, reasons
+
+
+def _walk(
+    solve_at: Callable[..., FloatArray | None],
+    path: Path,
+    target: float,
+    same_mode: Callable[[FloatArray, FloatArray], bool],
+) -> bool:
+    """Step from ``path[-1]`` to amplitude ``target`` in log a; True if it converged there.
+
+    ``path`` holds the last two converged (a, z), updated in place.
+    """
+    if target == path[-1][0]:
+        return True
+    full = math.log(target / path[-1][0])
+    step, least = full, abs(full) / 2.0**MAX_HALVINGS
+    while True:
+        a_now, z_now = path[-1]
+        left = math.log(target / a_now)
+        last = abs(step) >= abs(left) * (1.0 - 1e-12)
+        if last:
+            step = left
+        a = target if last else a_now * math.exp(step)
+        guess = z_now
+        if len(path) > 1:
+            back = math.log(a_now / path[-2][0])
+            if back != 0.0:
+                guess = z_now + (z_now - path[-2][1]) * (step / back)
+        z = solve_at(a, guess, 80 if step == full else _SUB_ITERATIONS)
+        if z is None or not same_mode(z_now, z):
+            if abs(step) * 0.5 < least * (1.0 - 1e-9):
+                return False
+            step *= 0.5
+            continue
+        path.append((a, z))
+        del path[:-2]
+        if last:
+            return True
+        step *= 2.0
+
+
+def _note(amps: FloatArray, reasons: dict[int, str]) -> str:
+    """One line per distinct reason: how many amplitudes failed, over which range, and why."""
+    lines = []
+    for why in sorted(set(reasons.values())):
+        at = amps[[i for i, r in reasons.items() if r == why]]
+        lines.append(
+            f"no mode at {at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m): "
+            f"{why}"
+        )
+    return "; ".join(lines)
+
+
+def _open_mode(model: LinearSystem, mode: int, ref: int) -> tuple[float, FloatArray, float]:
+    """(contact onset a_c in m, shape phi with phi[ref] = 1, w in rad/s) of the open pattern.
+
+    The linear mode ``mode`` of M and K + k0 (every joint in free-play), scaled to 1 on
+    the reference DOF, gives each joint a relative displacement amplitude |b_j^T phi|;
+    contact begins at a_c = min_j min(g_c, g_t) / |b_j^T phi|. Below a_c it is an exact
+    nonlinear mode. a_c is NaN if undefined (no joint, or phi[ref] = 0).
+    """
+    import scipy.linalg
+
+    w2, shapes = scipy.linalg.eigh(model.open_stiffness(), model.mass)
+    phi = shapes[:, mode - 1]
+    w = math.sqrt(max(float(w2[mode - 1]), 0.0))
+    if model.directions.shape[0] == 0 or not abs(phi[ref]) > 1e-9 * float(np.max(np.abs(phi))):
+        return math.nan, phi, w
+    phi = phi / phi[ref]
+    swing = np.abs(model.directions @ phi)
+    edge = np.minimum(model.g_c, model.g_t)
+    with np.errstate(divide="ignore"):
+        at = np.where(swing > 0.0, edge / swing, np.inf)
+    value = float(np.min(at))
+    return (value if math.isfinite(value) else math.nan), phi, w
+
+
+def _any_contact(
+    model: LinearSystem, basis: aft.Basis, amps: FloatArray, results: dict[int, FloatArray]
+) -> bool:
+    """True if a converged orbit takes some joint to or past a gap edge (or nothing to check)."""
+    if not results or model.directions.shape[0] == 0:
+        return True
+    n_c, n = 2 * basis.harmonics + 1, model.n_dof
+    for i, z in results.items():
+        delta = (z[: n_c * n] * amps[i]).reshape(n_c, n) @ model.directions.T
+        top, bottom = basis.extremes(delta)
+        if np.any(top >= model.g_c) or np.any(bottom <= -model.g_t):
+            return True
+    return False
 
 
 def _first_guess(
@@ -339,6 +553,7 @@ def _mode(
     mode: int,
     ref: int,
     omega_lin: float,
+    note: str = "",
 ) -> NonlinearMode:
     n, n_c = model.n_dof, 2 * basis.harmonics + 1
     n_u = n_c * n
@@ -388,6 +603,7 @@ def _mode(
         harmonics=basis.harmonics,
         reference_dof=model.dof_names[ref],
         dof_names=() if model.is_joint else tuple(model.dof_names),
+        note=note,
     )
 
 

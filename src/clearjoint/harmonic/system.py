@@ -13,6 +13,7 @@ each joint's law in series with its member.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -334,3 +335,38 @@ def friction_speed(system: Any, omega: float, given: float | None) -> float:
     if gaps:
         return 1e-3 * omega * max(max(gaps), 1e-6)
     return 0.0
+
+
+#: The largest array a harmonic-balance solve may allocate, bytes (2 GiB).
+MEMORY_BOUND = 2**31
+
+
+def check_size(n_dof: int, harmonics: int, samples: Callable[[int], int]) -> None:
+    """Refuse an H whose largest array would exceed :data:`MEMORY_BOUND`.
+
+    The two largest arrays are the dense Jacobian, (N (2H + 1) + 2)^2 floats, and the
+    AFT basis, N_t (2H + 1) floats (8 bytes each); ``samples(H)`` is N_t for that H
+    (the user's, or the default that grows with H).
+
+    Raises
+    ------
+    HarmonicError
+        Naming the size, the bound and the largest H that fits.
+    """
+
+    def largest(h: int) -> float:
+        return 8.0 * max((n_dof * (2 * h + 1) + 2) ** 2, samples(h) * (2 * h + 1))
+
+    need = largest(harmonics)
+    if need <= MEMORY_BOUND:
+        return
+    fits, above = 0, harmonics  # largest(fits) fits (0: nothing does), largest(above) not
+    while above - fits > 1:
+        middle = (fits + above) // 2
+        fits, above = (middle, above) if largest(middle) <= MEMORY_BOUND else (fits, middle)
+    raise HarmonicError(
+        f"harmonics {harmonics} with {n_dof} DOF(s) and {samples(harmonics)} samples needs an "
+        "array of "
+        f"{need / 2**30:.3g} GiB, above the {MEMORY_BOUND / 2**30:.0f} GiB bound: use fewer "
+        f"harmonics (H = 7 to 31 is usual for joints; H <= {fits} fits here)"
+    )
