@@ -364,3 +364,25 @@ def test_first_nonlinear_mode_of_the_example_mast_is_its_free_decay_backbone() -
     assert np.all(np.diff(peak) > 0.0)
     gap = w / np.interp(a, peak, nm.frequency) - 1.0
     assert np.all(np.abs(gap) < 1e-3)
+
+
+def test_a_structure_curve_names_its_dofs_in_the_plot(three_links: Structure) -> None:
+    """The legend of a Structure's curve carries the DOF names, not "DOF k"."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    fr = frequency_response(three_links, FORCE, 400.0, 410.0, max_points=3, check_points=0)
+    assert fr.settings["dof_names"] == list(three_links.dof_names)
+    labels = fr.plot().get_legend_handles_labels()[1]
+    assert any(name in label for label in labels for name in three_links.dof_names)
+    assert not any(label.startswith("DOF ") for label in labels)
+
+
+def test_a_size_beyond_the_memory_bound_is_one_clear_error() -> None:
+    """frequency_response refuses, as nonlinear_modes does, an H whose AFT basis would not
+    fit (H = 3000 on one DOF: 262144 samples x 6001 coefficients, 11.7 GiB)."""
+    from clearjoint import Joint
+
+    joint = Joint(mass=1.0, clearance=1e-4, compression_stiffness=1e6)
+    with pytest.raises(HarmonicError, match=r"harmonics 3000 .* needs an array of 11\.7 GiB"):
+        frequency_response(joint, 1.0, 100.0, 200.0, harmonics=3000)

@@ -43,6 +43,7 @@ from clearjoint.harmonic.system import (
     HarmonicError,
     LinearSystem,
     build,
+    check_size,
     force_vector,
     friction_speed,
     scale_length,
@@ -211,6 +212,7 @@ def frequency_response(
         raise ParameterError(
             f"stability must be 'hill' or 'monodromy' (or None for the default), got {stability!r}"
         )
+    check_size(model.n_dof, h, lambda k: aft.check_harmonics(k, samples)[1])
     basis = aft.Basis.make(h, n_t)
     k_ref = model.reference_stiffness
 
@@ -282,6 +284,9 @@ def frequency_response(
         "force_pattern": unit_force,
         "stability": stability or ("hill" if model.is_joint else "monodromy"),
     }
+    names = getattr(system, "dof_names", None)
+    if names is not None and not model.is_joint:
+        settings["dof_names"] = list(names)  # the plot's legend
     response = _response(
         model,
         basis,
