@@ -10,6 +10,7 @@ import pytest
 
 from clearjoint import Friction, Joint, ParameterError, dissipation, stiffness
 from clearjoint.harmonic import HarmonicError, NonlinearMode, nonlinear_modes
+from clearjoint.harmonic.modes import MAX_HALVINGS
 
 matplotlib.use("Agg")
 
@@ -212,7 +213,7 @@ def test_a_point_no_step_reaches_is_flagged_with_the_reason() -> None:
     assert "no mode at 1 of 3 amplitudes (8.18e-05..8.18e-05 m): Newton did not converge" in (
         nm.note
     )
-    assert "after 10 halvings" in nm.note
+    assert f"after {MAX_HALVINGS} halvings" in nm.note
 
 
 def test_harmonics_whose_arrays_exceed_the_memory_bound_are_refused() -> None:
