@@ -53,7 +53,8 @@ _LOWEST = 1e-3
 #: starts 2^-3 of the way from the neighbouring converged amplitude. More buys little
 #: where it fails (near contact onset the mode has several solutions close together):
 #: the example mast's first mode at 50 amplitudes (benchmarks/bench_harmonic.py sizes)
-#: converged at 43, 45 and 44 of 50 with 0, 3 and 10 halvings, in 15, 61 and 105 s.
+#: converged at 43, 45 and 44 of 50 with 0, 3 and 10 halvings, in 15, 61 and 105 s (2
+#: cores, another job running; with 3 and nothing else running, 45 of 50 in 45 s).
 MAX_HALVINGS = 3
 
 #: If the closed-pattern guess fails at the largest amplitude, it is tried at up to 10^4
