@@ -232,13 +232,24 @@ def check_orbits(
     )
 
 
-def untrusted_events(response: FrequencyResponse, check: OrbitCheck) -> list[Any]:
-    """Return one ``"untrusted"`` ResponseEvent per checked point whose residual is too large."""
+def untrusted(omega: ArrayLike, force: ArrayLike, amplitude: ArrayLike, i: int, note: str) -> Any:
+    """Return an ``"untrusted"`` ResponseEvent at point ``i`` of a curve (w in rad/s, the
+    force in N, per-point amplitudes in m, per DOF or not: their largest), saying why."""
     from clearjoint.periodic import ResponseEvent
 
+    return ResponseEvent(
+        "untrusted",
+        float(np.asarray(omega)[i]),
+        float(np.asarray(force)[i]),
+        float(np.max(np.asarray(amplitude)[i])),
+        note,
+    )
+
+
+def untrusted_events(response: FrequencyResponse, check: OrbitCheck) -> list[Any]:
+    """Return one ``"untrusted"`` ResponseEvent per checked point whose residual is too large."""
     out = []
     for m in np.flatnonzero(~check.trusted):
-        i = int(check.index[m])
         r = check.residual[m]
         what = (
             f"one period of exact motion misses it by {r:.2g} of its state"
@@ -246,11 +257,11 @@ def untrusted_events(response: FrequencyResponse, check: OrbitCheck) -> list[Any
             else "the exact motion from it could not be computed"
         )
         out.append(
-            ResponseEvent(
-                "untrusted",
-                float(response.omega[i]),
-                float(response.force_amplitude[i]),
-                float(np.max(response.amplitude[i])),
+            untrusted(
+                response.omega,
+                response.force_amplitude,
+                response.amplitude,
+                int(check.index[m]),
                 f"the harmonic-balance orbit is not the exact motion here ({what}; exact "
                 f"{int(check.exact_events[m])} gap-edge events against the orbit's "
                 f"{int(check.orbit_crossings[m])}): its stability verdict is not to be "

@@ -528,22 +528,22 @@ def _response(
     initial = np.concatenate((x0, v0), axis=1)
     events = _events(model, lam, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1))
     events += [
-        ResponseEvent(
-            "untrusted",
-            float(omega[i]),
-            float(force[i]),
-            float(np.max(amplitude[i])),
+        check.untrusted(
+            omega,
+            force,
+            amplitude,
+            i,
             f"Hill's eigenproblem at H = {basis.harmonics} resolves fewer than the 2N = {2 * n} "
             "exponents: no stability verdict here; raise harmonics or use stability='monodromy'",
         )
         for i in unresolved
     ]
     events += [
-        ResponseEvent(
-            "untrusted",
-            float(omega[i]),
-            float(force[i]),
-            float(np.max(amplitude[i])),
+        check.untrusted(
+            omega,
+            force,
+            amplitude,
+            i,
             f"Hill's largest multiplier {mine:.4g} and the exact monodromy's {exact:.4g} of the "
             "same orbit give other verdicts (the perturbation needs more harmonics than "
             "the orbit); use stability='monodromy'",
@@ -587,11 +587,11 @@ def _sticking_events(
         stuck = np.flatnonzero(rubbing & (turns > 2.0))
         if stuck.size:
             out.append(
-                ResponseEvent(
-                    "untrusted",
-                    float(response.omega[i]),
-                    float(response.force_amplitude[i]),
-                    float(np.max(response.amplitude[i])),
+                check.untrusted(
+                    response.omega,
+                    response.force_amplitude,
+                    response.amplitude,
+                    i,
                     f"joint {int(stuck[0])}'s relative speed reverses {int(turns[stuck[0]])} "
                     "times per period: it sticks, where the regularised friction's "
                     "linearisation (and this stability verdict) is not to be trusted; "
