@@ -498,22 +498,38 @@ def hill_exponents(
     (Lazarus & Thomas 2010). Kept as the reference sorting; the curves use
     :func:`clearjoint.harmonic.hill.spectrum` (centroid sorting).
     """
-    n = system.n_dof
+    lam = scipy.linalg.eigvals(
+        hill_matrix(system, basis, jacobian, omega, velocity_tangent), check_finite=False
+    )
+    keep = np.argsort(np.abs(lam.imag), kind="stable")[: 2 * system.n_dof]
+    return np.asarray(lam[keep], dtype=np.complex128)
+
+
+def hill_matrix(
+    system: LinearSystem,
+    basis: Basis,
+    jacobian: FloatArray,
+    omega: float,
+    velocity_tangent: FloatArray | None = None,
+) -> FloatArray:
+    """Return Hill's quadratic eigenproblem as a standard one, of size 2 (2H + 1) N.
+
+    (Delta_0 + lambda Delta_1 + lambda^2 Delta_2) s = 0 with Delta_0 the HB Jacobian,
+    Delta_1 = I x C + 2 w D x M (plus the friction's sampled viscous term) and Delta_2 =
+    I x M, inverted exactly since M is diagonal: [[0, I], [-Delta_2^-1 Delta_0,
+    -Delta_2^-1 Delta_1]], its first (2H + 1) N rows of an eigenvector being s.
+    """
     n_c = 2 * basis.harmonics + 1
-    inv_m = 1.0 / np.diag(system.mass)  # M is diagonal (lumped masses)
-    # Delta_1 = I x C + 2 w D x M (the linear Jacobian's pattern with K = 0, M = 0)
     delta1 = _damping_operator(system, basis, omega)
     if velocity_tangent is not None:  # regularised friction: a sampled viscous term
         add_joint_blocks(delta1, basis.products(velocity_tangent), system.directions)
-    size = n_c * n
-    scale = np.tile(inv_m, n_c)[:, None]
+    size = n_c * system.n_dof
+    scale = np.tile(1.0 / np.diag(system.mass), n_c)[:, None]  # M is diagonal (lumped)
     a = np.zeros((2 * size, 2 * size))
     a[:size, size:] = np.eye(size)
     a[size:, :size] = -scale * jacobian
     a[size:, size:] = -scale * delta1
-    lam = scipy.linalg.eigvals(a, check_finite=False)
-    keep = np.argsort(np.abs(lam.imag), kind="stable")[: 2 * n]
-    return np.asarray(lam[keep], dtype=np.complex128)
+    return a
 
 
 def _damping_operator(system: LinearSystem, basis: Basis, omega: float) -> FloatArray:

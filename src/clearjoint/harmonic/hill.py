@@ -54,10 +54,9 @@ from numpy.typing import NDArray
 
 from clearjoint.harmonic.aft import (
     Basis,
-    _damping_operator,
-    add_joint_blocks,
     check_harmonics,
     evaluate,
+    hill_matrix,
 )
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
 
@@ -184,16 +183,8 @@ def spectrum(
     if sorting not in ("centroid", "imaginary"):
         raise HarmonicError(f"sorting must be 'centroid' or 'imaginary', got {sorting!r}")
     n = system.n_dof
-    n_c = 2 * basis.harmonics + 1
-    size = n_c * n
-    delta1 = _damping_operator(system, basis, omega)
-    if velocity_tangent is not None:
-        add_joint_blocks(delta1, basis.products(velocity_tangent), system.directions)
-    scale = np.tile(1.0 / np.diag(system.mass), n_c)[:, None]  # M diagonal: Delta_2^-1 exact
-    a = np.zeros((2 * size, 2 * size))
-    a[:size, size:] = np.eye(size)
-    a[size:, :size] = -scale * jacobian
-    a[size:, size:] = -scale * delta1
+    size = (2 * basis.harmonics + 1) * n
+    a = hill_matrix(system, basis, jacobian, omega, velocity_tangent)
     period = 2.0 * math.pi / omega
     if sorting == "imaginary":
         lam = scipy.linalg.eigvals(a, check_finite=False)
