@@ -82,12 +82,9 @@ def _set_resolution(n: int) -> None:
 def _fitted_slope_backlash(x: np.ndarray, f: np.ndarray) -> float:
     """The variant not adopted: slope, place and step all by least absolute deviations
     (the slope on a fine grid about the median step's, 0.25 to 4 times it)."""
-    parts, rise, fall = _levels(x, f)
     out = []
-    for part, start, stop in ((parts[0], fall, rise), (parts[1], rise, fall)):
-        travel, fb = np.abs(x[part] - x[part][0]), f[part]
-        s = damper._crossings(travel, fb, start, stop)
-        assert s is not None
+    for branch in _branches(x, f):  # the crossings the adopted estimator reads
+        s = branch.s
         d0 = float(np.median(np.diff(s))) * damper.N_CROSSINGS
         best = (np.inf, 0.0)
         for d in d0 * np.geomspace(0.25, 4.0, 241):
