@@ -166,13 +166,11 @@ def test_hill_determinant_is_exact_for_constant_stiffness(omega: float) -> None:
     np.testing.assert_allclose(np.sort_complex(mu), np.sort_complex(exact), atol=1e-9)
 
 
-@pytest.mark.parametrize("omega", [0.8, 1.0, 1.3, 2.2])
-def test_hill_determinant_matches_the_integrated_monodromy(omega: float) -> None:
-    """Damped Mathieu-like k(t) = k (1 + 0.6 cos w t + 0.3 sin 2 w t): Hill's determinant
-    (H = 12) against the monodromy matrix integrated by scipy's solve_ivp; w = 1 and 1.3 lie
-    in instability tongues (real multipliers < -1). The truncated determinant converges as
-    H^-3 here (2e-5 at H = 12, 3e-7 at 48); at w = 1.3 the eigenvalue route's imaginary-part
-    criterion keeps one Floquet exponent twice (two tie at Im = w / 2) and misses -0.51."""
+def mathieu(omega: float) -> tuple[system.LinearSystem, aft.Basis, np.ndarray, np.ndarray]:
+    """The damped Mathieu-like case k(t) = k (1 + 0.6 cos w t + 0.3 sin 2 w t), m = 1,
+    c = 0.1, k = 0.5: its one-DOF model, an H = 12 basis (128 samples), the HB Jacobian of
+    the time-varying stiffness, and the exact multipliers from the monodromy matrix
+    integrated by scipy's solve_ivp (no clearjoint code in that route)."""
     from scipy.integrate import solve_ivp
 
     m, c, k = 1.0, 0.1, 0.5
@@ -185,7 +183,6 @@ def test_hill_determinant_matches_the_integrated_monodromy(omega: float) -> None
 
     jac = aft.linear_jacobian(model, basis, omega, model.damping)
     aft.add_joint_blocks(jac, basis.products(stiffness(tau / omega)[:, None]), np.ones((1, 1)))
-    mu = aft.hill_determinant_multipliers(model, basis, jac[None], np.array([omega]))[0]
     period = 2 * math.pi / omega
     columns = []
     for start in ([1.0, 0.0], [0.0, 1.0]):
@@ -197,7 +194,18 @@ def test_hill_determinant_matches_the_integrated_monodromy(omega: float) -> None
             atol=1e-12,
         )
         columns.append(sol.y[:, -1])
-    exact = np.linalg.eigvals(np.array(columns).T)
+    return model, basis, jac, np.linalg.eigvals(np.array(columns).T)
+
+
+@pytest.mark.parametrize("omega", [0.8, 1.0, 1.3, 2.2])
+def test_hill_determinant_matches_the_integrated_monodromy(omega: float) -> None:
+    """Damped Mathieu-like k(t) = k (1 + 0.6 cos w t + 0.3 sin 2 w t): Hill's determinant
+    (H = 12) against the monodromy matrix integrated by scipy's solve_ivp; w = 1 and 1.3 lie
+    in instability tongues (real multipliers < -1). The truncated determinant converges as
+    H^-3 here (2e-5 at H = 12, 3e-7 at 48); at w = 1.3 the eigenvalue route's imaginary-part
+    criterion keeps one Floquet exponent twice (two tie at Im = w / 2) and misses -0.51."""
+    model, basis, jac, exact = mathieu(omega)
+    mu = aft.hill_determinant_multipliers(model, basis, jac[None], np.array([omega]))[0]
     np.testing.assert_allclose(np.sort_complex(mu), np.sort_complex(exact), atol=5e-5)
     assert (np.max(np.abs(mu)) > 1.0) == (np.max(np.abs(exact)) > 1.0)
 

@@ -244,33 +244,10 @@ def test_damped_mathieu_against_the_integrated_monodromy(omega: float) -> None:
     integrated by scipy's solve_ivp. w = 1 and 1.3 lie in tongues (real multipliers, one
     below -1): at 1.3 the imaginary-part sorting keeps one exponent twice and misses -0.51;
     the centroid's family check keeps both."""
-    from scipy.integrate import solve_ivp
+    from test_harmonic_aft import mathieu
 
-    from test_harmonic_aft import _sdof
-
-    m, c, k = 1.0, 0.1, 0.5
-    model = _sdof(0.0, m, c)
-    basis = aft.Basis.make(12, 128)
-    tau = 2 * math.pi * np.arange(128) / 128
-
-    def stiffness(t: float | np.ndarray) -> float | np.ndarray:
-        return k * (1 + 0.6 * np.cos(omega * t) + 0.3 * np.sin(2 * omega * t))
-
-    jac = aft.linear_jacobian(model, basis, omega, model.damping)
-    aft.add_joint_blocks(jac, basis.products(stiffness(tau / omega)[:, None]), np.ones((1, 1)))
+    model, basis, jac, exact = mathieu(omega)
     found = hill.spectrum(model, basis, jac, omega)
-    period = 2 * math.pi / omega
-    columns = []
-    for start in ([1.0, 0.0], [0.0, 1.0]):
-        sol = solve_ivp(
-            lambda t, y: [y[1], -(c * y[1] + stiffness(t) * y[0]) / m],
-            (0.0, period),
-            start,
-            rtol=1e-11,
-            atol=1e-12,
-        )
-        columns.append(sol.y[:, -1])
-    exact = np.linalg.eigvals(np.array(columns).T)
     assert _set_distance(found.multipliers, exact) < 5e-5
     if omega == 1.3:
         strip = hill.spectrum(model, basis, jac, omega, sorting="imaginary")
