@@ -117,7 +117,12 @@ def test_result_object() -> None:
         ({"amplitudes": [-1e-6, 1e-3]}, ParameterError, "starts at -1e-06"),
         ({"harmonics": 0}, HarmonicError, "harmonics must be an integer >= 1"),
         ({"samples": 5}, HarmonicError, "samples must be an integer"),
-        ({"friction": Friction(0.1, 10.0)}, HarmonicError, "does not carry Coulomb friction"),
+        ({"friction": Friction(0.1, 10.0, "free-play")}, HarmonicError, "free-play stroke only"),
+        (
+            {"friction": Friction(0.1, 10.0), "friction_regularization": 0.0},
+            ParameterError,
+            "friction_regularization",
+        ),
         ({"restitution": 0.5}, HarmonicError, "clearjoint.periodic"),
     ],
 )

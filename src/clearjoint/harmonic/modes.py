@@ -16,6 +16,12 @@ energy over the orbit; EPMC's ratio equals it for sinusoidal motion only.
 
 For one joint without losses xi = 0 and w(a) is the paper's 2 pi / T(A) of
 section 1 (the dynamic stiffness is the backbone of the mode).
+
+Coulomb friction in joints (over the whole path, MODEL.md section 2) enters the
+residual regularised as mu_s P tanh(v / v_eps), with its slope in the Jacobian, as in
+:func:`clearjoint.harmonic.frequency_response` (:func:`clearjoint.harmonic.aft.evaluate`
+carries both); E_diss is then the friction's work, 2 mu_s P (x_max - x_min) per cycle
+for one joint sliding back and forth.
 """
 
 from __future__ import annotations
@@ -32,10 +38,10 @@ from clearjoint.errors import ParameterError, ParameterTypeError
 from clearjoint.harmonic import aft
 from clearjoint.harmonic.solve import newton
 from clearjoint.harmonic.system import (
-    HarmonicError,
     LinearSystem,
     build,
     check_size,
+    friction_speed,
     scale_length,
 )
 from clearjoint.joint import Friction
@@ -233,6 +239,32 @@ def _amplitudes(amplitudes: ArrayLike) -> FloatArray:
     return np.sort(a)
 
 
+def _model(
+    system: Any,
+    mode: int,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+    given: float | None,
+) -> tuple[LinearSystem, int, float, FloatArray]:
+    """(model, reference DOF, closed-pattern frequency, shape) of mode ``mode``.
+
+    Coulomb friction (a Joint's, or a Structure's joints', over the whole path) is
+    regularised as in :func:`clearjoint.harmonic.frequency_response`: mu_s P tanh(v / v_eps)
+    with v_eps = ``given``, or by default 1e-3 * w * c with w the mode's closed-pattern
+    frequency (frequency_response's w is its start frequency) and c the clearance.
+    """
+    import dataclasses
+
+    # v_eps does not enter the linear modes: build once with a placeholder, then set it
+    model = build(system, damping_ratio, friction, restitution, 1.0)
+    ref, omega_lin, shape = _reference(model, mode)
+    if model.friction_force is not None or given is not None:
+        speed = friction_speed(system, omega_lin, given)
+        model = dataclasses.replace(model, friction_speed=speed)
+    return model, ref, omega_lin, shape
+
+
 def _reference(model: LinearSystem, mode: int) -> tuple[int, float, FloatArray]:
     """(reference DOF, closed-pattern frequency, shape) of linear mode ``mode``."""
     import scipy.linalg
@@ -257,6 +289,7 @@ def nonlinear_modes(
     damping_ratio: float = 0.0,
     friction: Friction | None = None,
     restitution: float = 1.0,
+    friction_regularization: float | None = None,
 ) -> NonlinearMode:
     """Return a nonlinear mode's frequency, damping and shape against amplitude (MODEL.md 5.4).
 
@@ -281,9 +314,22 @@ def nonlinear_modes(
         N_t, as for :func:`clearjoint.harmonic.frequency_response`.
     damping_ratio : float
         zeta of a Joint's linear part (c_v = 2 zeta sqrt(m k_c)).
-    friction, restitution
-        Refused (HarmonicError): friction is not carried by EPMC here yet, and
-        impacts need :mod:`clearjoint.periodic`.
+    friction : Friction, optional
+        Coulomb friction of a Joint over its whole path (region "everywhere"),
+        regularised as mu_s P tanh(v / v_eps) exactly as in
+        :func:`clearjoint.harmonic.frequency_response`; a Structure's joints carry
+        their own friction (rigid members only) the same way. Friction over the
+        free-play stroke only is refused (HarmonicError). Where friction holds the
+        motion (a Joint's restoring force at a turning point at most mu_s P; a
+        Structure's every rubbing joint below 3 v_eps), the amplitude fails with the
+        reason in ``note``: the orbit HB finds there moves by the regularisation's
+        creep only.
+    restitution : float
+        Refused unless 1 (HarmonicError): impacts need :mod:`clearjoint.periodic`.
+    friction_regularization : float, optional
+        v_eps, m/s. Default 1e-3 w c, with w the mode's closed-pattern frequency
+        (frequency_response uses its start frequency) and c a Joint's clearance (for
+        a Structure the largest clearance of its joints with friction).
 
     Returns
     -------
@@ -295,16 +341,12 @@ def nonlinear_modes(
         A mode the system does not have, an amplitude at or below zero.
     HarmonicError
         Bad harmonics or samples, arrays above ``system.MEMORY_BOUND`` (2 GiB),
-        friction or restitution.
+        friction over the free-play stroke only, or restitution.
     """
     h, n_t = aft.check_harmonics(harmonics, samples)
-    if friction is not None and friction.force > 0.0:
-        raise HarmonicError(
-            "nonlinear_modes does not carry Coulomb friction yet; set friction=None, or use "
-            "clearjoint.harmonic.frequency_response (regularised) or clearjoint.periodic"
-        )
-    model = build(system, damping_ratio, friction, restitution)
-    ref, omega_lin, shape = _reference(model, mode)
+    model, ref, omega_lin, shape = _model(
+        system, mode, damping_ratio, friction, restitution, friction_regularization
+    )
     length = scale_length(model)
     amps = _amplitudes(
         np.geomspace(0.5 * length, 20.0 * length, 40) if amplitudes is None else amplitudes
@@ -313,36 +355,15 @@ def nonlinear_modes(
     basis = aft.Basis.make(h, n_t)
     n, n_c = model.n_dof, 2 * h + 1
     n_u = n_c * n
-    k_ref = model.reference_stiffness
-    zero_force = np.zeros(n)
 
     def solve_at(a: float, guess: FloatArray, iterations: int = 80) -> FloatArray | None:
         w_scale = max(omega_lin, 1e-300)
 
         def function(z: FloatArray) -> tuple[FloatArray, FloatArray]:
-            q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
-            ev = aft.evaluate(model, basis, q, w, zero_force, negative_damping=xi)
-            d_xi = -w * ((basis.derivative @ q.reshape(n_c, n)) @ model.mass).ravel()
-            r = np.empty(n_u + 2)
-            r[:n_u] = ev.residual / (k_ref * a)
-            r[n_u] = z[n + ref] - 1.0  # a_1 on the reference DOF = a
-            r[n_u + 1] = z[2 * n + ref]  # b_1 there = 0 (phase)
-            jac = np.zeros((n_u + 2, n_u + 2))
-            jac[:n_u, :n_u] = ev.jacobian / k_ref
-            jac[:n_u, n_u] = ev.d_omega * w_scale / (k_ref * a)
-            jac[:n_u, n_u + 1] = d_xi * w_scale / (k_ref * a)
-            jac[n_u, n + ref] = 1.0
-            jac[n_u + 1, 2 * n + ref] = 1.0
-            return r, jac
+            return epmc_residual(model, basis, z, a, w_scale, ref)
 
         def residual(z: FloatArray) -> FloatArray:
-            q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
-            ev = aft.evaluate(model, basis, q, w, zero_force, negative_damping=xi, jacobian=False)
-            r = np.empty(n_u + 2)
-            r[:n_u] = ev.residual / (k_ref * a)
-            r[n_u] = z[n + ref] - 1.0
-            r[n_u + 1] = z[2 * n + ref]
-            return r
+            return epmc_residual(model, basis, z, a, w_scale, ref, jacobian=False)[0]
 
         found = newton(function, guess, 1.0, residual=residual, max_iterations=iterations)
         if found is None:
@@ -394,7 +415,13 @@ def nonlinear_modes(
                 results[i] = path[-1][1]
                 del reasons[i]
                 upward.append(i)
+    held, partly = _held(model, basis, amps, results, omega_lin)
+    for i, why in held.items():
+        del results[i]
+        reasons[i] = why
     note = _note(amps, reasons)
+    if partly:
+        note = (note + "; " if note else "") + partly
     if upward:
         at = amps[upward]
         note = (note + "; " if note else "") + (
@@ -409,6 +436,66 @@ def nonlinear_modes(
             + (f": contact begins near {reach:.3g} m" if math.isfinite(reach) else "")
         )
     return _mode(model, basis, amps, results, int(mode), ref, omega_lin, note)
+
+
+def epmc_residual(
+    model: LinearSystem,
+    basis: aft.Basis,
+    z: FloatArray,
+    amplitude: float,
+    w_scale: float,
+    ref: int,
+    *,
+    jacobian: bool = True,
+) -> tuple[FloatArray, FloatArray]:
+    """Return EPMC's scaled residual and its exact Jacobian at z (MODEL.md 5.4).
+
+    The HB residual of the free motion with the negative damping -xi M u'
+    (:func:`clearjoint.harmonic.aft.evaluate`, which carries the joints' laws and their
+    regularised friction mu_s P tanh(v / v_eps) with its slope), divided by k_ref a, and
+    the two conditions a_1 = a, b_1 = 0 on the reference DOF.
+
+    Parameters
+    ----------
+    model : LinearSystem
+    basis : aft.Basis
+    z : (N (2H + 1) + 2,) ndarray
+        The coefficients over a (row-major from (2H + 1, N)), then w and xi over
+        ``w_scale``.
+    amplitude : float
+        The modal amplitude a, m.
+    w_scale : float
+        The scale of w and xi, rad/s (the closed-pattern frequency).
+    ref : int
+        The reference DOF.
+    jacobian : bool
+        False: the Jacobian is an empty (0, 0) array.
+
+    Returns
+    -------
+    residual : (N (2H + 1) + 2,) ndarray
+    jacobian : (N (2H + 1) + 2, N (2H + 1) + 2) ndarray
+        d residual / d z.
+    """
+    n, n_c = model.n_dof, 2 * basis.harmonics + 1
+    n_u = n_c * n
+    k_ref, a = model.reference_stiffness, amplitude
+    q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
+    ev = aft.evaluate(model, basis, q, w, np.zeros(n), negative_damping=xi, jacobian=jacobian)
+    r = np.empty(n_u + 2)
+    r[:n_u] = ev.residual / (k_ref * a)
+    r[n_u] = z[n + ref] - 1.0  # a_1 on the reference DOF = a
+    r[n_u + 1] = z[2 * n + ref]  # b_1 there = 0 (phase)
+    if not jacobian:
+        return r, np.empty((0, 0))
+    d_xi = -w * ((basis.derivative @ q.reshape(n_c, n)) @ model.mass).ravel()
+    jac = np.zeros((n_u + 2, n_u + 2))
+    jac[:n_u, :n_u] = ev.jacobian / k_ref
+    jac[:n_u, n_u] = ev.d_omega * w_scale / (k_ref * a)
+    jac[:n_u, n_u + 1] = d_xi * w_scale / (k_ref * a)
+    jac[n_u, n + ref] = 1.0
+    jac[n_u + 1, 2 * n + ref] = 1.0
+    return r, jac
 
 
 def _march(
@@ -485,6 +572,76 @@ def _walk(
         if last:
             return True
         step *= 2.0
+
+
+#: A structure's rubbing joint whose relative speed stays below this many v_eps over the
+#: whole cycle never reaches 99.5 % of its friction force (tanh 3): friction holds it.
+HELD = 3.0
+
+
+def _held(
+    model: LinearSystem,
+    basis: aft.Basis,
+    amps: FloatArray,
+    results: dict[int, FloatArray],
+    omega_lin: float,
+) -> tuple[dict[int, str], str]:
+    """The converged amplitudes where friction holds the motion, and a note on others.
+
+    A Joint: the exact free motion sticks at a turning point (v = 0) whose restoring
+    force |f(x)| is at most mu_s P (MODEL.md section 2's Coulomb law; x_max and x_min
+    of the orbit). EPMC's negative damping, which vanishes with v, cannot move it there
+    either: an orbit found exists only by the regularisation's creep, and fails.
+
+    A Structure: a rubbing joint whose peak relative speed stays below :data:`HELD`
+    v_eps is held over the whole cycle. If every rubbing joint is held, the amplitude
+    fails (its losses are creep only); if some are, it is kept (they act as locked,
+    their creep loss shrinks with v_eps) and counted in the returned note.
+
+    Returns
+    -------
+    dict
+        Failed index -> reason.
+    str
+        Empty, or the note on amplitudes with some joints held.
+    """
+    if model.friction_force is None or not results:
+        return {}, ""
+    rubbing = model.friction_force > 0.0
+    n_c, n = 2 * basis.harmonics + 1, model.n_dof
+    failed: dict[int, str] = {}
+    partly: list[int] = []
+    for i, z in results.items():
+        delta = (z[: n_c * n] * amps[i]).reshape(n_c, n) @ model.directions.T
+        if model.is_joint:
+            top, bottom = basis.extremes(delta)
+            force, _ = model.joint_forces(np.vstack((top, bottom)))
+            rub = float(model.friction_force[0])
+            if min(float(force[0, 0]), -float(force[1, 0])) <= rub:
+                failed[i] = (
+                    "friction holds the joint: its restoring force at a turning point is below "
+                    f"mu_s P = {rub:.3g} N, so the free motion sticks (the orbit found moves by "
+                    "the regularisation's creep only)"
+                )
+            continue
+        top, bottom = basis.extremes(z[n_c * n] * omega_lin * (basis.derivative @ delta))
+        held = rubbing & (np.maximum(np.abs(top), np.abs(bottom)) < HELD * model.friction_speed)
+        if np.all(held[rubbing]):
+            failed[i] = (
+                f"friction holds every rubbing joint (relative speed below {HELD:g} v_eps = "
+                f"{HELD * model.friction_speed:.3g} m/s over the whole cycle: they stick, and "
+                "the losses are the regularisation's creep only)"
+            )
+        elif np.any(held):
+            partly.append(i)
+    if not partly:
+        return failed, ""
+    at = amps[partly]
+    return failed, (
+        f"at {at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) friction "
+        "holds some rubbing joints over the whole cycle: they act as locked, and their loss "
+        "there is the regularisation's creep (it shrinks with friction_regularization)"
+    )
 
 
 def _note(amps: FloatArray, reasons: dict[int, str]) -> str:
