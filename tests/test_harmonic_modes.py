@@ -249,3 +249,129 @@ def test_cli_refuses_huge_and_bad_harmonics_in_one_line(
         assert message in err
         assert len(err.strip().splitlines()) == 1
         assert not out.exists()
+
+
+# ---- Coulomb friction in nonlinear modes (regularised, as frequency_response) ----------------
+
+#: 1 kN of sliding friction over the whole path on the paper's joint: it holds the mass
+#: where the contact force k_c A at a turning point is below mu_s P, A < 12.5 um.
+HEAVY = Friction(coefficient=0.5, lateral_load=2000.0)
+
+#: Modal amplitudes with x_max from 1.7 to 30 times the symmetric joint's stick limit
+#: g_c + mu_s P / k_c.
+SLIDING = np.geomspace(1e-4, 2e-3, 6)
+
+
+@pytest.mark.parametrize("name", ["symmetric", "off-centre"])
+def test_epmc_jacobian_with_friction_is_the_finite_difference_one(name: str) -> None:
+    """The bordered EPMC Jacobian (the tanh's slope in q and in w, the xi column)."""
+    from clearjoint.harmonic import aft
+    from clearjoint.harmonic.modes import epmc_residual
+    from clearjoint.harmonic.system import build
+
+    j = CASES[name]
+    h = 5
+    model = build(j, 0.01, HEAVY, 1.0, 0.05)  # v_eps 0.05 m/s: a slope finite differences see
+    basis = aft.Basis.make(h, 64)
+    rng = np.random.default_rng(7)
+    w_scale = math.sqrt(j.compression_stiffness / j.mass)
+    z = np.zeros(2 * h + 3)
+    z[1], z[3], z[0] = 1.0, 0.1, 0.05  # a_1 = a, a_2, a mean shift
+    z[: 2 * h + 1] += 0.02 * rng.standard_normal(2 * h + 1)
+    z[2 * h + 1], z[2 * h + 2] = 0.8, 0.05
+    a = 2e-4
+    r, jac = epmc_residual(model, basis, z, a, w_scale, 0)
+    numeric = np.empty_like(jac)
+    for k in range(z.size):
+        step = np.zeros_like(z)
+        step[k] = 1e-7
+        plus = epmc_residual(model, basis, z + step, a, w_scale, 0, jacobian=False)[0]
+        minus = epmc_residual(model, basis, z - step, a, w_scale, 0, jacobian=False)[0]
+        numeric[:, k] = (plus - minus) / 2e-7
+    assert np.max(np.abs(jac - numeric)) < 1e-6 * np.max(np.abs(jac))
+    # the friction is in it: the same point without friction has another residual
+    plain = epmc_residual(build(j, 0.01, None, 1.0), basis, z, a, w_scale, 0)[0]
+    assert np.max(np.abs(r - plain)) > 1e-3
+
+
+def _sliding(
+    name: str, harmonics: int, sharper: float = 1.0, friction: Friction = HEAVY
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(zeta, relative error of damping_ratio against dissipation's free orbit, relative
+    error of energy_per_cycle against the closed form 2 mu_s P (x_max - x_min))."""
+    j = CASES[name]
+    w = math.sqrt(j.compression_stiffness / j.mass)
+    v_eps = 1e-3 * w * j.clearance * sharper  # sharper = 1: the default
+    nm = nonlinear_modes(
+        j, 1, SLIDING, harmonics=harmonics, friction=friction, friction_regularization=v_eps
+    )
+    assert nm.converged.all()
+    assert nm.note == ""
+    a = nm.x_max - j.compression_gap
+    # MODEL.md section 2: Coulomb's work per cycle is mu_s P times the distance slid,
+    # 2 (x_max - x_min) for one maximum and one minimum; on the exact free orbit of the
+    # same penetration A that is 4 mu_s P X, with E_max = V(x_max) (clearjoint.dissipation)
+    exact = dissipation.energies(j, a, friction=friction).loss_factor / 2.0
+    closed = 2.0 * friction.force * (nm.x_max - nm.x_min)
+    return nm.damping_ratio, nm.damping_ratio / exact - 1.0, nm.energy_per_cycle / closed - 1.0
+
+
+def _largest(values: np.ndarray) -> float:
+    return float(np.max(np.abs(values)))
+
+
+def test_friction_damping_ratio_is_the_coulomb_loss_factor_of_the_free_orbit() -> None:
+    """zeta (no viscous damping; 1 kN, zeta 0.26 down to 0.004) against E_diss / (4 pi
+    E_max) of the exact free orbit of the same A, symmetric joint, converging with H and
+    with v_eps made sharper. Measured (python docs/harmonic_friction_modes.py): 1.8e-4,
+    6.1e-5, 2.9e-5 at H = 7, 15, 31 (default v_eps); at H = 31 with v_eps 100, 10, 1 times
+    the default 9.0e-3, 8.7e-5, 2.9e-5 (the regularisation's error falls as v_eps^2 to the
+    truncation error's floor; the default is on the floor)."""
+    errors = [_largest(_sliding("symmetric", h)[1]) for h in (7, 15, 31)]
+    assert errors[0] < 5e-4
+    assert errors[2] < 5e-5
+    assert errors[2] < errors[0] / 4.0
+    smooth = [_largest(_sliding("symmetric", 31, sharper)[1]) for sharper in (100.0, 10.0)]
+    assert smooth[0] > 3e-3
+    assert smooth[1] < smooth[0] / 50.0
+    assert errors[2] < smooth[1]
+
+
+def test_friction_damping_ratio_off_centre_differs_by_the_orbit_distortion() -> None:
+    """Off-centre joint (k_t 30 MN/m, k0 1 MN/m): where zeta is large EPMC's periodic orbit
+    is not the conservative free orbit (the negative damping feeds what friction takes at
+    other phases: x_min 2.4 % further out at zeta 0.48), so zeta differs from the free
+    orbit's loss factor by 0.2 to 0.5 zeta^2 (5.1e-2 at zeta 0.48, 6.4e-3 at 0.14, 2.9e-4
+    at 0.026), whatever H; with 100 N (zeta <= 0.05) it is below 1e-3."""
+    zeta, err15, _ = _sliding("off-centre", 15)
+    _, err31, _ = _sliding("off-centre", 31)
+    assert np.all(np.abs(err31) < 0.5 * zeta**2 + 5e-5)
+    assert err15[0] == pytest.approx(err31[0], rel=0.1)  # not H truncation
+    assert _largest(_sliding("off-centre", 31, friction=Friction(0.5, 200.0))[1]) < 1e-3
+
+
+def test_friction_energy_per_cycle_is_coulombs_work_on_the_orbit() -> None:
+    """energy_per_cycle = xi * integral of m x'^2 dt against 2 mu_s P (x_max - x_min)."""
+    for name in ("symmetric", "off-centre"):
+        errors = [_largest(_sliding(name, h)[2]) for h in (7, 31)]
+        assert errors[0] < 1e-3
+        assert errors[1] < 1e-4
+
+
+def test_friction_that_holds_the_joint_fails_the_amplitude_with_the_reason() -> None:
+    """Below the stick limit (k_c A <= mu_s P at a turning point, A = x_max - g_c) the free
+    motion sticks; HB still finds an orbit there (creep at about 10^-3 of the speed, zeta
+    70-340, 45-70 Hz): it must fail, with the reason, and the amplitudes above converge."""
+    j = joint()
+    stick = j.compression_gap + HEAVY.force / j.compression_stiffness  # x_max at the limit
+    amps = np.array([4.62e-5, 1e-4, 1e-3])
+    for h in (7, 15):
+        nm = nonlinear_modes(j, 1, amps, harmonics=h, friction=HEAVY)
+        assert list(nm.converged) == [False, True, True]
+        assert math.isnan(nm.damping_ratio[0])
+        assert "no mode at 1 of 3 amplitudes (4.62e-05..4.62e-05 m): friction holds the joint" in (
+            nm.note
+        )
+        assert np.all(nm.x_max[1:] > 1.5 * stick)
+    loose = nonlinear_modes(j, 1, amps, harmonics=7, friction=Friction(0.1, 100.0))
+    assert loose.converged.all()  # 10 N: the same amplitudes slide
