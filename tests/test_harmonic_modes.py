@@ -360,8 +360,9 @@ def test_friction_energy_per_cycle_is_coulombs_work_on_the_orbit() -> None:
 
 def test_friction_that_holds_the_joint_fails_the_amplitude_with_the_reason() -> None:
     """Below the stick limit (k_c A <= mu_s P at a turning point, A = x_max - g_c) the free
-    motion sticks; HB still finds an orbit there (creep at about 10^-3 of the speed, zeta
-    70-340, 45-70 Hz): it must fail, with the reason, and the amplitudes above converge."""
+    motion sticks; HB still finds an orbit there (47 Hz and zeta 340 at H = 7, 71 Hz and
+    zeta 68 at H = 15, driven by EPMC's negative damping): it must fail, with the reason,
+    and the amplitudes above converge."""
     j = joint()
     stick = j.compression_gap + HEAVY.force / j.compression_stiffness  # x_max at the limit
     amps = np.array([4.62e-5, 1e-4, 1e-3])
