@@ -124,7 +124,8 @@ class NonlinearMode:
     note : str
         Empty, or one line per thing the user should know: how many amplitudes found
         no mode and why (Newton did not converge from the neighbouring amplitude after
-        :data:`MAX_HALVINGS` halvings of the step; w fell to 0); how many were reached
+        :data:`MAX_HALVINGS` halvings of the step; w fell to 0; friction holds a
+        rubbing joint at a turning point); how many were reached
         instead up from the open-pattern mode below contact onset (the branch from
         above did not reach them: the solutions there may not be unique); or that no
         joint reached a gap edge over the whole range (with where contact begins).
@@ -319,11 +320,11 @@ def nonlinear_modes(
         regularised as mu_s P tanh(v / v_eps) exactly as in
         :func:`clearjoint.harmonic.frequency_response`; a Structure's joints carry
         their own friction (rigid members only) the same way. Friction over the
-        free-play stroke only is refused (HarmonicError). Where friction holds the
-        motion (a Joint's restoring force at a turning point at most mu_s P; a
-        Structure's every rubbing joint below 3 v_eps), the amplitude fails with the
-        reason in ``note``: the orbit HB finds there moves by the regularisation's
-        creep only.
+        free-play stroke only is refused (HarmonicError). Where a rubbing joint
+        would stick at a turning point (the force that would hold it, for a Joint
+        its restoring force, within mu_s P: :func:`holding_forces`), the amplitude
+        fails with the reason in ``note``: EPMC's regularised orbit has no stick
+        phase and creeps through there, driven by the negative damping.
     restitution : float
         Refused unless 1 (HarmonicError): impacts need :mod:`clearjoint.periodic`.
     friction_regularization : float, optional
