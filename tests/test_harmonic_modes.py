@@ -511,7 +511,8 @@ def test_structure_amplitudes_where_the_rubbing_joint_would_stick_fail_with_the_
     orbits down there anyway (at 7.1 um: 61 Hz, zeta 0.9, moved by EPMC's negative
     damping): none may be returned. Checked by hand on every converged orbit: at each
     turning point of mass 0 (u0' = 0) the force that would hold it, -f(u0) + k_s (u1 -
-    u0), exceeds mu_s P; and the amplitude where it does not is named in the note."""
+    u0), exceeds mu_s P. (Which orbits Newton reaches down there depends on the amplitude
+    stepping; the test below names the reason on orbits made by hand.)"""
     from clearjoint.harmonic import aft
 
     amps = np.geomspace(3e-6, 3e-3, 25)
@@ -519,7 +520,6 @@ def test_structure_amplitudes_where_the_rubbing_joint_would_stick_fail_with_the_
     assert K_S * amps[0] < RUB.force
     assert not nm.converged[0]
     assert nm.converged.sum() >= 10
-    assert "a rubbing joint sticks at a turning point" in nm.note
     basis = aft.Basis.make(7, 480)
     tau = 2.0 * math.pi * np.arange(4096) / 4096
     for coef in nm.harmonic_shapes[nm.converged]:
@@ -546,3 +546,43 @@ def test_holding_force_is_the_chains_spring_and_joint_force_by_hand() -> None:
     u = basis.evaluate(coef, tau)
     expected = [-_law2(a) + K_S * (b - a) for a, b in u]
     np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-9)
+
+
+def test_the_stick_check_names_orbits_made_by_hand() -> None:
+    """The 2-DOF chain, H = 3: mass 1 swinging 3 um on a nearly still mass 0 (the spring
+    can pull with at most 3 N < 20 N) fails with the reason; both masses sliding by mm
+    (holding force at mass 0's turning points |-f(1 mm) + k_s (1 mm)| = 50 N > 20 N)
+    passes."""
+    from clearjoint.harmonic import aft
+    from clearjoint.harmonic.modes import _held
+    from clearjoint.harmonic.system import build
+
+    model = build(_rubbing_chain(), 0.0, None, 1.0, 1e-3)
+    basis = aft.Basis.make(3, 64)
+    omega = 2.0 * math.pi * 159.0
+    orbits = {}
+    for i, (a, fundamental) in enumerate(((3e-6, [1e-7, 3e-6]), (2e-3, [1e-3, 2e-3]))):
+        coef = np.zeros((7, 2))
+        coef[1] = fundamental
+        orbits[i] = np.concatenate((coef.ravel() / a, [1.0, 0.0]))
+    failed = _held(model, basis, np.array([3e-6, 2e-3]), orbits, omega)
+    assert list(failed) == [0]
+    assert failed[0].startswith("a rubbing joint sticks at a turning point")
+
+
+def test_the_stick_check_on_a_joint_is_the_restoring_force_at_the_turning_points() -> None:
+    """x = X cos(w t) on the paper's joint with 1 kN of friction: the restoring force at
+    x_max, k_c (X - g_c), is 160 N at X = 55 um (held) and 12 kN at 0.2 mm (slides)."""
+    from clearjoint.harmonic import aft
+    from clearjoint.harmonic.modes import _held
+    from clearjoint.harmonic.system import build
+
+    j = joint()
+    model = build(j, 0.0, HEAVY, 1.0, 1e-3)
+    basis = aft.Basis.make(3, 64)
+    orbits = {i: np.array([0.0, 1.0, 0, 0, 0, 0, 0, 1.0, 0.0]) for i in range(2)}
+    amps = np.array([55e-6, 2e-4])
+    assert j.compression_stiffness * (amps[0] - j.compression_gap) < HEAVY.force
+    failed = _held(model, basis, amps, orbits, 6000.0)
+    assert list(failed) == [0]
+    assert failed[0].startswith("friction holds the joint")
