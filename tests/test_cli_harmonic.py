@@ -6,6 +6,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from clearjoint.cli import main
@@ -203,7 +204,11 @@ FRICTION = '\n[losses]\ndamping_ratio = 0.01\nfriction_coefficient = 0.1\nlatera
 @pytest.mark.parametrize(
     ("command", "losses", "message"),
     [
-        ("modes", FRICTION, "set friction_coefficient = 0"),
+        (
+            "modes",
+            FRICTION + 'friction_region = "free-play"\n',
+            'set friction_region = "everywhere"',
+        ),
         ("modes", "\n[losses]\nrestitution = 0.8\n", "set restitution = 1"),
         ("frf", "\n[losses]\nrestitution = 0.8\n", "drop --method harmonic"),
         (
@@ -324,3 +329,26 @@ def test_frf_without_an_orbit_at_the_start_says_so_in_one_line(
     assert f"clearjoint structure {study} respond" in last
     assert "Traceback" not in err
     assert not out.exists()
+
+
+def test_modes_of_a_joint_study_with_friction(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Friction over the whole path used to be refused by `clearjoint modes`; now it runs,
+    with the same --json keys, and (no viscous damping) its energy per cycle is Coulomb's
+    work on the orbit, 2 mu_s P (x_max - x_min) with mu_s P = 10 N (MODEL.md section 2)."""
+    import xarray as xr
+
+    text = EXAMPLE.read_text()
+    study = tmp_path / "rubbing.toml"
+    study.write_text(text[: text.index("[losses]")] + FRICTION.replace("0.01", "0"))
+    out = tmp_path / "m.nc"
+    args = ["modes", str(study), "--amplitude", "0.1mm..2mm", "--points", "4", "--json"]
+    code, printed, err = run([*args, "--out", str(out)], capsys)
+    assert code == 0, err
+    data = json.loads(printed)
+    assert set(data) == MODES_JSON_KEYS
+    assert all(z > 0.0 for z in data["damping_ratio"])
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        span = ds["x_max"].values - ds["x_min"].values
+    np.testing.assert_allclose(data["energy_per_cycle_j"], 2.0 * 10.0 * span, rtol=2e-3)

@@ -258,8 +258,9 @@ def test_first_nonlinear_mode_of_a_small_mast_is_its_free_decay_backbone() -> No
 
 def test_friction_in_a_structure_joint_is_carried_and_a_sticking_orbit_flagged() -> None:
     """Friction in rigid members' joints is carried by HB (tests/test_harmonic_friction.py
-    checks it); nonlinear modes and the exact structure motion still refuse it, and an orbit
-    whose joints stick (20 N of friction against 40 N of forcing) is flagged untrusted."""
+    checks it; nonlinear modes, tests/test_harmonic_modes.py); the exact structure motion
+    still refuses it, and an orbit whose joints stick (20 N of friction against 40 N of
+    forcing) is flagged untrusted."""
     from clearjoint import Friction
     from clearjoint.structure import StructureError
 
@@ -271,8 +272,6 @@ def test_friction_in_a_structure_joint_is_carried_and_a_sticking_orbit_flagged()
     sticking = [e for e in fr.events if e.kind == "untrusted"]
     assert len(sticking) == 2
     assert "it sticks" in sticking[0].note
-    with pytest.raises(HarmonicError, match="not by nonlinear_modes"):
-        nonlinear_modes(s, 1, [1e-3])
     with pytest.raises(StructureError, match="friction"):
         time_response(s, np.array([0.0, 40.0]), 300.0, 0.01)
 

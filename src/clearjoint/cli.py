@@ -1124,13 +1124,6 @@ def _harmonic_losses(study: Any, path: str, command: str) -> None:
     friction = study.friction
     if friction is None or friction.force <= 0.0:
         return
-    if command == "modes":
-        raise ParameterError(
-            f"{path}: [losses] friction_coefficient = {friction.coefficient:g} with a lateral "
-            "load: nonlinear modes do not carry Coulomb friction yet; set friction_coefficient "
-            "= 0, or follow the forced response with clearjoint frf STUDY (exact stick-slip) or "
-            "clearjoint frf STUDY --method harmonic (regularised friction)"
-        )
     if friction.region != "everywhere":
         raise ParameterError(
             f"{path}: [losses] friction_region = {friction.region!r} is not carried by harmonic "

@@ -16,6 +16,12 @@ energy over the orbit; EPMC's ratio equals it for sinusoidal motion only.
 
 For one joint without losses xi = 0 and w(a) is the paper's 2 pi / T(A) of
 section 1 (the dynamic stiffness is the backbone of the mode).
+
+Coulomb friction in joints (over the whole path, MODEL.md section 2) enters the
+residual regularised as mu_s P tanh(v / v_eps), with its slope in the Jacobian, as in
+:func:`clearjoint.harmonic.frequency_response` (:func:`clearjoint.harmonic.aft.evaluate`
+carries both); E_diss is then the friction's work, 2 mu_s P (x_max - x_min) per cycle
+for one joint sliding back and forth.
 """
 
 from __future__ import annotations
@@ -32,10 +38,10 @@ from clearjoint.errors import ParameterError, ParameterTypeError
 from clearjoint.harmonic import aft
 from clearjoint.harmonic.solve import newton
 from clearjoint.harmonic.system import (
-    HarmonicError,
     LinearSystem,
     build,
     check_size,
+    friction_speed,
     scale_length,
 )
 from clearjoint.joint import Friction
@@ -118,7 +124,8 @@ class NonlinearMode:
     note : str
         Empty, or one line per thing the user should know: how many amplitudes found
         no mode and why (Newton did not converge from the neighbouring amplitude after
-        :data:`MAX_HALVINGS` halvings of the step; w fell to 0); how many were reached
+        :data:`MAX_HALVINGS` halvings of the step; w fell to 0; friction holds a
+        rubbing joint at a turning point); how many were reached
         instead up from the open-pattern mode below contact onset (the branch from
         above did not reach them: the solutions there may not be unique); or that no
         joint reached a gap edge over the whole range (with where contact begins).
@@ -233,6 +240,32 @@ def _amplitudes(amplitudes: ArrayLike) -> FloatArray:
     return np.sort(a)
 
 
+def _model(
+    system: Any,
+    mode: int,
+    damping_ratio: float,
+    friction: Friction | None,
+    restitution: float,
+    given: float | None,
+) -> tuple[LinearSystem, int, float, FloatArray]:
+    """(model, reference DOF, closed-pattern frequency, shape) of mode ``mode``.
+
+    Coulomb friction (a Joint's, or a Structure's joints', over the whole path) is
+    regularised as in :func:`clearjoint.harmonic.frequency_response`: mu_s P tanh(v / v_eps)
+    with v_eps = ``given``, or by default 1e-3 * w * c with w the mode's closed-pattern
+    frequency (frequency_response's w is its start frequency) and c the clearance.
+    """
+    import dataclasses
+
+    # v_eps does not enter the linear modes: build once with a placeholder, then set it
+    model = build(system, damping_ratio, friction, restitution, 1.0)
+    ref, omega_lin, shape = _reference(model, mode)
+    if model.friction_force is not None or given is not None:
+        speed = friction_speed(system, omega_lin, given)
+        model = dataclasses.replace(model, friction_speed=speed)
+    return model, ref, omega_lin, shape
+
+
 def _reference(model: LinearSystem, mode: int) -> tuple[int, float, FloatArray]:
     """(reference DOF, closed-pattern frequency, shape) of linear mode ``mode``."""
     import scipy.linalg
@@ -257,6 +290,7 @@ def nonlinear_modes(
     damping_ratio: float = 0.0,
     friction: Friction | None = None,
     restitution: float = 1.0,
+    friction_regularization: float | None = None,
 ) -> NonlinearMode:
     """Return a nonlinear mode's frequency, damping and shape against amplitude (MODEL.md 5.4).
 
@@ -281,9 +315,22 @@ def nonlinear_modes(
         N_t, as for :func:`clearjoint.harmonic.frequency_response`.
     damping_ratio : float
         zeta of a Joint's linear part (c_v = 2 zeta sqrt(m k_c)).
-    friction, restitution
-        Refused (HarmonicError): friction is not carried by EPMC here yet, and
-        impacts need :mod:`clearjoint.periodic`.
+    friction : Friction, optional
+        Coulomb friction of a Joint over its whole path (region "everywhere"),
+        regularised as mu_s P tanh(v / v_eps) exactly as in
+        :func:`clearjoint.harmonic.frequency_response`; a Structure's joints carry
+        their own friction (rigid members only) the same way. Friction over the
+        free-play stroke only is refused (HarmonicError). Where a rubbing joint
+        would stick at a turning point (the force that would hold it, for a Joint
+        its restoring force, within mu_s P: :func:`holding_forces`), the amplitude
+        fails with the reason in ``note``: EPMC's regularised orbit has no stick
+        phase and creeps through there, driven by the negative damping.
+    restitution : float
+        Refused unless 1 (HarmonicError): impacts need :mod:`clearjoint.periodic`.
+    friction_regularization : float, optional
+        v_eps, m/s. Default 1e-3 w c, with w the mode's closed-pattern frequency
+        (frequency_response uses its start frequency) and c a Joint's clearance (for
+        a Structure the largest clearance of its joints with friction).
 
     Returns
     -------
@@ -295,16 +342,12 @@ def nonlinear_modes(
         A mode the system does not have, an amplitude at or below zero.
     HarmonicError
         Bad harmonics or samples, arrays above ``system.MEMORY_BOUND`` (2 GiB),
-        friction or restitution.
+        friction over the free-play stroke only, or restitution.
     """
     h, n_t = aft.check_harmonics(harmonics, samples)
-    if friction is not None and friction.force > 0.0:
-        raise HarmonicError(
-            "nonlinear_modes does not carry Coulomb friction yet; set friction=None, or use "
-            "clearjoint.harmonic.frequency_response (regularised) or clearjoint.periodic"
-        )
-    model = build(system, damping_ratio, friction, restitution)
-    ref, omega_lin, shape = _reference(model, mode)
+    model, ref, omega_lin, shape = _model(
+        system, mode, damping_ratio, friction, restitution, friction_regularization
+    )
     length = scale_length(model)
     amps = _amplitudes(
         np.geomspace(0.5 * length, 20.0 * length, 40) if amplitudes is None else amplitudes
@@ -313,36 +356,15 @@ def nonlinear_modes(
     basis = aft.Basis.make(h, n_t)
     n, n_c = model.n_dof, 2 * h + 1
     n_u = n_c * n
-    k_ref = model.reference_stiffness
-    zero_force = np.zeros(n)
 
     def solve_at(a: float, guess: FloatArray, iterations: int = 80) -> FloatArray | None:
         w_scale = max(omega_lin, 1e-300)
 
         def function(z: FloatArray) -> tuple[FloatArray, FloatArray]:
-            q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
-            ev = aft.evaluate(model, basis, q, w, zero_force, negative_damping=xi)
-            d_xi = -w * ((basis.derivative @ q.reshape(n_c, n)) @ model.mass).ravel()
-            r = np.empty(n_u + 2)
-            r[:n_u] = ev.residual / (k_ref * a)
-            r[n_u] = z[n + ref] - 1.0  # a_1 on the reference DOF = a
-            r[n_u + 1] = z[2 * n + ref]  # b_1 there = 0 (phase)
-            jac = np.zeros((n_u + 2, n_u + 2))
-            jac[:n_u, :n_u] = ev.jacobian / k_ref
-            jac[:n_u, n_u] = ev.d_omega * w_scale / (k_ref * a)
-            jac[:n_u, n_u + 1] = d_xi * w_scale / (k_ref * a)
-            jac[n_u, n + ref] = 1.0
-            jac[n_u + 1, 2 * n + ref] = 1.0
-            return r, jac
+            return epmc_residual(model, basis, z, a, w_scale, ref)
 
         def residual(z: FloatArray) -> FloatArray:
-            q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
-            ev = aft.evaluate(model, basis, q, w, zero_force, negative_damping=xi, jacobian=False)
-            r = np.empty(n_u + 2)
-            r[:n_u] = ev.residual / (k_ref * a)
-            r[n_u] = z[n + ref] - 1.0
-            r[n_u + 1] = z[2 * n + ref]
-            return r
+            return epmc_residual(model, basis, z, a, w_scale, ref, jacobian=False)[0]
 
         found = newton(function, guess, 1.0, residual=residual, max_iterations=iterations)
         if found is None:
@@ -394,6 +416,11 @@ def nonlinear_modes(
                 results[i] = path[-1][1]
                 del reasons[i]
                 upward.append(i)
+    held = _held(model, basis, amps, results, omega_lin)
+    for i, why in held.items():
+        del results[i]
+        reasons[i] = why
+    upward = [i for i in upward if i not in held]
     note = _note(amps, reasons)
     if upward:
         at = amps[upward]
@@ -409,6 +436,66 @@ def nonlinear_modes(
             + (f": contact begins near {reach:.3g} m" if math.isfinite(reach) else "")
         )
     return _mode(model, basis, amps, results, int(mode), ref, omega_lin, note)
+
+
+def epmc_residual(
+    model: LinearSystem,
+    basis: aft.Basis,
+    z: FloatArray,
+    amplitude: float,
+    w_scale: float,
+    ref: int,
+    *,
+    jacobian: bool = True,
+) -> tuple[FloatArray, FloatArray]:
+    """Return EPMC's scaled residual and its exact Jacobian at z (MODEL.md 5.4).
+
+    The HB residual of the free motion with the negative damping -xi M u'
+    (:func:`clearjoint.harmonic.aft.evaluate`, which carries the joints' laws and their
+    regularised friction mu_s P tanh(v / v_eps) with its slope), divided by k_ref a, and
+    the two conditions a_1 = a, b_1 = 0 on the reference DOF.
+
+    Parameters
+    ----------
+    model : LinearSystem
+    basis : aft.Basis
+    z : (N (2H + 1) + 2,) ndarray
+        The coefficients over a (row-major from (2H + 1, N)), then w and xi over
+        ``w_scale``.
+    amplitude : float
+        The modal amplitude a, m.
+    w_scale : float
+        The scale of w and xi, rad/s (the closed-pattern frequency).
+    ref : int
+        The reference DOF.
+    jacobian : bool
+        False: the Jacobian is an empty (0, 0) array.
+
+    Returns
+    -------
+    residual : (N (2H + 1) + 2,) ndarray
+    jacobian : (N (2H + 1) + 2, N (2H + 1) + 2) ndarray
+        d residual / d z.
+    """
+    n, n_c = model.n_dof, 2 * basis.harmonics + 1
+    n_u = n_c * n
+    k_ref, a = model.reference_stiffness, amplitude
+    q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
+    ev = aft.evaluate(model, basis, q, w, np.zeros(n), negative_damping=xi, jacobian=jacobian)
+    r = np.empty(n_u + 2)
+    r[:n_u] = ev.residual / (k_ref * a)
+    r[n_u] = z[n + ref] - 1.0  # a_1 on the reference DOF = a
+    r[n_u + 1] = z[2 * n + ref]  # b_1 there = 0 (phase)
+    if not jacobian:
+        return r, np.empty((0, 0))
+    d_xi = -w * ((basis.derivative @ q.reshape(n_c, n)) @ model.mass).ravel()
+    jac = np.zeros((n_u + 2, n_u + 2))
+    jac[:n_u, :n_u] = ev.jacobian / k_ref
+    jac[:n_u, n_u] = ev.d_omega * w_scale / (k_ref * a)
+    jac[:n_u, n_u + 1] = d_xi * w_scale / (k_ref * a)
+    jac[n_u, n + ref] = 1.0
+    jac[n_u + 1, 2 * n + ref] = 1.0
+    return r, jac
 
 
 def _march(
@@ -485,6 +572,123 @@ def _walk(
         if last:
             return True
         step *= 2.0
+
+
+#: Phases per period on which the holding forces and the turning points are sought.
+_TURNS = 1024
+
+
+def holding_forces(
+    model: LinearSystem, basis: aft.Basis, coefficients: FloatArray, omega: float, tau: FloatArray
+) -> FloatArray:
+    """Return the friction force that would hold each joint still at phases ``tau``, N.
+
+    Joint j stays put (b_j^T u'' = 0) if its friction supplies phi_j = b_j^T M^-1 r /
+    (b_j^T M^-1 b_j), r = -K u - C u' - sum_k b_k f_k(delta_k) - sum_(k != j) b_k
+    mu_s,k P_k tanh(v_k / v_eps) (MODEL.md sections 2 and 5.2; EPMC's artificial
+    -xi M u' left out: it is no force of the free motion). At a turning point of a
+    Joint (x' = 0) this is -f(x).
+
+    Parameters
+    ----------
+    model : LinearSystem
+    basis : aft.Basis
+    coefficients : (2H + 1, N) ndarray
+        The orbit, m.
+    omega : float
+        w, rad/s.
+    tau : (n,) ndarray
+        Phases w t, rad.
+
+    Returns
+    -------
+    (n, n_j) ndarray
+        phi_j at each phase, N.
+    """
+    b = model.directions
+    u = basis.evaluate(coefficients, tau)
+    du = omega * basis.evaluate(basis.derivative @ coefficients, tau)
+    law, _ = model.joint_forces(u @ b.T)
+    load = -(u @ model.stiffness.T) - du @ model.damping.T - law @ b
+    rub = np.zeros_like(law)
+    if model.friction_force is not None:
+        rub, _ = model.friction_forces(du @ b.T)
+        load = load - rub @ b
+    inverse_mass = np.linalg.inv(model.mass)
+    per = b @ inverse_mass  # (n_j, N): row j is b_j^T M^-1
+    # adding joint j's own friction back: b_j^T M^-1 b_j rub_j
+    own = np.einsum("jn,jn->j", per, b)
+    return np.asarray((load @ per.T) / own + rub, dtype=np.float64)
+
+
+def _turning_phases(
+    model: LinearSystem, basis: aft.Basis, coefficients: FloatArray
+) -> list[FloatArray]:
+    """Phases where each joint's relative speed changes sign (grid of :data:`_TURNS`, then
+    linear interpolation), rad."""
+    tau = 2.0 * math.pi * np.arange(_TURNS) / _TURNS
+    speed = basis.evaluate(basis.derivative @ coefficients, tau) @ model.directions.T
+    out = []
+    for v in speed.T:
+        after = np.roll(v, -1)
+        turns = np.flatnonzero((v > 0.0) != (after > 0.0))
+        share = v[turns] / np.where(v[turns] != after[turns], v[turns] - after[turns], 1.0)
+        out.append(tau[turns] + share * (2.0 * math.pi / _TURNS))
+    return out
+
+
+def _held(
+    model: LinearSystem,
+    basis: aft.Basis,
+    amps: FloatArray,
+    results: dict[int, FloatArray],
+    omega_lin: float,
+) -> dict[int, str]:
+    """The converged amplitudes where friction holds the motion, with the reason.
+
+    A rubbing joint sticks at a turning point where the force that would hold it
+    (:func:`holding_forces`) is at most its mu_s P: the exact Coulomb motion stops there.
+    For a Joint that stop is for good; in a Structure the joint stays stuck until the
+    rest of the structure pulls it free. The regularised EPMC orbit has no stick phase:
+    it creeps through, moved by the negative damping -xi M u', which is no force of the
+    free motion (at 3 um on the tests' 2-DOF chain it finds 59 Hz and zeta 1.3 where the
+    exact motion keeps the joint locked). So such an amplitude fails, with the reason,
+    rather than give a number nothing checks.
+
+    Returns
+    -------
+    dict
+        Failed index -> reason.
+    """
+    if model.friction_force is None or not results:
+        return {}
+    rubbing = np.flatnonzero(model.friction_force > 0.0)
+    limit = model.friction_force
+    n_c, n = 2 * basis.harmonics + 1, model.n_dof
+    failed: dict[int, str] = {}
+    for i, z in results.items():
+        coef = (z[: n_c * n] * amps[i]).reshape(n_c, n)
+        w = z[n_c * n] * omega_lin
+        phases = _turning_phases(model, basis, coef)
+        for j in rubbing.tolist():
+            held = np.abs(holding_forces(model, basis, coef, w, phases[j])[:, j])
+            if not np.any(held <= limit[j]):
+                continue
+            if model.is_joint:
+                failed[i] = (
+                    "friction holds the joint: its restoring force at a turning point is below "
+                    f"mu_s P = {float(limit[0]):.3g} N, so the free motion sticks (the orbit "
+                    "found is moved by EPMC's negative damping and the regularisation's creep)"
+                )
+            else:
+                failed[i] = (
+                    "a rubbing joint sticks at a turning point (the force that would hold it "
+                    "is below its mu_s P): EPMC with regularised friction has no stick phase "
+                    "(its orbit creeps through, moved by the negative damping); follow the "
+                    "forced response with clearjoint.harmonic.frequency_response instead"
+                )
+            break
+    return failed
 
 
 def _note(amps: FloatArray, reasons: dict[int, str]) -> str:

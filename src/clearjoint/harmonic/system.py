@@ -233,12 +233,12 @@ def from_structure(structure: Any, friction_speed: float = 0.0) -> LinearSystem:
     rub = np.array([0.0 if law.friction is None else law.friction.force for law in laws])
     forces = None
     if np.any(rub > 0.0):
-        if not friction_speed > 0.0:  # nonlinear_modes: no regularisation speed given
+        if not friction_speed > 0.0:  # a caller that gave no regularisation speed
             member = structure.joint_members[int(np.argmax(rub > 0.0))]
             raise HarmonicError(
-                f"Coulomb friction in the joint of member {member} is carried (regularised) by "
-                "clearjoint.harmonic.frequency_response only, not by nonlinear_modes; "
-                "set friction=None on the structure's joints for nonlinear modes"
+                f"Coulomb friction in the joint of member {member} needs a regularisation "
+                f"speed v_eps > 0 (got {friction_speed!r} m/s); pass friction_regularization "
+                "or build through frequency_response / nonlinear_modes, which set it"
             )
         forces = rub
         friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
