@@ -7,6 +7,8 @@
     python docs/identify_bias.py --bouc-wen     # the same on a smooth loop with no gap
     python docs/identify_bias.py --rig-residuals DIR  # every model's residual / noise floor
         # on the records of DIR (e.g. the default campaign: clearjoint rig --out DIR)
+    python docs/identify_bias.py --csv-residuals DIR  # the same on DIR/*.csv
+        # (e.g. examples/lab-csv, the tutorial's records)
 
 1 % noise on every channel, with an acceleration channel, seeds 1-5. Errors in % of the
 simulator's own truth; the friction's standard error (in % of the truth) and its flag.
@@ -141,6 +143,9 @@ def main() -> None:
     parser.add_argument(
         "--rig-residuals", type=Path, default=None, help="each rig record's (*.nc) residual"
     )
+    parser.add_argument(
+        "--csv-residuals", type=Path, default=None, help="each CSV record's (*.csv) residual"
+    )
     args = parser.parse_args()
     if args.bouc_wen:
         from test_identify_loopcheck import bouc_wen
@@ -153,6 +158,8 @@ def main() -> None:
         _brfd_residuals()
     if args.rig_residuals is not None:
         _brfd_residuals(args.rig_residuals, "*.nc")
+    if args.csv_residuals is not None:
+        _brfd_residuals(args.csv_residuals, "*.csv")
     head = " | ".join(name for _, name in KEYS)
     folder = Path(tempfile.mkdtemp())
     if args.off_grid:

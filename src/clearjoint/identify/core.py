@@ -26,9 +26,12 @@ MODEL.md section 3. The steps:
    integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
-   exceeds a quarter of it, a fit residual above the noise floor (the weak form's
-   equation residual; the damper model's residual on the loop and the joint's or the
-   line's per-sample fit's, :mod:`clearjoint.identify.loopcheck`), a force-controlled
+   exceeds a quarter of it, a fit residual above three times its noise floor (the weak
+   form's equation residual; the damper model's residual on the loop and the joint's or
+   the line's per-sample fit's; the floor errors-in-variables, per sample: the force's
+   noise, the displacement's times the model's slope and the velocity sign's flips,
+   :mod:`clearjoint.identify.loopcheck`), a fit whose velocity sign is a toss-up on more
+   than ``UNSURE_SHARE`` of its samples, a force-controlled
    record without a mass (then estimated from the record, with a warning), or a damper
    whose backlash reads more than twice as long on one branch as on the other.
 """
@@ -94,9 +97,9 @@ FloatArray = NDArray[np.float64]
 RESOLUTION = 1e-3
 #: A fit whose velocity sign is unsure (a flip by the noise more likely than
 #: ``loopcheck.UNSURE_SIGN``) on more than this share of its samples rests on noise: the
-#: independent simulator's 40 Hz joint at 1 % noise shows 0.27-0.42 (values accurate), the
-#: Bouc-Wen loop read as a line at 1 % noise 0.68-0.89 (docs/identify.md, Flags).
-UNSURE_SHARE = 0.5
+#: independent simulator's 40 Hz joint at 1 % noise and 6-24 cycles shows 0.14-0.50, the
+#: Bouc-Wen loop read as a line or a joint at 1 % noise 0.68-0.91 (docs/identify.md, Flags).
+UNSURE_SHARE = 0.6
 #: A fit residual this many times its noise floor (errors-in-variables, per sample:
 #: :mod:`clearjoint.identify.loopcheck`) on the cycle average makes a value doubtful.
 RESIDUAL_FACTOR = 3.0

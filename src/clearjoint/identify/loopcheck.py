@@ -144,8 +144,8 @@ def jackknife_noise(replicates: FloatArray) -> float:
 def sign_noise(velocity: FloatArray, noise: float) -> FloatArray:
     """The standard deviation of sgn(v + e), e ~ N(0, ``noise``^2), at each sample, (M,).
 
-    2 sqrt(p (1 - p)), p = Phi(-|v| / noise) the chance that the noise flips the sign
-    (the measured |v| stands for the true one); zeros when ``noise`` is NaN or zero.
+    2 sqrt(p (1 - p)), p = Phi(-abs(v) / noise) the chance that the noise flips the sign
+    (the measured abs(v) stands for the true one); zeros when ``noise`` is NaN or zero.
     """
     if not noise > 0.0:
         return np.zeros_like(velocity)
@@ -220,7 +220,7 @@ def reading(
     """Return the residual ``error`` against its errors-in-variables noise floor.
 
     Each error's sigma is sqrt((g_F sigma_F)^2 + (g_x sigma_x)^2 + s^2): on a sample g_F = 1
-    and g_x = |k_i|, the model's local slope dF/dx, and s = |F_f| times the standard
+    and g_x = abs(k_i), the model's local slope dF/dx, and s = abs(F_f) times the standard
     deviation of the velocity's sign there (:func:`sign_noise`); on a weak-form equation
     the rms-summed weights of the equation on the force's, the displacement's and the
     sign's samples. The ratio is the rms of error / sigma (``robust``: 1.4826 times its
@@ -411,12 +411,12 @@ def weak_residual(
 ) -> Reading:
     """Return the weak form's equation residual (replicate 0) against its floor.
 
-    Equation e, divided by its scale sum|phi| as the fit divides it, weighs the force
+    Equation e, divided by its scale sum(abs(phi)) as the fit divides it, weighs the force
     samples by phi and the displacement samples by k_s phi - c phi' (+ m phi'' when the
     inertia is read from the displacement, no acceleration channel): its sigma is
     sqrt(sigma_F^2 sum(phi^2) + sigma_x^2 sum((k_s phi - c phi' + m phi'')^2)) / scale
     (white noise on the cycle average's samples), and the friction column int(phi sgn x')
-    adds |F_f| sqrt(sum(phi^2 s^2)) / scale, s the sign's standard deviation per sample
+    adds abs(F_f) sqrt(sum(phi^2 s^2)) / scale, s the sign's standard deviation per sample
     (:func:`sign_noise`).
 
     Parameters
