@@ -118,8 +118,19 @@ class Reading:
 
 
 def scatter(stacked: FloatArray) -> float:
-    """The rms noise of one channel's cycle average: the scatter over the cycles / sqrt(n);
-    NaN with fewer than two cycles."""
+    """Return the rms noise of one channel's cycle average.
+
+    Parameters
+    ----------
+    stacked : (n, M) ndarray
+        The channel's n cycles on one phase grid.
+
+    Returns
+    -------
+    float
+        The scatter over the cycles (rms over the phase of the per-sample standard
+        deviation) / sqrt(n); NaN with fewer than two cycles.
+    """
     n = stacked.shape[0]
     if n < 2:
         return math.nan
@@ -127,11 +138,18 @@ def scatter(stacked: FloatArray) -> float:
 
 
 def jackknife_noise(replicates: FloatArray) -> float:
-    """The rms noise of an average from its jackknife replicates.
+    """Return the rms noise of an average from its jackknife replicates.
 
-    ``replicates`` (G + 1, M): row 0 the average of all cycles, then the averages without
-    each of G groups; the noise is sqrt(mean over samples of (G - 1)/G sum (theta_g -
-    mean theta)^2). NaN with fewer than two groups.
+    Parameters
+    ----------
+    replicates : (G + 1, M) ndarray
+        Row 0 the average of all cycles, then the averages without each of G groups.
+
+    Returns
+    -------
+    float
+        sqrt(mean over samples of (G - 1)/G sum (theta_g - mean theta)^2); NaN with fewer
+        than two groups.
     """
     rows = replicates[1:]
     g = rows.shape[0]
@@ -142,10 +160,20 @@ def jackknife_noise(replicates: FloatArray) -> float:
 
 
 def sign_noise(velocity: FloatArray, noise: float) -> FloatArray:
-    """The standard deviation of sgn(v + e), e ~ N(0, ``noise``^2), at each sample, (M,).
+    """Return the standard deviation of sgn(v + e), e Gaussian with the rms ``noise``.
 
-    2 sqrt(p (1 - p)), p = Phi(-abs(v) / noise) the chance that the noise flips the sign
-    (the measured abs(v) stands for the true one); zeros when ``noise`` is NaN or zero.
+    Parameters
+    ----------
+    velocity : (M,) ndarray
+        The velocity whose sign is taken, m/s (it stands for the true one).
+    noise : float
+        The rms noise of that velocity, m/s.
+
+    Returns
+    -------
+    (M,) ndarray
+        2 sqrt(p (1 - p)), p = Phi(-abs(v) / noise) the chance that the noise flips the
+        sign; zeros when ``noise`` is NaN or zero.
     """
     if not noise > 0.0:
         return np.zeros_like(velocity)
@@ -156,8 +184,18 @@ def sign_noise(velocity: FloatArray, noise: float) -> FloatArray:
 
 
 def unsure_share(spread: FloatArray) -> float:
-    """The share of samples whose sign's standard deviation ``spread`` (:func:`sign_noise`)
-    means a flip with a chance above ``UNSURE_SIGN``."""
+    """Return the share of samples whose velocity sign is a toss-up.
+
+    Parameters
+    ----------
+    spread : (M,) ndarray
+        The sign's standard deviation per sample (:func:`sign_noise`).
+
+    Returns
+    -------
+    float
+        The share whose flip has a chance above ``UNSURE_SIGN`` (0 when empty).
+    """
     if spread.size == 0:
         return 0.0
     return float(np.mean(spread > 2.0 * math.sqrt(UNSURE_SIGN * (1.0 - UNSURE_SIGN))))
