@@ -351,3 +351,45 @@ def test_independent_records_at_one_percent_noise_are_not_flagged_for_the_residu
         assert s["energy_per_cycle_j"] == pytest.approx(truth["energy_per_cycle_j"], rel=0.01)
         assert "fit residual" not in result.flag_reason, (seed, result.flag_reason)
         assert "velocity's sign" not in result.flag_reason
+
+
+@pytest.mark.parametrize(("noise", "seed"), [(0.0, 0), (0.01, 1)])
+def test_a_smooth_loop_forced_into_the_weak_form_is_flagged(
+    monkeypatch: pytest.MonkeyPatch, noise: float, seed: int
+) -> None:
+    """The Bouc-Wen loop read as a joint's three stages (as in the sample-fit test) by the
+    weak form (its interpolated stack goes there): doubtful on every fitted quantity,
+    noise-free for its residual (36 times its floor), at 1 % noise because the spectral
+    velocity's sign is noise on most samples (the floor then covers the residual)."""
+    _no_damper(monkeypatch)
+    fit = core._joint_fit
+
+    def windows(x: np.ndarray, y: np.ndarray, n: int) -> list[tuple[bool, float, float]]:
+        a, m = 0.5 * float(np.ptp(x)), 0.5 * float(x.max() + x.min())
+        return [
+            (True, m - a, m - 0.7 * a),
+            (False, m - 0.5 * a, m + 0.5 * a),
+            (True, m + 0.7 * a, m + a),
+        ]
+
+    monkeypatch.setattr(core, "_windows", windows)
+    monkeypatch.setattr(
+        core, "_joint_fit", lambda x, r, v, parts, w, compete=True: fit(x, r, v, parts, w, False)
+    )
+    seen: list[Reading] = []
+    original = core.weak_residual
+
+    def spy(*args: object, **kwargs: object) -> Reading:
+        value = original(*args, **kwargs)  # type: ignore[arg-type]
+        seen.append(value)
+        return value
+
+    monkeypatch.setattr(core, "weak_residual", spy)
+    result = identify(bouc_wen(noise, seed))
+    assert result.model == "joint"
+    assert len(seen) == 1  # the weak form
+    why = "fit residual" if noise == 0.0 else "velocity's sign is flipped by its noise"
+    for q in ("compression_stiffness_n_per_m", "friction_force_n", "gap_stiffness_n_per_m"):
+        flag, reason = result.flags[q]
+        assert flag == "doubtful", q
+        assert why in reason, q
