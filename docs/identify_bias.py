@@ -91,9 +91,10 @@ def _brfd_residuals(folder: Path | None = None, pattern: str = "*.json") -> None
 
 
 def _bouc_wen_forced(bouc_wen: Any) -> None:
-    """The Bouc-Wen loops forced into the line's fit (no damper) and into the joint's
+    """The Bouc-Wen loops forced into the line's fit (no damper), into the joint's
     sample-by-sample fit (stage windows at 70-100 % of the stroke each way and the middle
-    half, the weak form held off), as tests/test_identify_loopcheck.py forces them."""
+    half, the weak form held off) and into the weak form (the same windows), as
+    tests/test_identify_loopcheck.py forces them."""
     import numpy as np
 
     import clearjoint.identify.core as core
@@ -113,11 +114,11 @@ def _bouc_wen_forced(bouc_wen: Any) -> None:
 
     try:
         core._damper_fit = lambda *args: None  # type: ignore[assignment]
-        for path in ("line", "joint"):
-            if path == "joint":
+        for path in ("line", "joint", "weak form"):
+            if path != "line":
                 core._windows = windows  # type: ignore[assignment]
                 core._joint_fit = lambda x, r, v, p, w, compete=True: fit(x, r, v, p, w, False)  # type: ignore[assignment]
-                core.MIN_EQUATIONS = 10**9
+                core.MIN_EQUATIONS = 10**9 if path == "joint" else saved["MIN_EQUATIONS"]
             for noise, seed in ((0.0, 0), (0.01, 1), (0.01, 2), (0.01, 3), (0.01, 4)):
                 result = identify(bouc_wen(noise, seed))
                 reason = result.flags["friction_force_n"][1]
