@@ -29,6 +29,7 @@ from clearjoint.identify.loopcheck import (
     channel_noise,
     damper_residual,
     reading,
+    scatter,
     sign_noise,
     weak_residual,
 )
@@ -275,7 +276,7 @@ def test_one_cycle_gives_the_force_only_floor_with_a_note() -> None:
     rng = np.random.default_rng(4)
     x = rng.normal(0.0, 1e-6, (1, 200))
     f = 1e3 * np.sin(np.linspace(0.0, 2 * np.pi, 200))[None, :]
-    noise = channel_noise(f, x, 1e-3)
+    noise = channel_noise(f, scatter(x), 1e-3)
     assert np.isnan(noise.displacement)
     assert "force channel alone" in noise.note
     assert noise.force == pytest.approx(1e-3 * float(np.std(f)))

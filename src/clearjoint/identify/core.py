@@ -417,15 +417,12 @@ def _identify_stack(
         else None
     )
     # and the noise of the velocity whose sign the friction term takes: a measured one's
-    # scatter, a derived one's jackknife over the replicates (the same cut-off rule)
+    # scatter, a derived one's jackknife over the replicates' spectral velocities (taken
+    # below where the fit needs them; the damper's residual takes no sign)
     noise = channel_noise(
-        rs,
-        xs,
-        RESOLUTION,
-        scatter(st.channels["v"])
-        if "v" in st.channels
-        else jackknife_noise(_periodic_derivatives(reps_x, st.step, noise_x)[0]),
+        rs, noise_x, RESOLUTION, scatter(st.channels["v"]) if "v" in st.channels else math.nan
     )
+    derived_v = "v" not in st.channels
     fits: list[_Fit]
     masses: FloatArray
     residual = Reading(math.nan, math.nan, math.nan)
@@ -453,6 +450,9 @@ def _identify_stack(
                 )
             )
         masses = weak.mass
+        if derived_v:
+            spectral = _periodic_derivatives(reps_x, st.step, noise_x)[0]
+            noise = replace(noise, velocity=jackknife_noise(spectral))
         residual = weak_residual(
             system, weak, v, noise, inertia_from_x=force_control and reps_a is None
         )
@@ -464,6 +464,8 @@ def _identify_stack(
             reps_v = np.broadcast_to(v, reps_x.shape)
         else:
             reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
+            if derived_v:
+                noise = replace(noise, velocity=jackknife_noise(reps_v))
             if reps_a is not None:
                 reps_ad = reps_a
             if "v" in st.channels:

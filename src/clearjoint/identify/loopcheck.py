@@ -175,11 +175,13 @@ def sign_noise(velocity: FloatArray, noise: float) -> FloatArray:
         2 sqrt(p (1 - p)), p = Phi(-abs(v) / noise) the chance that the noise flips the
         sign; zeros when ``noise`` is NaN or zero.
     """
+    out: FloatArray = np.zeros_like(velocity)
     if not noise > 0.0:
-        return np.zeros_like(velocity)
+        return out
     u = np.abs(velocity) / (noise * math.sqrt(2.0))
-    p = 0.5 * np.vectorize(math.erfc, otypes=[np.float64])(u)
-    out: FloatArray = 2.0 * np.sqrt(p * (1.0 - p))
+    near = np.flatnonzero(u < 6.0)  # beyond, a flip's chance is below 1e-17
+    p = 0.5 * np.array([math.erfc(value) for value in u[near]])
+    out[near] = 2.0 * np.sqrt(p * (1.0 - p))
     return out
 
 
@@ -203,7 +205,7 @@ def unsure_share(spread: FloatArray) -> float:
 
 def channel_noise(
     force: FloatArray,
-    displacement: FloatArray,
+    displacement: float,
     resolution: float,
     velocity: float = math.nan,
 ) -> Noise:
@@ -211,9 +213,10 @@ def channel_noise(
 
     Parameters
     ----------
-    force, displacement : (n, M) ndarray
-        The restoring force (N) and the displacement (m) of the n steady cycles, stacked on
-        one phase grid.
+    force : (n, M) ndarray
+        The restoring force (N) of the n steady cycles, stacked on one phase grid.
+    displacement : float
+        The displacement's :func:`scatter` on the same stack (m; NaN with one cycle).
     velocity : float
         The noise of the velocity whose sign the friction term takes, m/s
         (:func:`scatter` of a measured one, :func:`jackknife_noise` of a derived one).
@@ -230,7 +233,7 @@ def channel_noise(
         with a note (the floor then counts the force channel only).
     """
     f_res = resolution * float(np.std(force.mean(axis=0)))
-    sf, sx = scatter(force), scatter(displacement)
+    sf, sx = scatter(force), displacement
     if math.isnan(sx):
         note = (
             f"{force.shape[0]} cycle: no scatter over cycles to estimate the displacement's "
