@@ -7,6 +7,9 @@
     python docs/identify_bias.py --bouc-wen     # the same on a smooth loop with no gap
     python docs/identify_bias.py --rig-residuals DIR  # every model's residual / noise floor
         # on the records of DIR (e.g. the default campaign: clearjoint rig --out DIR)
+    python docs/identify_bias.py --floor [FILE ...]  # residual, floor, ratio, unsure signs
+    python docs/identify_bias.py --csv-residuals DIR  # the same on DIR/*.csv
+        # (e.g. examples/lab-csv, the tutorial's records)
 
 1 % noise on every channel, with an acceleration channel, seeds 1-5. Errors in % of the
 simulator's own truth; the friction's standard error (in % of the truth) and its flag.
@@ -89,9 +92,10 @@ def _brfd_residuals(folder: Path | None = None, pattern: str = "*.json") -> None
 
 
 def _bouc_wen_forced(bouc_wen: Any) -> None:
-    """The Bouc-Wen loops forced into the line's fit (no damper) and into the joint's
+    """The Bouc-Wen loops forced into the line's fit (no damper), into the joint's
     sample-by-sample fit (stage windows at 70-100 % of the stroke each way and the middle
-    half, the weak form held off), as tests/test_identify_loopcheck.py forces them."""
+    half, the weak form held off) and into the weak form (the same windows), as
+    tests/test_identify_loopcheck.py forces them."""
     import numpy as np
 
     import clearjoint.identify.core as core
@@ -111,11 +115,11 @@ def _bouc_wen_forced(bouc_wen: Any) -> None:
 
     try:
         core._damper_fit = lambda *args: None  # type: ignore[assignment]
-        for path in ("line", "joint"):
-            if path == "joint":
+        for path in ("line", "joint", "weak form"):
+            if path != "line":
                 core._windows = windows  # type: ignore[assignment]
                 core._joint_fit = lambda x, r, v, p, w, compete=True: fit(x, r, v, p, w, False)  # type: ignore[assignment]
-                core.MIN_EQUATIONS = 10**9
+                core.MIN_EQUATIONS = 10**9 if path == "joint" else saved["MIN_EQUATIONS"]
             for noise, seed in ((0.0, 0), (0.01, 1), (0.01, 2), (0.01, 3), (0.01, 4)):
                 result = identify(bouc_wen(noise, seed))
                 reason = result.flags["friction_force_n"][1]
@@ -124,6 +128,66 @@ def _bouc_wen_forced(bouc_wen: Any) -> None:
     finally:
         for k, v in saved.items():
             setattr(core, k, v)
+
+
+def _floor(paths: list[Path], folder: Path) -> None:
+    """Each record's fit residual against its errors-in-variables noise floor, with the
+    noise of each channel and the share of toss-up velocity signs: the given records, or
+    the independent simulator's (1 % noise, 24 cycles, seeds 0-2; 0 and 0.2 % at 12
+    cycles; 6-24 cycles at 40 Hz, seeds 1-5) with the friction's error."""
+    import clearjoint.identify.core as core
+
+    seen: list[Any] = []
+    flags = core._flags
+
+    def spy(model: str, summary: Any, stderr: Any, residual: Any, *rest: Any) -> Any:
+        seen.append(residual)
+        return flags(model, summary, stderr, residual, *rest)
+
+    def show(label: str, path: Path, truth: dict[str, float] | None) -> None:
+        seen.clear()
+        result = identify(read_record(path))
+        r = seen[0]
+        miss = ""
+        if truth is not None:
+            error = 100 * (result.summary["friction_force_n"] / truth["friction_force_n"] - 1)
+            se = 100 * result.stderr["friction_force_n"] / truth["friction_force_n"]
+            miss = f"  friction {error:+.1f} ± {se:.1f} %"
+        print(
+            f"{label}: {result.model}, residual {r.residual:.3g} N, floor {r.floor:.3g} N, "
+            f"ratio {r.ratio:.2f}, unsure signs {r.unsure:.0%}{miss}",
+            flush=True,
+        )
+
+    core._flags = spy  # type: ignore[assignment]
+    try:
+        for path in paths:
+            show(path.name, path, None)
+        if paths:
+            return
+        runs = [
+            (f, acc, noise, 24, seed)
+            for f in (40.0, 100.0)
+            for acc in (True, False)
+            for seed in (0, 1, 2)
+            for noise in (0.01,)
+        ]
+        runs += [
+            (f, True, noise, 12, seed)
+            for f in (40.0, 100.0)
+            for noise in (0.0, 0.002)
+            for seed in (1, 2)
+        ]
+        runs += [(40.0, True, 0.01, n, seed) for n in (6, 10, 16, 24) for seed in SEEDS]
+        for f, acc, noise, cycles, seed in runs:
+            joint = TrueJoint(frequency_hz=f)
+            path = write_record(
+                joint, folder / "r.csv", noise=noise, acceleration=acc, seed=seed, cycles=cycles
+            )
+            label = f"{f:g} Hz, acceleration {acc}, noise {noise:.1%}, {cycles} cycles, seed {seed}"
+            show(label, path, steady_truth(joint))
+    finally:
+        core._flags = flags  # type: ignore[assignment]
 
 
 def main() -> None:
@@ -141,7 +205,19 @@ def main() -> None:
     parser.add_argument(
         "--rig-residuals", type=Path, default=None, help="each rig record's (*.nc) residual"
     )
+    parser.add_argument(
+        "--csv-residuals", type=Path, default=None, help="each CSV record's (*.csv) residual"
+    )
+    parser.add_argument(
+        "--floor",
+        nargs="*",
+        type=Path,
+        default=None,
+        help="each record's residual, floor and ratio (the simulator's without files)",
+    )
     args = parser.parse_args()
+    if args.floor is not None:
+        _floor(args.floor, Path(tempfile.mkdtemp()))
     if args.bouc_wen:
         from test_identify_loopcheck import bouc_wen
 
@@ -153,6 +229,8 @@ def main() -> None:
         _brfd_residuals()
     if args.rig_residuals is not None:
         _brfd_residuals(args.rig_residuals, "*.nc")
+    if args.csv_residuals is not None:
+        _brfd_residuals(args.csv_residuals, "*.csv")
     head = " | ".join(name for _, name in KEYS)
     folder = Path(tempfile.mkdtemp())
     if args.off_grid:

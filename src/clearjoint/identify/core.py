@@ -26,9 +26,12 @@ MODEL.md section 3. The steps:
    integral of F dx, in which the inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
-   exceeds a quarter of it, a fit residual above the noise floor (the weak form's
-   equation residual; the damper model's residual on the loop and the joint's or the
-   line's per-sample fit's, :mod:`clearjoint.identify.loopcheck`), a force-controlled
+   exceeds a quarter of it, a fit residual above three times its noise floor (the weak
+   form's equation residual; the damper model's residual on the loop and the joint's or
+   the line's per-sample fit's; the floor errors-in-variables, per sample: the force's
+   noise, the displacement's times the model's slope and the velocity sign's flips,
+   :mod:`clearjoint.identify.loopcheck`), a fit whose velocity sign is a toss-up on more
+   than ``UNSURE_SHARE`` of its samples, a force-controlled
    record without a mass (then estimated from the record, with a warning), or a damper
    whose backlash reads more than twice as long on one branch as on the other.
 """
@@ -59,7 +62,17 @@ from clearjoint.identify.cycles import (
     steady_rule,
 )
 from clearjoint.identify.damper import BRANCH_RATIO, _damper_fit
-from clearjoint.identify.loopcheck import NO_STAGE, damper_residual, sample_fit_residual
+from clearjoint.identify.loopcheck import (
+    NO_STAGE,
+    UNSURE_SIGN,
+    Reading,
+    channel_noise,
+    damper_residual,
+    jackknife_noise,
+    sample_fit_residual,
+    scatter,
+    weak_residual,
+)
 from clearjoint.identify.result import QUANTITIES, CycleResult, Identification, damper_stages
 from clearjoint.identify.segments import (
     STAGE_COMPRESSION,
@@ -79,10 +92,16 @@ from clearjoint.records import Record
 
 FloatArray = NDArray[np.float64]
 
-#: The noise floor is at least this part of the force's standard deviation (the resolution
-#: of a record's digits and ADC): a noise-free record is not held to zero residual.
+#: The force's noise in the floor is at least this part of its standard deviation (the
+#: resolution of a record's digits and ADC): a noise-free record is not held to zero residual.
 RESOLUTION = 1e-3
-#: A fit residual this many times the noise floor of the cycle average makes a value doubtful.
+#: A fit whose velocity sign is unsure (a flip by the noise more likely than
+#: ``loopcheck.UNSURE_SIGN``) on more than this share of its samples rests on noise: the
+#: independent simulator's 40 Hz joint at 1 % noise and 6-24 cycles shows 0.14-0.50, the
+#: Bouc-Wen loop read as a line or a joint at 1 % noise 0.68-0.91 (docs/identify.md, Flags).
+UNSURE_SHARE = 0.6
+#: A fit residual this many times its noise floor (errors-in-variables, per sample:
+#: :mod:`clearjoint.identify.loopcheck`) on the cycle average makes a value doubtful.
 RESIDUAL_FACTOR = 3.0
 #: Samples this close to a gap edge (a fraction of the clearance) belong to no stage's
 #: test functions: the contact instants are where the stages' laws switch.
@@ -256,13 +275,6 @@ def _window_stages(
     return stage
 
 
-def _noise_floor(stacked: FloatArray) -> float:
-    """The rms noise of the cycle average of one channel: the scatter over cycles / sqrt(n)."""
-    n = stacked.shape[0]
-    scatter = float(np.sqrt(np.mean(np.var(stacked, axis=0, ddof=1))))
-    return scatter / math.sqrt(n)
-
-
 def identify(record: Record, *, tolerance: float = 0.03) -> Identification:
     """Return the identification of one record (see the module's docstring for the steps).
 
@@ -325,7 +337,7 @@ def _identify_stack(
     xs, fs = st.channels["x"], st.channels["f"]
     x = xs.mean(axis=0)
     f = fs.mean(axis=0)
-    noise_x = _noise_floor(xs)
+    noise_x = scatter(xs)
     warnings: list[str] = []
     force_control = record.control == "force"
     # the average's acceleration is used only under force control: with a measured
@@ -343,6 +355,9 @@ def _identify_stack(
     mass_missing = force_control and mass is None
     m_guess = _estimate_mass(x, f, v, a) if mass_missing else (mass or 0.0)
     r = f - m_guess * a if force_control else f
+    # the floor's channels: the restoring force (with a measured acceleration its noise
+    # times m is the force's too) and the displacement, each cycle's scatter
+    rs = fs - m_guess * st.channels["a"] if force_control and "a" in st.channels else fs
     parts = _branches_of(m, x)
     if parts is None:
         raise IdentificationError(f"{where}: the steady cycles' average has no rising branch")
@@ -401,9 +416,16 @@ def _identify_stack(
         if "a" in st.channels
         else None
     )
+    # and the noise of the velocity whose sign the friction term takes: a measured one's
+    # scatter, a derived one's jackknife over the replicates' spectral velocities (taken
+    # below where the fit needs them; the damper's residual takes no sign)
+    noise = channel_noise(
+        rs, noise_x, RESOLUTION, scatter(st.channels["v"]) if "v" in st.channels else math.nan
+    )
+    derived_v = "v" not in st.channels
     fits: list[_Fit]
     masses: FloatArray
-    residual = math.nan
+    residual = Reading(math.nan, math.nan, math.nan)
     if model == "joint" and system is not None:
         from clearjoint.identify.weak import weak_fit
 
@@ -428,7 +450,12 @@ def _identify_stack(
                 )
             )
         masses = weak.mass
-        residual = float(weak.residual[0])
+        if derived_v:
+            spectral = _periodic_derivatives(reps_x, st.step, noise_x)[0]
+            noise = replace(noise, velocity=jackknife_noise(spectral))
+        residual = weak_residual(
+            system, weak, v, noise, inertia_from_x=force_control and reps_a is None
+        )
     else:
         # every replicate's velocity and restoring force, (G + 1, M), then the fits of all
         # replicates in one batched solve (row by row only if that solve is singular)
@@ -437,6 +464,8 @@ def _identify_stack(
             reps_v = np.broadcast_to(v, reps_x.shape)
         else:
             reps_v, reps_ad = _periodic_derivatives(reps_x, st.step, noise_x)
+            if derived_v:
+                noise = replace(noise, velocity=jackknife_noise(reps_v))
             if reps_a is not None:
                 reps_ad = reps_a
             if "v" in st.channels:
@@ -453,11 +482,11 @@ def _identify_stack(
                 ]
             fits = [fit or first_fit for fit in batch]
             residual = sample_fit_residual(
-                reps_x[0], reps_r[0], reps_v[0], fits[0], _window_stages(x, parts, windows)
+                reps_x[0], reps_r[0], reps_v[0], fits[0], noise, _window_stages(x, parts, windows)
             )
         elif model == "damper":
             assert head_damper is not None
-            residual = damper_residual(x, f, parts, head_damper)
+            residual = damper_residual(x, f, parts, head_damper, noise)
             fits.append(head_damper)  # replicate 0 is the average itself: fitted above
             for xr_, fr_, rr_, vr_ in zip(
                 reps_x[1:], reps_f[1:], reps_r[1:], reps_v[1:], strict=True
@@ -473,7 +502,7 @@ def _identify_stack(
                     for xr_, rr_, vr_ in zip(reps_x, reps_r, reps_v, strict=True)
                 ]
             )
-            residual = sample_fit_residual(reps_x[0], reps_r[0], reps_v[0], fits[0])
+            residual = sample_fit_residual(reps_x[0], reps_r[0], reps_v[0], fits[0], noise)
         masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     values = [
         _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
@@ -528,7 +557,6 @@ def _identify_stack(
         summary,
         stderr,
         residual,
-        max(_noise_floor(fs), RESOLUTION * float(np.std(f))),
         mass_missing,
         summary["mass_kg"],
     )
@@ -623,8 +651,7 @@ def _flags(
     model: str,
     summary: dict[str, float],
     stderr: dict[str, float],
-    residual: float,
-    noise: float,
+    residual: Reading,
     mass_missing: bool,
     mass: float,
 ) -> dict[str, tuple[str, str]]:
@@ -645,12 +672,23 @@ def _flags(
                 "doubtful",
                 f"{q} has a standard error of {abs(se / value):.0%} of its value",
             )
-    if math.isfinite(residual) and residual > RESIDUAL_FACTOR * noise:
+    if math.isfinite(residual.ratio) and residual.ratio > RESIDUAL_FACTOR:
         reason = (
-            f"fit residual {residual:.3g} N is {residual / noise:.1f} times the noise floor "
-            f"{noise:.3g} N of the cycle average"
+            f"fit residual {residual.residual:.3g} N is {residual.ratio:.1f} times the noise "
+            f"floor {residual.floor:.3g} N of the cycle average (its force, displacement and "
+            "velocity-sign noise)"
         )
+        if residual.note:
+            reason += f" ({residual.note})"
         for q in fitted:  # beside any other doubt: a model that misses the loop says why
+            _doubt(flags, q, reason)
+    if residual.unsure > UNSURE_SHARE:
+        reason = (
+            f"the velocity's sign is flipped by its noise with a chance above "
+            f"{UNSURE_SIGN:.0%} on {residual.unsure:.0%} of the samples: the friction term, "
+            "and the fit residual's floor, rest on noise"
+        )
+        for q in fitted:
             _doubt(flags, q, reason)
     if mass_missing:
         reason = f"force control without a mass: m = {mass:.4g} kg estimated from the record"

@@ -194,13 +194,15 @@ def weak_system(
 class WeakFit:
     """Coefficients per replicate: lines (R, 3, 2) as (intercept, slope) of tension,
     free play and compression; drag c, friction F_f and mass m (R,); rms equation
-    residual (R,), N."""
+    residual (R,), N; the equation residuals of replicate 0 (E,), N, which
+    :func:`clearjoint.identify.loopcheck.weak_residual` reads against its noise floor."""
 
     lines: FloatArray
     drag: FloatArray
     friction: FloatArray
     mass: FloatArray
     residual: FloatArray
+    equations: FloatArray
 
 
 def weak_fit(
@@ -250,4 +252,4 @@ def weak_fit(
     rms = np.sqrt(np.mean(residual**2, axis=1))
     lines = coef[:, :6].reshape(r, 3, 2)
     m_hat = coef[:, 8] if mass is None else np.full(r, float(mass))
-    return WeakFit(lines, coef[:, 6], coef[:, 7], m_hat, rms)
+    return WeakFit(lines, coef[:, 6], coef[:, 7], m_hat, rms, residual[0])
