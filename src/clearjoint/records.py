@@ -25,7 +25,7 @@ import math
 import re
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -805,14 +805,21 @@ BRFD_CITATION = (
 def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
     """The JSON's metadata (without 'data') and its 'data' matrix, from the file's bytes.
 
-    Parsed by orjson: its numbers are the correctly rounded doubles that Python's
-    ``float`` gives, bit for bit, and it is faster than numpy's C parser of the matrix
-    text over the 31 BRFD files, more so with the garbage collector off from the parse
-    until the rows' lists are freed (they hold only numbers: no cycles to collect; with the
-    collector back on while they live, its next pass walks every one of them); side by
-    side by ``python benchmarks/bench_identify.py --parsers``.
+    A plain matrix of numbers (every row a list of numbers, all of one length, no other
+    list in the file, each key once) is parsed by simdjson straight into doubles
+    (:func:`_simd_matrix`: no Python object per number; about three times faster than
+    the route below over the 31 BRFD files, side by side by ``python
+    benchmarks/bench_identify.py --parsers``). Anything else goes by orjson, as before
+    (its lists, then :func:`_rows_matrix`), which also says what is wrong with it. Both
+    give the correctly rounded doubles that Python's ``float`` gives, bit for bit.
+    orjson runs with the garbage collector off from the parse until the rows' lists are
+    freed (they hold only numbers: no cycles to collect; with the collector on while they
+    live, its next pass walks every one of them).
     """
-    import orjson  # only a JSON record needs it
+    fast = _simd_matrix(raw)
+    if fast is not None:
+        return fast
+    import orjson  # only a JSON record that is not a plain matrix needs it
 
     collecting = gc.isenabled()
     gc.disable()  # tens of thousands of new lists, no cycles: the collector only costs time
@@ -821,6 +828,56 @@ def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
     finally:
         if collecting:
             gc.enable()
+
+
+#: Errors of simdjson's parser and accessors: the file goes to the orjson route instead.
+_SIMD_DECLINES = (ValueError, TypeError, KeyError, RuntimeError, AttributeError)
+
+
+def _simd_matrix(raw: bytes) -> tuple[dict[str, Any], FloatArray] | None:
+    """The metadata and the 'data' matrix of a JSON object by simdjson, or None.
+
+    None (the caller then parses with orjson) unless the bytes are one JSON object (no
+    byte-order mark: orjson refuses one) whose keys are all different, whose 'data' is a
+    non-empty list of equally long, non-empty lists of numbers, and which holds no other
+    list (its ``[`` bytes number exactly the rows plus one: a list nested in a row, whose
+    numbers simdjson's buffer would flatten into the matrix, or a ``[`` in any text,
+    sends the file to orjson). The numbers are simdjson's correctly rounded doubles (an
+    integer converted to the nearest double), those of orjson and Python's ``float``.
+    """
+    import simdjson  # only a JSON record needs it
+
+    if raw.startswith(b"\xef\xbb\xbf"):
+        return None
+    try:
+        document = simdjson.Parser().parse(raw)
+        if not isinstance(document, simdjson.Object):
+            return None
+        keys = list(document.keys())
+        rows = document["data"] if "data" in keys else None
+        if len(set(keys)) != len(keys) or not isinstance(rows, simdjson.Array):
+            return None
+        n = len(rows)
+        if n == 0 or raw.count(b"[") != n + 1:
+            return None
+        widths = set(map(len, cast(list[list[float]], rows)))  # a number for a row: TypeError
+        width = widths.pop() if len(widths) == 1 else 0
+        flat = np.frombuffer(rows.as_buffer(of_type="d"), dtype=np.float64)
+        if width == 0 or flat.size != n * width:
+            return None
+        meta = {key: _plain(simdjson, document[key]) for key in keys if key != "data"}
+    except _SIMD_DECLINES:  # not JSON, not UTF-8, a text or null among the numbers...
+        return None
+    return meta, flat.reshape(n, width)
+
+
+def _plain(simdjson: Any, value: Any) -> Any:
+    """A simdjson value as Python's own (an object a dict, an array a list)."""
+    if isinstance(value, simdjson.Object):
+        return value.as_dict()
+    if isinstance(value, simdjson.Array):
+        return value.as_list()
+    return value
 
 
 def _json_matrix(where: str, raw: bytes, orjson: Any) -> tuple[dict[str, Any], FloatArray]:

@@ -721,7 +721,7 @@ def _warm_readers(paths: list[str]) -> None:
     if suffixes & {".nc", ".h5", ".hdf5"}:
         import h5py  # noqa: F401
     if ".json" in suffixes:
-        import orjson  # noqa: F401
+        import simdjson  # noqa: F401
 
 
 def _size(path: str) -> int:
