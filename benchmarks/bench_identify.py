@@ -23,6 +23,9 @@ worker's own (the larger of the two; the interpreter's start before ``main`` and
 after are not in it), best of ``--repeats``, old and new code interleaved.
 ``--parsers`` compares JSON readers of the BRFD files side by side (CPU seconds, best of
 ``--repeats``; each must give the same doubles as Python's json module, bit for bit).
+``--compare`` (with ``--old-src``) runs both codes' command once on each set and compares
+their results.csv: byte for byte, else every number within 1e-12 relative and every text
+(flags, reasons) equal; it prints the verdict per set and exits 1 on a difference.
 Target (issue 15): 1e6 samples per second.
 """
 
@@ -118,6 +121,21 @@ def _numpy_text(raw: bytes) -> np.ndarray:
     return np.fromstring(body.translate(_BRACKETS), sep=",").reshape(rows, -1)
 
 
+def _orjson_fromiter(raw: bytes) -> np.ndarray:
+    """The reader before simdjson: orjson's lists (collector off), numpy.fromiter over them."""
+    import gc
+
+    import orjson
+
+    from clearjoint.records import _json_matrix
+
+    gc.disable()
+    try:
+        return _json_matrix("", raw, orjson)[1]
+    finally:
+        gc.enable()
+
+
 def _previous_reader(raw: bytes) -> np.ndarray:
     """The reader before numpy.fromiter: the collector off while orjson parses only."""
     import gc
@@ -142,7 +160,8 @@ def parsers(files: list[Path], repeats: int) -> None:
         "numpy.fromstring of the text": _numpy_text,
         "orjson + numpy.array": lambda raw: np.array(orjson.loads(raw)["data"], dtype=np.float64),
         "orjson (no gc) + numpy.array": _previous_reader,
-        "the reader (orjson, fromiter)": lambda raw: _brfd_json("", raw)[1],
+        "orjson (no gc) + numpy.fromiter": _orjson_fromiter,
+        "the reader (simdjson, checked)": lambda raw: _brfd_json("", raw)[1],
     }
     reference = [ways["json + numpy.array"](raw) for raw in raws]
     megabytes = sum(map(len, raws)) / 1e6
@@ -217,6 +236,52 @@ def _critical(sets: dict[str, list[Path]], args: argparse.Namespace, out: Path) 
             print(f"{name:22s} ratio old/new {best['old'][0] / best['new'][0]:.2f}x")
 
 
+def _csv_rows(path: Path) -> list[list[str]]:
+    import csv
+
+    with path.open(newline="", encoding="utf-8") as handle:
+        return list(csv.reader(handle))
+
+
+def _same_results(new: Path, old: Path) -> str:
+    """'identical' (byte for byte), 'within 1e-12 (largest relative difference D)', or
+    what differs first."""
+    if new.read_bytes() == old.read_bytes():
+        return "identical byte for byte"
+    a, b = _csv_rows(new), _csv_rows(old)
+    if len(a) != len(b) or a[0] != b[0]:
+        return f"DIFFERENT: {len(a)} rows against {len(b)}, or other columns"
+    worst = 0.0
+    for row, (ra, rb) in enumerate(zip(a[1:], b[1:], strict=True), start=2):
+        for name, x, y in zip(a[0], ra, rb, strict=True):
+            if x == y:
+                continue
+            try:
+                fx, fy = float(x), float(y)
+            except ValueError:
+                return f"DIFFERENT at line {row}, column {name}: {x!r} against {y!r}"
+            scale = max(abs(fx), abs(fy))
+            if not (fx == fy or (scale > 0 and abs(fx - fy) <= 1e-12 * scale)):
+                return f"DIFFERENT at line {row}, column {name}: {x} against {y}"
+            worst = max(worst, abs(fx - fy) / scale)
+    return f"within 1e-12 relative (largest difference {worst:.2g})"
+
+
+def compare(sets: dict[str, list[Path]], old_src: str, folder: Path) -> bool:
+    """Both codes' results.csv over each set, compared; True when all agree."""
+    agree = True
+    for name, files in sets.items():
+        new_out, old_out = folder / "new.csv", folder / "old.csv"
+        run(files, None, 1, new_out)
+        run(files, old_src, 1, old_out)
+        verdict = _same_results(new_out, old_out)
+        agree &= not verdict.startswith("DIFFERENT")
+        print(
+            f"{name:22s} {len(files):3d} files: results.csv, this code against {old_src}: {verdict}"
+        )
+    return agree
+
+
 def _load() -> str:
     return " ".join(f"{value:.2f}" for value in os.getloadavg())
 
@@ -233,6 +298,11 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument(
         "--parsers", action="store_true", help="only compare JSON readers on the BRFD files"
+    )
+    parser.add_argument(
+        "--compare",
+        action="store_true",
+        help="only compare both codes' results.csv over each set (needs --old-src)",
     )
     parser.add_argument(
         "--critical-path",
@@ -254,6 +324,10 @@ def main() -> None:
         if brfd.exists():
             sets["BRFD folder"] = sorted(brfd.glob("*.json"))
         out = Path(folder) / "results.csv"
+        if args.compare:
+            if not args.old_src:
+                parser.error("--compare needs --old-src")
+            sys.exit(0 if compare(sets, args.old_src, Path(folder)) else 1)
         print("load average (1, 5, 15 min) before: " + _load())
         if args.critical_path:
             _critical(sets, args, out)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -93,6 +94,64 @@ def test_netcdf_variables_of_other_types_and_string_kinds_are_read(tmp_path: Pat
         del handle["force"].attrs["units"]
     with pytest.raises(RecordError, match="variable 'force' has no units attribute"):
         read_record(path)
+
+
+def test_netcdf_attributes_read_as_h5pys_attribute_manager_gives_them(tmp_path: Path) -> None:
+    # the low-level reading of the metadata against h5py's own AttributeManager, on every
+    # kind an attribute may have: scalars and arrays of numbers, fixed- and variable-length
+    # strings (one not UTF-8), an empty attribute and one of an array type (both left to
+    # h5py: None)
+    import h5py
+
+    from clearjoint.records import _h5_attribute
+
+    path = tmp_path / "kinds.nc"
+    with h5py.File(path, "w") as handle:
+        attrs = handle.attrs
+        attrs["scalar"] = 2.5
+        attrs["one"] = np.array([1.5])
+        attrs["ints"] = np.array([1, 2, 3], dtype=np.int16)
+        attrs["text"] = "beam"
+        attrs["fixed"] = np.bytes_(b"force")
+        attrs.create("latin", data=b"caf\xe9", dtype=h5py.string_dtype())
+        attrs.create("strings", data=["a", "bc"], dtype=h5py.string_dtype())
+        attrs["empty"] = h5py.Empty("f8")
+        attrs.create("arraytype", data=np.zeros((2, 3)), dtype=np.dtype("(3,)f8"))
+    with h5py.File(path, "r") as handle:
+        for name in handle.attrs:
+            fast = _h5_attribute(h5py, handle.id, name.encode())
+            if name in ("empty", "arraytype"):
+                assert fast is None
+                continue
+            expected = handle.attrs[name]
+            assert type(fast) is type(expected)
+            np.testing.assert_array_equal(fast, expected, strict=True)
+
+
+def test_netcdf_metadata_as_before(tmp_path: Path) -> None:
+    # a record's metadata read by the low-level attributes, against xarray's reading
+    import xarray as xr
+
+    rec = Record(
+        time=np.arange(600) / 600.0,
+        force=np.sin(np.arange(600) / 10.0),
+        displacement=np.cos(np.arange(600) / 10.0),
+        frequency_hz=10.0,
+        mass=1.25,
+        clearance=1e-4,
+        joint_id="pin 3",
+        notes="caf\u00e9 [x]",
+        control="displacement",
+    )
+    path = write_record(rec, tmp_path / "r.nc")
+    back = read_record(path)
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        assert back.frequency_hz == float(ds.attrs["frequency_hz"]) == 10.0
+        assert back.mass == float(ds.attrs["mass_kg"]) == 1.25
+        assert back.clearance == float(ds.attrs["clearance_m"])
+        assert back.joint_id == ds.attrs["joint_id"] == "pin 3"
+        assert back.notes == ds.attrs["notes"] == "caf\u00e9 [x]"
+        assert back.control == ds.attrs["control"]
 
 
 def test_csv_units_are_converted_to_si(tmp_path: Path) -> None:
@@ -630,3 +689,95 @@ def test_cli_warns_in_one_line_for_an_extra_column(
         f"clearjoint identify: warning: {path}: ignored column(s) 'temperature [C]': a record "
         "has no such channel (it reads time, force, displacement, velocity, acceleration)"
     ]
+
+
+def _orjson_route(raw: bytes) -> tuple[dict[str, object], np.ndarray]:
+    """The reader's route for what simdjson declines: orjson's lists, then the rows."""
+    import orjson
+
+    from clearjoint.records import _json_matrix
+
+    return _json_matrix("x.json", raw, orjson)
+
+
+def test_simdjson_matrix_gives_pythons_doubles_bit_for_bit() -> None:
+    # numbers written every way a JSON writer may (repr, %.17g, %.6e, integers, negative
+    # zero, subnormals, the largest doubles, 2**53 + 1), against Python's json module (an
+    # integer is an int there, so "-0" reads +0.0 as from orjson; float("-0") is -0.0)
+    from clearjoint.records import _simd_matrix
+
+    rng = np.random.default_rng(7)
+    values = np.concatenate(
+        (
+            rng.standard_normal(300) * 10.0 ** rng.integers(-300, 300, 300),
+            [0.0, -0.0, 5e-324, -2.2250738585072014e-308, 1.7976931348623157e308, 0.1],
+        )
+    )
+    texts = [repr(float(v)) for v in values] + [f"{v:.17g}" for v in values]
+    texts += [f"{v:.6e}" for v in values] + ["9007199254740993", "-0", "123456789012345678"]
+    texts += ["1E5", "1e-400", "0.30000000000000004", "18446744073709551615"]
+    texts += [str(int(v)) for v in rng.integers(-(2**62), 2**62, 20)]
+    width = 3
+    texts += ["0"] * (-len(texts) % width)
+    rows = [texts[i : i + width] for i in range(0, len(texts), width)]
+    raw = '{"dt": 0.5, "data": [' + ", ".join(f"[{', '.join(r)}]" for r in rows) + "]}"
+    fast = _simd_matrix(raw.encode())
+    assert fast is not None
+    meta, matrix = fast
+    expected = np.array(json.loads(raw)["data"], dtype=np.float64)
+    assert matrix.shape == expected.shape
+    assert matrix.tobytes() == expected.tobytes()  # bit for bit, -0.0 included
+    assert meta == {"dt": 0.5}
+    assert matrix.tobytes() == _orjson_route(raw.encode())[1].tobytes()
+
+
+@pytest.mark.parametrize(
+    "raw",
+    [
+        b'{"data": [[1.0, 2.0, 3.0], [4.0], [5.0, 6.0]]}',  # ragged, 6 numbers in 3 rows
+        b'{"data": [[1.0, [2.0]], [3.0, 4.0]]}',  # nested: the flat buffer would fit 2 x 2
+        b'{"data": [[1.0, 2.0], 3.0, [4.0, 5.0]]}',  # a number for a row
+        b'{"data": [[1.0, true], [3.0, 4.0]]}',  # a bool (orjson: 1.0, as before)
+        b'{"data": [[1.0, null], [3.0, 4.0]]}',
+        b'{"data": [[1.0, "2.5"], [3.0, 4.0]]}',
+        b'{"data": [[1.0, 2.0]], "data": [[3.0, 4.0]]}',  # a repeated key: the last one
+        b'{"data": [[1.0, 2.0]], "note": "a [bracket"}',  # a [ in a text
+        b'{"data": [[1.0, 2.0]], "gains": [1, 2]}',  # another list
+        b'{"data": [[1.0, 2.0]], "d\\u0061ta": [[3.0, 4.0]]}',  # the same key, escaped
+        b'\xef\xbb\xbf{"data": [[1.0, 2.0]]}',  # a byte-order mark (orjson refuses it)
+        b'{"data": [[1.0, 2.0]], "note": "caf\xe9"}',  # not UTF-8
+        b'{"data": [[1e400, 2.0]]}',
+        b'{"data": [[NaN, 2.0]]}',
+        b'{"data": [[]]}',
+        b'{"data": []}',
+        b'{"data": 3}',
+        b"[1, 2]",
+        b'{"data": [[1.0, 2.0]]} trailing',
+    ],
+)
+def test_simdjson_declines_what_orjson_must_judge(raw: bytes) -> None:
+    # whatever simdjson does not take as a plain matrix goes the orjson route, which
+    # gives the same matrix or the same error as before the fast path
+    from clearjoint.records import _brfd_json, _simd_matrix
+
+    assert _simd_matrix(raw) is None
+
+    def outcome(read: Callable[[bytes], tuple[dict[str, object], np.ndarray]]) -> object:
+        try:
+            meta, matrix = read(raw)
+        except RecordError as exc:
+            return str(exc)
+        return meta, matrix.shape, matrix.tobytes()
+
+    assert outcome(lambda b: _brfd_json("x.json", b)) == outcome(_orjson_route)
+
+
+def test_simdjson_takes_a_plain_matrix_with_its_metadata() -> None:
+    from clearjoint.records import _simd_matrix
+
+    raw = b'{"data": [[0, 1.5], [2, -3e-5]], "units": {"a": "in"}, "dt": 1, "x": null}'
+    fast = _simd_matrix(raw)
+    assert fast is not None
+    assert fast[0] == {"units": {"a": "in"}, "dt": 1, "x": None}
+    assert fast[1].tolist() == [[0.0, 1.5], [2.0, -3e-5]]
+    assert fast[0] == _orjson_route(raw)[0]

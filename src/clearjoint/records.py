@@ -25,7 +25,7 @@ import math
 import re
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -705,11 +705,11 @@ def _read_netcdf(path: Path, resample_: bool) -> Record:
             columns[name] = values * _factor(where, name, unit)
             units[name] = unit
         meta: dict[str, Any] = {}
-        attrs = handle.attrs
-        present = set(attrs.keys())
         for attr, key in _NC_META.items():
-            if attr in present:
-                value = attrs[attr]
+            if h5py.h5a.exists(root, attr.encode()):
+                value = _h5_attribute(h5py, root, attr.encode())
+                if value is None:  # empty, or of an array type: h5py's own reading
+                    value = handle.attrs[attr]
                 meta[key] = (
                     _text(value)
                     if key in ("joint_id", "control", "notes")
@@ -738,6 +738,25 @@ def _h5_variable(h5py: Any, root: Any, name: bytes) -> tuple[str, FloatArray] | 
     values = np.empty(dataset.shape, dtype=np.float64)
     dataset.read(h5py.h5s.ALL, h5py.h5s.ALL, values)
     return unit, values
+
+
+def _h5_attribute(h5py: Any, owner: Any, name: bytes) -> Any:
+    """An attribute's value as ``h5py.AttributeManager.__getitem__`` gives it (the same
+    steps, without building the manager, which cost most of a rig record's metadata
+    reading); None for an empty attribute or one of an array type (read by h5py then)."""
+    attr = h5py.h5a.open(owner, name)
+    shape = attr.shape
+    dtype = attr.dtype
+    if shape is None or dtype.subdtype is not None:
+        return None
+    values = np.zeros(shape, dtype=dtype, order="C")
+    attr.read(values, mtype=h5py.h5t.py_create(dtype))
+    info = h5py.h5t.check_string_dtype(dtype)
+    if info and info.length is None:  # variable-length strings: Python str, as h5py does
+        values = np.array(
+            [b.decode("utf-8", "surrogateescape") for b in values.flat], dtype=dtype
+        ).reshape(values.shape)
+    return values[()] if values.ndim == 0 else values
 
 
 def _text(value: Any) -> str:
@@ -805,14 +824,21 @@ BRFD_CITATION = (
 def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
     """The JSON's metadata (without 'data') and its 'data' matrix, from the file's bytes.
 
-    Parsed by orjson: its numbers are the correctly rounded doubles that Python's
-    ``float`` gives, bit for bit, and it is faster than numpy's C parser of the matrix
-    text over the 31 BRFD files, more so with the garbage collector off from the parse
-    until the rows' lists are freed (they hold only numbers: no cycles to collect; with the
-    collector back on while they live, its next pass walks every one of them); side by
-    side by ``python benchmarks/bench_identify.py --parsers``.
+    A plain matrix of numbers (every row a list of numbers, all of one length, no other
+    list in the file, each key once) is parsed by simdjson straight into doubles
+    (:func:`_simd_matrix`: no Python object per number; about three times faster than
+    the route below over the 31 BRFD files, side by side by ``python
+    benchmarks/bench_identify.py --parsers``). Anything else goes by orjson, as before
+    (its lists, then :func:`_rows_matrix`), which also says what is wrong with it. Both
+    give the correctly rounded doubles that Python's ``float`` gives, bit for bit.
+    orjson runs with the garbage collector off from the parse until the rows' lists are
+    freed (they hold only numbers: no cycles to collect; with the collector on while they
+    live, its next pass walks every one of them).
     """
-    import orjson  # only a JSON record needs it
+    fast = _simd_matrix(raw)
+    if fast is not None:
+        return fast
+    import orjson  # only a JSON record that is not a plain matrix needs it
 
     collecting = gc.isenabled()
     gc.disable()  # tens of thousands of new lists, no cycles: the collector only costs time
@@ -821,6 +847,58 @@ def _brfd_json(where: str, raw: bytes) -> tuple[dict[str, Any], FloatArray]:
     finally:
         if collecting:
             gc.enable()
+
+
+_OPEN = ord("[")
+#: Errors of simdjson's parser and accessors: the file goes to the orjson route instead.
+_SIMD_DECLINES = (ValueError, TypeError, KeyError, RuntimeError, AttributeError)
+
+
+def _simd_matrix(raw: bytes) -> tuple[dict[str, Any], FloatArray] | None:
+    """The metadata and the 'data' matrix of a JSON object by simdjson, or None.
+
+    None (the caller then parses with orjson) unless the bytes are one JSON object (no
+    byte-order mark: orjson refuses one) whose keys are all different, whose 'data' is a
+    non-empty list of equally long, non-empty lists of numbers, and which holds no other
+    list (its ``[`` bytes number exactly the rows plus one: a list nested in a row, whose
+    numbers simdjson's buffer would flatten into the matrix, or a ``[`` in any text,
+    sends the file to orjson). The numbers are simdjson's correctly rounded doubles (an
+    integer converted to the nearest double), those of orjson and Python's ``float``.
+    """
+    import simdjson  # only a JSON record needs it
+
+    if raw.startswith(b"\xef\xbb\xbf"):
+        return None
+    try:
+        document = simdjson.Parser().parse(raw)
+        if not isinstance(document, simdjson.Object):
+            return None
+        keys = list(document.keys())
+        rows = document["data"] if "data" in keys else None
+        if len(set(keys)) != len(keys) or not isinstance(rows, simdjson.Array):
+            return None
+        n = len(rows)
+        # numpy counts the bytes faster than bytes.count (1.6 GB/s here: 25 ms of 50 MB)
+        if n == 0 or np.count_nonzero(np.frombuffer(raw, dtype=np.uint8) == _OPEN) != n + 1:
+            return None
+        widths = set(map(len, cast(list[list[float]], rows)))  # a number for a row: TypeError
+        width = widths.pop() if len(widths) == 1 else 0
+        flat = np.frombuffer(rows.as_buffer(of_type="d"), dtype=np.float64)
+        if width == 0 or flat.size != n * width:
+            return None
+        meta = {key: _plain(simdjson, document[key]) for key in keys if key != "data"}
+    except _SIMD_DECLINES:  # not JSON, not UTF-8, a text or null among the numbers...
+        return None
+    return meta, flat.reshape(n, width)
+
+
+def _plain(simdjson: Any, value: Any) -> Any:
+    """A simdjson value as Python's own (an object a dict, an array a list)."""
+    if isinstance(value, simdjson.Object):
+        return value.as_dict()
+    if isinstance(value, simdjson.Array):
+        return value.as_list()
+    return value
 
 
 def _json_matrix(where: str, raw: bytes, orjson: Any) -> tuple[dict[str, Any], FloatArray]:

@@ -221,10 +221,16 @@ def _groups(n: int) -> list[NDArray[np.int64]]:
 
 
 def _leave_one_out(values: FloatArray, groups: list[NDArray[np.int64]]) -> FloatArray:
-    """The averages of the (n, M) rows without each group in turn, (G, M)."""
+    """The averages of the (n, M) rows without each group in turn, (G, M).
+
+    The groups are contiguous (:func:`_groups`): each is summed as a slice of the rows
+    (the same additions in the same order as over a copy of them, without the copy).
+    """
     n = values.shape[0]
     total = values.sum(axis=0)
-    out: FloatArray = np.array([(total - values[g].sum(axis=0)) / (n - g.size) for g in groups])
+    out: FloatArray = np.array(
+        [(total - values[g[0] : g[-1] + 1].sum(axis=0)) / (n - g.size) for g in groups]
+    )
     return out
 
 
@@ -587,11 +593,14 @@ def _identify_stack(
             "'# mass = \"1.5 kg\"', netCDF attribute mass_kg) to use the known one"
         )
     head = fits[0]
+    # each quantity's per-cycle values as Python floats at once (the same doubles as
+    # float() of each element, without a numpy scalar per value)
+    columns = {q: np.asarray(per_cycle[q], dtype=np.float64).tolist() for q in QUANTITIES}
     cycles = tuple(
         CycleResult(
             int(st.starts[j]),
             int(st.starts[j]) + m,
-            {q: float(per_cycle[q][j]) for q in QUANTITIES},
+            {q: columns[q][j] for q in QUANTITIES},
             head.upper_edge,
             head.lower_edge,
             model,
@@ -759,7 +768,7 @@ def _warm_readers(paths: list[str]) -> None:
     if suffixes & {".nc", ".h5", ".hdf5"}:
         import h5py  # noqa: F401
     if ".json" in suffixes:
-        import orjson  # noqa: F401
+        import simdjson  # noqa: F401
 
 
 def _size(path: str) -> int:

@@ -13,6 +13,7 @@ what keeps displacement noise from biasing the regressors (errors in variables).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass
@@ -67,13 +68,21 @@ def _smooth_length(n: int) -> int:
     return best
 
 
+@functools.lru_cache(maxsize=8)
+def _hanning(n: int) -> FloatArray:
+    """``numpy.hanning(n)``, made once per length (a campaign's records share a few), read-only."""
+    window = np.hanning(n)
+    window.flags.writeable = False
+    return window
+
+
 def excitation_frequency(record: Record) -> float:
     """Return the excitation frequency in Hz: the displacement spectrum's peak, interpolated."""
     x = record.displacement - record.displacement.mean()
     n = x.size
     padded = _smooth_length(4 * n)  # a length the FFT factors fast
     # numpy's FFT (pocketfft): importing scipy.fft cost more than all the fits of a record
-    spectrum = np.abs(np.fft.rfft(x * np.hanning(n), n=padded))
+    spectrum = np.abs(np.fft.rfft(x * _hanning(n), n=padded))
     spectrum[0] = 0.0
     k = float(np.argmax(spectrum))
     i = int(k)

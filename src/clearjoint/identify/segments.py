@@ -11,6 +11,7 @@ from the weak form (:mod:`clearjoint.identify.weak`).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass
@@ -22,6 +23,16 @@ FloatArray = NDArray[np.float64]
 
 STAGE_FREE, STAGE_COMPRESSION, STAGE_TENSION = 0, 1, -1
 BINS = 48
+
+
+@functools.lru_cache(maxsize=4)
+def _pieces(m: int) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Every piece of at least two of ``m`` bins, [i, j): ``numpy.triu_indices(m + 1, k=2)``,
+    made once per bin count (read-only)."""
+    i, j = np.triu_indices(m + 1, k=2)
+    i.flags.writeable = False
+    j.flags.writeable = False
+    return i, j
 
 
 def _segments(x: FloatArray, y: FloatArray, n_segments: int, bins: int) -> list[tuple[int, int]]:
@@ -41,7 +52,7 @@ def _segments(x: FloatArray, y: FloatArray, n_segments: int, bins: int) -> list[
     syy = np.add.reduceat(y * y, edges[:-1])
     cum = [np.concatenate(([0.0], np.cumsum(s))) for s in (w, sx, sy, sxx, sxy, syy)]
     m = w.size
-    i, j = np.triu_indices(m + 1, k=2)  # pieces of at least two bins: [i, j)
+    i, j = _pieces(m)
     cw, cx, cy, cxx, cxy, cyy = (c[j] - c[i] for c in cum)
     vxx = cxx - cx * cx / cw
     vxy = cxy - cx * cy / cw

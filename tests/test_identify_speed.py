@@ -1,0 +1,66 @@
+"""The identification's fast paths against the calls they replace (issue 15, speed)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from clearjoint.identify.cycles import _hanning
+
+
+@pytest.mark.parametrize("n", [16, 3600, 8221])
+def test_cached_window_is_numpys_hanning_and_read_only(n: int) -> None:
+    window = _hanning(n)
+    assert window.tobytes() == np.hanning(n).tobytes()
+    assert _hanning(n) is window  # made once per length
+    with pytest.raises(ValueError, match="read-only"):
+        window[0] = 1.0
+
+
+@pytest.mark.parametrize("n", [3, 8, 9, 37])
+def test_leave_one_out_by_slices_is_the_sum_over_copies_bit_for_bit(n: int) -> None:
+    from clearjoint.identify.core import _groups, _leave_one_out
+
+    values = np.random.default_rng(n).standard_normal((n, 257)) * 1e3
+    groups = _groups(n)
+    total = values.sum(axis=0)
+    before = np.array([(total - values[g].sum(axis=0)) / (n - g.size) for g in groups])
+    assert _leave_one_out(values, groups).tobytes() == before.tobytes()
+    # and against the definition, the mean of the other rows, to rounding
+    for k, g in enumerate(groups):
+        others = np.delete(values, g, axis=0).mean(axis=0)
+        np.testing.assert_allclose(_leave_one_out(values, groups)[k], others, rtol=1e-12)
+
+
+@pytest.mark.parametrize("m", [2, 5, 48])
+def test_cached_pieces_are_numpys_upper_triangle(m: int) -> None:
+    from clearjoint.identify.segments import _pieces
+
+    i, j = _pieces(m)
+    ref_i, ref_j = np.triu_indices(m + 1, k=2)
+    np.testing.assert_array_equal(i, ref_i, strict=True)
+    np.testing.assert_array_equal(j, ref_j, strict=True)
+    assert np.all(j - i >= 2)
+    assert _pieces(m)[0] is i
+
+
+def test_per_cycle_values_are_python_floats_of_their_own_cycle() -> None:
+    # a shipped BRFD record: each cycle's amplitude is nearest to half the range of the
+    # record's displacement over that cycle's own samples (not another cycle's; the stack
+    # interpolates, so to 1e-4 here, where the cycles differ by 3e-4 to 8e-4)
+    from pathlib import Path
+
+    from clearjoint.identify import identify
+    from clearjoint.records import read_brfd
+
+    shipped = Path(__file__).resolve().parent / "data" / "brfd" / "2Hz30lbtension0.5amplitude.json"
+    record = read_brfd(shipped)
+    ident = identify(record)
+    assert len(ident.cycles) >= 3
+    amplitude = np.array([c.values["amplitude_m"] for c in ident.cycles])
+    own = np.array([0.5 * np.ptp(record.displacement[c.start : c.stop]) for c in ident.cycles])
+    misfit = np.abs(amplitude[:, None] / own[None, :] - 1.0)
+    assert np.all(np.argmin(misfit, axis=1) == np.arange(len(ident.cycles)))
+    assert np.all(np.diag(misfit) < 1e-4)
+    for cycle in ident.cycles:
+        assert all(type(v) is float for v in cycle.values.values())
