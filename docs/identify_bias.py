@@ -205,7 +205,7 @@ def _spread(counts: list[int], draws: int, calibrated: bool, folder: Path) -> No
 
     from clearjoint.identify import weak
 
-    own = weak.WeakSystem.friction_of
+    own = getattr(weak.WeakSystem, "friction_of", None)  # None: an older src, run as it is
     if calibrated:
         from scipy.special import erf
 
@@ -242,7 +242,8 @@ def _spread(counts: list[int], draws: int, calibrated: bool, folder: Path) -> No
                 flush=True,
             )
     finally:
-        weak.WeakSystem.friction_of = own  # type: ignore[method-assign]
+        if own is not None:
+            weak.WeakSystem.friction_of = own  # type: ignore[method-assign]
 
 
 def main() -> None:

@@ -21,9 +21,10 @@ MODEL.md section 3. The steps:
    sign and drag from its spectral derivative); the damper's and the line's by their
    per-sample fits;
 6. a jackknife over the cycles (the average without each of at most eight contiguous
-   groups of cycles in turn, all replicates fitted in one batched solve) for every
-   standard error; the energy per cycle is each cycle's own loop area (the closed
-   integral of F dx, in which the inertia term cancels);
+   groups of cycles in turn, all replicates fitted in one batched solve, each with the
+   sign of its own velocity for the friction term) for every standard error; the energy
+   per cycle is each cycle's own loop area (the closed integral of F dx, in which the
+   inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
    exceeds a quarter of it, a fit residual above three times its noise floor (the weak

@@ -24,8 +24,8 @@ batched solve. The friction term's weights int(phi sgn x') are not: they follow 
 of the velocity, which the noise flips near each reversal. Each replicate therefore takes
 them from its own velocity (:meth:`WeakSystem.friction_of`), so the jackknife's spread
 carries the sign's noise too; with the average's sign shared by every replicate it did
-not, and the friction's standard error came out 2.1-2.6 times too small (docs/identify.md,
-"The number of cycles").
+not, and the friction's standard error came out 1.9-2.6 times too small over noise draws
+(docs/identify.md, "The number of cycles").
 """
 
 from __future__ import annotations
