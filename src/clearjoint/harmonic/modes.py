@@ -68,8 +68,9 @@ _SUB_ITERATIONS = 20
 _MAC = 0.5
 
 _NEWTON = (
-    f"Newton did not converge from the neighbouring converged amplitude after {MAX_HALVINGS} "
-    "halvings of the step in log amplitude (or converged to another mode)"
+    "Newton did not converge from the neighbouring converged amplitude above (nor below, where "
+    f"one converged) after {MAX_HALVINGS} halvings of the step in log amplitude (or converged "
+    "to another mode)"
 )
 
 Path = list[tuple[float, FloatArray]]
@@ -119,9 +120,10 @@ class NonlinearMode:
         Empty, or one line per thing the user should know: how many amplitudes found
         no mode and why (Newton did not converge from the neighbouring amplitude after
         :data:`MAX_HALVINGS` halvings of the step; w fell to 0); how many were reached
-        instead up from the open-pattern mode below contact onset (the branch from
-        above did not reach them: the solutions there may not be unique); or that no
-        joint reached a gap edge over the whole range (with where contact begins).
+        instead up from the open-pattern mode below contact onset, or up from a
+        converged amplitude below (the branch from above did not reach them: it folds
+        in amplitude there, the solutions are not unique); or that no joint reached a
+        gap edge over the whole range (with where contact begins).
     """
 
     amplitude: FloatArray
@@ -263,7 +265,12 @@ def nonlinear_modes(
     EPMC with harmonic balance: at each modal amplitude a, solve for Q, w and the
     negative damping xi that makes the free motion periodic. Amplitudes are solved
     from the largest down, each from the ones before (a secant predictor in log a);
-    where Newton fails the step is halved, up to :data:`MAX_HALVINGS` times, and an
+    where Newton fails the step is halved, up to :data:`MAX_HALVINGS` times. An amplitude
+    the branch from above does not reach is then tried up from the open-pattern mode (below
+    contact onset) and up from the nearest converged amplitude below it: near onset the
+    branch folds in amplitude (docs/harmonic.md), so several solutions lie at one
+    amplitude; each point is the one on the branch continued from above where that
+    reaches it, else the one continued from below (``note`` says which and how many). An
     amplitude still failing is flagged in ``converged`` and explained in ``note``.
 
     Parameters
@@ -394,6 +401,7 @@ def nonlinear_modes(
                 results[i] = path[-1][1]
                 del reasons[i]
                 upward.append(i)
+    beside = _neighbours(solve_at, amps, results, reasons, same_mode)
     note = _note(amps, reasons)
     if upward:
         at = amps[upward]
@@ -401,6 +409,13 @@ def nonlinear_modes(
             f"{at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) followed up "
             f"from the open-pattern mode below contact onset ({reach:.3g} m): the branch from "
             "above did not reach them"
+        )
+    if beside:
+        at = amps[beside]
+        note = (note + "; " if note else "") + (
+            f"{at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) reached from "
+            "a converged amplitude below, not from above: near contact onset the branch folds in "
+            "amplitude (several solutions at one amplitude), so the curve may jump between pieces"
         )
     if not _any_contact(model, basis, amps, results):
         note = (note + "; " if note else "") + (
@@ -485,6 +500,40 @@ def _walk(
         if last:
             return True
         step *= 2.0
+
+
+def _neighbours(
+    solve_at: Callable[..., FloatArray | None],
+    amps: FloatArray,
+    results: dict[int, FloatArray],
+    reasons: dict[int, str],
+    same_mode: Callable[[FloatArray, FloatArray], bool],
+) -> list[int]:
+    """Solve the failed amplitudes up from the nearest converged one below; their indices.
+
+    Near contact onset the branch followed down from above can fold back in amplitude
+    (an internal resonance with a higher mode, or a gap edge crossed at a sample; see
+    docs/harmonic.md), so that no step reaches the amplitudes under the fold from above,
+    while the piece of the branch under it reaches them from below. Each failed amplitude
+    is walked to (:func:`_walk`, secant predictor on the two converged amplitudes below
+    when both are there) from the nearest converged amplitude below it, in ascending
+    order, so a recovered one serves the next; ``same_mode`` refuses jumps to another
+    mode as in the march. ``results`` and ``reasons`` are updated in place.
+    """
+    reached: list[int] = []
+    for i in sorted(reasons):
+        below = [j for j in results if j < i]
+        if not below or reasons[i] != _NEWTON:
+            continue
+        j = max(below)
+        path: Path = [(float(amps[j]), results[j])]
+        if j - 1 in results:
+            path.insert(0, (float(amps[j - 1]), results[j - 1]))
+        if _walk(solve_at, path, float(amps[i]), same_mode):
+            results[i] = path[-1][1]
+            del reasons[i]
+            reached.append(i)
+    return reached
 
 
 def _note(amps: FloatArray, reasons: dict[int, str]) -> str:
