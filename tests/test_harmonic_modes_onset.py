@@ -36,9 +36,8 @@ def _start(coefficients: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarr
 def test_amplitudes_above_a_fold_are_reached_from_below_and_are_free_orbits() -> None:
     nm = nonlinear_modes(FOUR_BAYS, 1, AMPLITUDES, harmonics=7)
     assert nm.converged.all()
-    assert "2 of 3 amplitudes (0.00431..0.005 m) reached from a converged amplitude below" in (
-        nm.note
-    )
+    below = "2 of 3 amplitudes (0.00431..0.005 m) reached from the nearest converged amplitude"
+    assert below in nm.note
     ref = FOUR_BAYS.dof_names.index(nm.reference_dof)
     np.testing.assert_allclose(nm.harmonic_shapes[:, 1, ref], AMPLITUDES, rtol=1e-9)
     # the same mode along the three: fundamental shapes alike (MAC) and w rising

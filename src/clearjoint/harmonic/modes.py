@@ -401,7 +401,7 @@ def nonlinear_modes(
                 results[i] = path[-1][1]
                 del reasons[i]
                 upward.append(i)
-    beside = _neighbours(solve_at, amps, results, reasons, same_mode)
+    from_below, from_above = _neighbours(solve_at, amps, results, reasons, same_mode)
     note = _note(amps, reasons)
     if upward:
         at = amps[upward]
@@ -410,13 +410,18 @@ def nonlinear_modes(
             f"from the open-pattern mode below contact onset ({reach:.3g} m): the branch from "
             "above did not reach them"
         )
-    if beside:
-        at = amps[beside]
-        note = (note + "; " if note else "") + (
-            f"{at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) reached from "
-            "a converged amplitude below, not from above: near contact onset the branch folds in "
-            "amplitude (several solutions at one amplitude), so the curve may jump between pieces"
-        )
+    for where, which in (
+        ("the nearest converged amplitude below", from_below),
+        ("one of the two nearest converged amplitudes above, with no predictor", from_above),
+    ):
+        if which:
+            at = amps[which]
+            note = (note + "; " if note else "") + (
+                f"{at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) reached "
+                f"from {where}, not by the march from above: near "
+                "contact onset the branch folds in amplitude (several solutions at one "
+                "amplitude), so the curve may jump between its pieces"
+            )
     if not _any_contact(model, basis, amps, results):
         note = (note + "; " if note else "") + (
             f"no joint reaches a gap edge over {amps[0]:.3g}..{amps[-1]:.3g} m (linear "
@@ -508,32 +513,53 @@ def _neighbours(
     results: dict[int, FloatArray],
     reasons: dict[int, str],
     same_mode: Callable[[FloatArray, FloatArray], bool],
-) -> list[int]:
-    """Solve the failed amplitudes up from the nearest converged one below; their indices.
+) -> tuple[list[int], list[int]]:
+    """Solve the failed amplitudes from their nearest converged neighbours.
 
     Near contact onset the branch followed down from above can fold back in amplitude
     (an internal resonance with a higher mode, or a gap edge crossed at a sample; see
     docs/harmonic.md), so that no step reaches the amplitudes under the fold from above,
-    while the piece of the branch under it reaches them from below. Each failed amplitude
-    is walked to (:func:`_walk`, secant predictor on the two converged amplitudes below
-    when both are there) from the nearest converged amplitude below it, in ascending
-    order, so a recovered one serves the next; ``same_mode`` refuses jumps to another
-    mode as in the march. ``results`` and ``reasons`` are updated in place.
+    while the piece of the branch under it reaches them from below. In ascending order,
+    each failed amplitude is walked to (:func:`_walk`) up from the nearest converged
+    amplitude below it (secant predictor on the two converged below when both are
+    there), so a recovered one serves the next; then, in descending order, down from
+    the nearest converged one above with no predictor (the march's secant, taken along
+    the piece above the fold, points past the solutions under it), or from the next
+    nearest if that fails. Both passes repeat
+    while they recover any. ``same_mode`` refuses jumps to another mode as in the march.
+    ``results`` and ``reasons`` are updated in place.
+
+    Returns
+    -------
+    (list of int, list of int)
+        The indices reached from below, and from above.
     """
-    reached: list[int] = []
-    for i in sorted(reasons):
-        below = [j for j in results if j < i]
-        if not below or reasons[i] != _NEWTON:
-            continue
-        j = max(below)
-        path: Path = [(float(amps[j]), results[j])]
-        if j - 1 in results:
-            path.insert(0, (float(amps[j - 1]), results[j - 1]))
-        if _walk(solve_at, path, float(amps[i]), same_mode):
-            results[i] = path[-1][1]
-            del reasons[i]
-            reached.append(i)
-    return reached
+    up: list[int] = []
+    down: list[int] = []
+    while True:
+        before = len(results)
+        for i in sorted(i for i in reasons if reasons[i] == _NEWTON):
+            below = [j for j in results if j < i]
+            if not below:
+                continue
+            j = max(below)
+            path: Path = [(float(amps[j]), results[j])]
+            if j - 1 in results:
+                path.insert(0, (float(amps[j - 1]), results[j - 1]))
+            if _walk(solve_at, path, float(amps[i]), same_mode):
+                results[i] = path[-1][1]
+                del reasons[i]
+                up.append(i)
+        for i in sorted((i for i in reasons if reasons[i] == _NEWTON), reverse=True):
+            for j in sorted(j for j in results if j > i)[:2]:
+                path = [(float(amps[j]), results[j])]
+                if _walk(solve_at, path, float(amps[i]), same_mode):
+                    results[i] = path[-1][1]
+                    del reasons[i]
+                    down.append(i)
+                    break
+        if len(results) == before:
+            return up, down
 
 
 def _note(amps: FloatArray, reasons: dict[int, str]) -> str:
