@@ -522,12 +522,12 @@ def _neighbours(
     while the piece of the branch under it reaches them from below. In ascending order,
     each failed amplitude is walked to (:func:`_walk`) up from the nearest converged
     amplitude below it (secant predictor on the two converged below when both are
-    there), so a recovered one serves the next; then, in descending order, down from
-    the nearest converged one above with no predictor (the march's secant, taken along
-    the piece above the fold, points past the solutions under it), or from the next
-    nearest if that fails. Both passes repeat
-    while they recover any. ``same_mode`` refuses jumps to another mode as in the march.
-    ``results`` and ``reasons`` are updated in place.
+    there), so a recovered one serves the next; then, in descending order, Newton at
+    the full step from the nearest converged one above with no predictor (the march's
+    secant, taken along the piece above the fold, points past the solutions under it),
+    or from the next nearest if that fails. Both passes repeat while they recover any,
+    never trying the same pair of amplitudes twice. ``same_mode`` refuses jumps to
+    another mode as in the march. ``results`` and ``reasons`` are updated in place.
 
     Returns
     -------
@@ -536,13 +536,15 @@ def _neighbours(
     """
     up: list[int] = []
     down: list[int] = []
+    tried: set[tuple[int, int]] = set()
     while True:
         before = len(results)
         for i in sorted(i for i in reasons if reasons[i] == _NEWTON):
             below = [j for j in results if j < i]
-            if not below:
+            if not below or (i, max(below)) in tried:
                 continue
             j = max(below)
+            tried.add((i, j))
             path: Path = [(float(amps[j]), results[j])]
             if j - 1 in results:
                 path.insert(0, (float(amps[j - 1]), results[j - 1]))
@@ -552,9 +554,12 @@ def _neighbours(
                 up.append(i)
         for i in sorted((i for i in reasons if reasons[i] == _NEWTON), reverse=True):
             for j in sorted(j for j in results if j > i)[:2]:
-                path = [(float(amps[j]), results[j])]
-                if _walk(solve_at, path, float(amps[i]), same_mode):
-                    results[i] = path[-1][1]
+                if (i, j) in tried:
+                    continue
+                tried.add((i, j))
+                z = solve_at(float(amps[i]), results[j])
+                if z is not None and same_mode(results[j], z):
+                    results[i] = z
                     del reasons[i]
                     down.append(i)
                     break
