@@ -29,7 +29,7 @@ H = 7
 #: the 30 amplitudes of ``clearjoint modes examples/mast.toml --mode 1 --amplitude 2mm..7mm
 #: --points 30``; each leg (start index, stop in m) starts on the solution found there
 AMPLITUDES = np.geomspace(2e-3, 7e-3, 30)
-LEGS = ((29, 2e-3), (0, 2.5e-3), (5, 2e-3))
+LEGS = ((29, 2e-3), (0, 2.5e-3), (5, 2e-3), (3, 2e-3), (3, 2.5e-3), (4, 2e-3))
 
 
 class Epmc:
