@@ -267,10 +267,11 @@ def nonlinear_modes(
     from the largest down, each from the ones before (a secant predictor in log a);
     where Newton fails the step is halved, up to :data:`MAX_HALVINGS` times. An amplitude
     the branch from above does not reach is then tried up from the open-pattern mode (below
-    contact onset) and up from the nearest converged amplitude below it: near onset the
-    branch folds in amplitude (docs/harmonic.md), so several solutions lie at one
-    amplitude; each point is the one on the branch continued from above where that
-    reaches it, else the one continued from below (``note`` says which and how many). An
+    contact onset), up from the nearest converged amplitude below it, and down from the
+    two nearest above without the predictor: near onset the branch folds in amplitude
+    (docs/harmonic.md), so several solutions lie at one amplitude; each point is the one
+    on the branch continued from above where that reaches it, else the one reached from
+    such a neighbour, not every solution (``note`` says how many, from which side). An
     amplitude still failing is flagged in ``converged`` and explained in ``note``.
 
     Parameters
