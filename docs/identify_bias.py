@@ -10,6 +10,9 @@
     python docs/identify_bias.py --floor [FILE ...]  # residual, floor, ratio, unsure signs
     python docs/identify_bias.py --csv-residuals DIR  # the same on DIR/*.csv
         # (e.g. examples/lab-csv, the tutorial's records)
+    python docs/identify_bias.py --spread 6 10 16 24  # the friction over 40 noise draws:
+        # its spread against the mean standard error reported (add --calibrated for the
+        # regression-calibrated sign, erf(v / (sqrt 2 sigma_v)), tried and not kept)
 
 1 % noise on every channel, with an acceleration channel, seeds 1-5. Errors in % of the
 simulator's own truth; the friction's standard error (in % of the truth) and its flag.
@@ -190,6 +193,59 @@ def _floor(paths: list[Path], folder: Path) -> None:
         core._flags = flags  # type: ignore[assignment]
 
 
+def _spread(counts: list[int], draws: int, calibrated: bool, folder: Path) -> None:
+    """The friction of one independent record (40 Hz, 12 kHz, 1 % noise on every channel,
+    with acceleration) over ``draws`` noise seeds (1000, 1001, ...) at each number of
+    cycles: mean error, spread (standard deviation over the draws), rms of the standard
+    errors reported, their ratio, the share of draws more than 2 standard errors off and
+    the share flagged; all in % of the truth."""
+    import math
+
+    import numpy as np
+
+    from clearjoint.identify import weak
+
+    own = getattr(weak.WeakSystem, "friction_of", None)  # None: an older src, run as it is
+    if calibrated:
+        from scipy.special import erf
+
+        from clearjoint.identify.loopcheck import jackknife_noise
+
+        def friction_of(self: Any, velocity: Any) -> Any:
+            sigma = jackknife_noise(velocity)  # the replicates' spread: the average's noise
+            return self.integrals(erf(velocity / (math.sqrt(2.0) * sigma)), self.phi)
+
+        weak.WeakSystem.friction_of = friction_of  # type: ignore[method-assign]
+    joint = TrueJoint(frequency_hz=40.0)
+    truth = steady_truth(joint)["friction_force_n"]
+    print(
+        "| cycles | draws | mean error | spread | rms SE | spread / rms SE | > 2 SE off | flagged |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    try:
+        for cycles in counts:
+            est, se, flagged = [], [], 0
+            for seed in range(1000, 1000 + draws):
+                path = write_record(joint, folder / "s.csv", noise=0.01, seed=seed, cycles=cycles)
+                result = identify(read_record(path))
+                est.append(result.summary["friction_force_n"])
+                se.append(result.stderr["friction_force_n"])
+                flagged += result.flags["friction_force_n"][0] != "ok"
+            e, s = np.array(est), np.array(se)
+            spread = float(np.std(e, ddof=1))
+            rms = float(np.sqrt(np.mean(s**2)))
+            off = float(np.mean(np.abs(e - truth) > 2.0 * s))
+            print(
+                f"| {cycles} | {draws} | {100 * (e.mean() / truth - 1):+.1f} | "
+                f"{100 * spread / truth:.1f} | {100 * rms / truth:.1f} | {spread / rms:.2f} | "
+                f"{off:.0%} | {flagged / draws:.0%} |",
+                flush=True,
+            )
+    finally:
+        if own is not None:
+            weak.WeakSystem.friction_of = own  # type: ignore[method-assign]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--off-grid", action="store_true")
@@ -215,7 +271,20 @@ def main() -> None:
         default=None,
         help="each record's residual, floor and ratio (the simulator's without files)",
     )
+    parser.add_argument(
+        "--spread",
+        nargs="*",
+        type=int,
+        default=None,
+        help="numbers of cycles (6 10 16 24): the friction's spread over noise draws",
+    )
+    parser.add_argument("--draws", type=int, default=40, help="noise draws for --spread")
+    parser.add_argument("--calibrated", action="store_true", help="--spread, erf sign")
     args = parser.parse_args()
+    if args.spread is not None:
+        _spread(
+            args.spread or [6, 10, 16, 24], args.draws, args.calibrated, Path(tempfile.mkdtemp())
+        )
     if args.floor is not None:
         _floor(args.floor, Path(tempfile.mkdtemp()))
     if args.bouc_wen:

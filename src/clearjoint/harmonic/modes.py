@@ -74,8 +74,9 @@ _SUB_ITERATIONS = 20
 _MAC = 0.5
 
 _NEWTON = (
-    f"Newton did not converge from the neighbouring converged amplitude after {MAX_HALVINGS} "
-    "halvings of the step in log amplitude (or converged to another mode)"
+    "Newton did not converge from the neighbouring converged amplitude above (nor below, where "
+    f"one converged) after {MAX_HALVINGS} halvings of the step in log amplitude (or converged "
+    "to another mode)"
 )
 
 Path = list[tuple[float, FloatArray]]
@@ -125,10 +126,11 @@ class NonlinearMode:
         Empty, or one line per thing the user should know: how many amplitudes found
         no mode and why (Newton did not converge from the neighbouring amplitude after
         :data:`MAX_HALVINGS` halvings of the step; w fell to 0; friction holds a
-        rubbing joint at a turning point); how many were reached
-        instead up from the open-pattern mode below contact onset (the branch from
-        above did not reach them: the solutions there may not be unique); or that no
-        joint reached a gap edge over the whole range (with where contact begins).
+        rubbing joint at a turning point); how many were reached instead up from the
+        open-pattern mode below contact onset, or up from a converged amplitude below
+        (the branch from above did not reach them: it folds in amplitude there, the
+        solutions are not unique); or that no joint reached a gap edge over the whole
+        range (with where contact begins).
     """
 
     amplitude: FloatArray
@@ -297,7 +299,13 @@ def nonlinear_modes(
     EPMC with harmonic balance: at each modal amplitude a, solve for Q, w and the
     negative damping xi that makes the free motion periodic. Amplitudes are solved
     from the largest down, each from the ones before (a secant predictor in log a);
-    where Newton fails the step is halved, up to :data:`MAX_HALVINGS` times, and an
+    where Newton fails the step is halved, up to :data:`MAX_HALVINGS` times. An amplitude
+    the branch from above does not reach is then tried up from the open-pattern mode (below
+    contact onset), up from the nearest converged amplitude below it, and down from the
+    two nearest above without the predictor: near onset the branch folds in amplitude
+    (docs/harmonic.md), so several solutions lie at one amplitude; each point is the one
+    on the branch continued from above where that reaches it, else the one reached from
+    such a neighbour, not every solution (``note`` says how many, from which side). An
     amplitude still failing is flagged in ``converged`` and explained in ``note``.
 
     Parameters
@@ -416,11 +424,14 @@ def nonlinear_modes(
                 results[i] = path[-1][1]
                 del reasons[i]
                 upward.append(i)
+    from_below, from_above = _neighbours(solve_at, amps, results, reasons, same_mode)
     held = _held(model, basis, amps, results, omega_lin)
     for i, why in held.items():
         del results[i]
         reasons[i] = why
     upward = [i for i in upward if i not in held]
+    from_below = [i for i in from_below if i not in held]
+    from_above = [i for i in from_above if i not in held]
     note = _note(amps, reasons)
     if upward:
         at = amps[upward]
@@ -429,6 +440,18 @@ def nonlinear_modes(
             f"from the open-pattern mode below contact onset ({reach:.3g} m): the branch from "
             "above did not reach them"
         )
+    for where, which in (
+        ("the nearest converged amplitude below", from_below),
+        ("one of the two nearest converged amplitudes above, with no predictor", from_above),
+    ):
+        if which:
+            at = amps[which]
+            note = (note + "; " if note else "") + (
+                f"{at.size} of {amps.size} amplitudes ({at.min():.3g}..{at.max():.3g} m) reached "
+                f"from {where}, not by the march from above: near "
+                "contact onset the branch folds in amplitude (several solutions at one "
+                "amplitude), so the curve may jump between its pieces"
+            )
     if not _any_contact(model, basis, amps, results):
         note = (note + "; " if note else "") + (
             f"no joint reaches a gap edge over {amps[0]:.3g}..{amps[-1]:.3g} m (linear "
@@ -689,6 +712,66 @@ def _held(
                 )
             break
     return failed
+
+
+def _neighbours(
+    solve_at: Callable[..., FloatArray | None],
+    amps: FloatArray,
+    results: dict[int, FloatArray],
+    reasons: dict[int, str],
+    same_mode: Callable[[FloatArray, FloatArray], bool],
+) -> tuple[list[int], list[int]]:
+    """Solve the failed amplitudes from their nearest converged neighbours.
+
+    Near contact onset the branch followed down from above can fold back in amplitude
+    (an internal resonance with a higher mode, or a gap edge crossed at a sample; see
+    docs/harmonic.md), so that no step reaches the amplitudes under the fold from above,
+    while the piece of the branch under it reaches them from below. In ascending order,
+    each failed amplitude is walked to (:func:`_walk`) up from the nearest converged
+    amplitude below it (secant predictor on the two converged below when both are
+    there), so a recovered one serves the next; then, in descending order, Newton at
+    the full step from the nearest converged one above with no predictor (the march's
+    secant, taken along the piece above the fold, points past the solutions under it),
+    or from the next nearest if that fails. Both passes repeat while they recover any,
+    never trying the same pair of amplitudes twice. ``same_mode`` refuses jumps to
+    another mode as in the march. ``results`` and ``reasons`` are updated in place.
+
+    Returns
+    -------
+    (list of int, list of int)
+        The indices reached from below, and from above.
+    """
+    up: list[int] = []
+    down: list[int] = []
+    tried: set[tuple[int, int]] = set()
+    while True:
+        before = len(results)
+        for i in sorted(i for i in reasons if reasons[i] == _NEWTON):
+            below = [j for j in results if j < i]
+            if not below or (i, max(below)) in tried:
+                continue
+            j = max(below)
+            tried.add((i, j))
+            path: Path = [(float(amps[j]), results[j])]
+            if j - 1 in results:
+                path.insert(0, (float(amps[j - 1]), results[j - 1]))
+            if _walk(solve_at, path, float(amps[i]), same_mode):
+                results[i] = path[-1][1]
+                del reasons[i]
+                up.append(i)
+        for i in sorted((i for i in reasons if reasons[i] == _NEWTON), reverse=True):
+            for j in sorted(j for j in results if j > i)[:2]:
+                if (i, j) in tried:
+                    continue
+                tried.add((i, j))
+                z = solve_at(float(amps[i]), results[j])
+                if z is not None and same_mode(results[j], z):
+                    results[i] = z
+                    del reasons[i]
+                    down.append(i)
+                    break
+        if len(results) == before:
+            return up, down
 
 
 def _note(amps: FloatArray, reasons: dict[int, str]) -> str:

@@ -21,9 +21,10 @@ MODEL.md section 3. The steps:
    sign and drag from its spectral derivative); the damper's and the line's by their
    per-sample fits;
 6. a jackknife over the cycles (the average without each of at most eight contiguous
-   groups of cycles in turn, all replicates fitted in one batched solve) for every
-   standard error; the energy per cycle is each cycle's own loop area (the closed
-   integral of F dx, in which the inertia term cancels);
+   groups of cycles in turn, all replicates fitted in one batched solve, each with the
+   sign of its own velocity for the friction term) for every standard error; the energy
+   per cycle is each cycle's own loop area (the closed integral of F dx, in which the
+   inertia term cancels);
 7. a flag per quantity: ``rejected`` for a clearance whose two-standard-error interval
    spans zero, ``doubtful`` for a stiffness, friction or energy whose standard error
    exceeds a quarter of it, a fit residual above three times its noise floor (the weak
@@ -137,8 +138,19 @@ def restoring_force(
     return record.force - m * acceleration
 
 
+def _harmonic_cut(x: FloatArray, noise: float) -> NDArray[np.int64]:
+    """The last harmonic of each row of ``x`` (M,) or (R, M) whose amplitude exceeds three
+    times that of the noise (``noise``: rms per sample), at least the first, (R,)."""
+    rows = np.atleast_2d(x)
+    spectrum = np.abs(np.fft.rfft(rows, axis=1))
+    above = spectrum > 3.0 * noise * math.sqrt(rows.shape[1] / 2.0)
+    last = spectrum.shape[1] - 1 - np.argmax(above[:, ::-1], axis=1)
+    out: NDArray[np.int64] = np.where(above.any(axis=1), last, 1)
+    return out
+
+
 def _periodic_derivatives(
-    x: FloatArray, step: float, noise: float = 0.0
+    x: FloatArray, step: float, noise: float = 0.0, cut: int | None = None
 ) -> tuple[FloatArray, FloatArray]:
     """Velocity and acceleration of periodic cycles, spectrally, harmonics above the noise.
 
@@ -147,16 +159,15 @@ def _periodic_derivatives(
     amplitude exceeds three times the noise's (``noise``: the rms noise per sample of
     ``x``). Used only to place the stages, choose the model and take the sign of the
     velocity; the joint's parameters never use them (the weak form needs no derivative).
+    ``cut``, when given, is the last harmonic kept in every row (the jackknife's
+    replicates keep the average's, so their velocities are one linear filter of the data).
     """
     rows = np.atleast_2d(x)
     m = rows.shape[1]
     spectrum = np.fft.rfft(rows, axis=1)
     k = np.arange(spectrum.shape[1])
-    floor = 3.0 * noise * math.sqrt(m / 2.0)
-    above = np.abs(spectrum) > floor
-    last = spectrum.shape[1] - 1 - np.argmax(above[:, ::-1], axis=1)
-    cut = np.where(above.any(axis=1), last, 1)
-    spectrum[k[None, :] > cut[:, None]] = 0.0
+    last = _harmonic_cut(rows, noise) if cut is None else np.full(rows.shape[0], cut)
+    spectrum[k[None, :] > last[:, None]] = 0.0
     w = 2.0 * math.pi * k / (m * step)
     v = np.fft.irfft(1j * w * spectrum, n=m, axis=1)
     a = np.fft.irfft(-(w**2) * spectrum, n=m, axis=1)
@@ -458,8 +469,22 @@ def _identify_stack(
     if model == "joint" and system is not None:
         from clearjoint.identify.weak import weak_fit
 
+        # each replicate's friction term follows its own velocity's sign (the sign's flips
+        # by the noise are then in the jackknife's spread: the friction's standard error);
+        # replicate 0, the average itself, keeps the velocity the system was built with
+        if derived_v:
+            cut = int(_harmonic_cut(x, noise_x)[0])
+            spectral = _periodic_derivatives(reps_x, st.step, noise_x, cut)[0]
+            own_v = np.vstack((v[None, :], spectral[1:]))
+        else:
+            own_v = np.vstack((v[None, :], _leave_one_out(st.channels["v"], groups)))
         weak = weak_fit(
-            system, reps_x, reps_f, mass=mass if force_control else 0.0, acceleration=reps_a
+            system,
+            reps_x,
+            reps_f,
+            mass=mass if force_control else 0.0,
+            acceleration=reps_a,
+            velocity=own_v,
         )
         fits = []
         for (lt, lf, lc), c_f in zip(weak.lines, weak.friction, strict=True):
@@ -479,9 +504,9 @@ def _identify_stack(
                 )
             )
         masses = weak.mass
-        if derived_v:
-            spectral = _periodic_derivatives(reps_x, st.step, noise_x)[0]
-            noise = replace(noise, velocity=jackknife_noise(spectral))
+        if derived_v:  # the floor's sign noise: each replicate's velocity with its own cut
+            crude = _periodic_derivatives(reps_x, st.step, noise_x)[0]
+            noise = replace(noise, velocity=jackknife_noise(crude))
         residual = weak_residual(
             system, weak, v, noise, inertia_from_x=force_control and reps_a is None
         )

@@ -18,8 +18,14 @@ in (a_s, k_s, c, F_f[, m]), solved by least squares. With a measured acceleratio
 int(phi a) replaces int(phi'' x). When the record has no mass (force control), m is
 one more unknown.
 
-Everything is linear in the data, so the same equations, built once, solve every
-jackknife replicate (the average without one cycle) in one batched solve.
+Everything but the friction term is linear in the data, so the same equations, built
+once, solve every jackknife replicate (the average without one group of cycles) in one
+batched solve. The friction term's weights int(phi sgn x') are not: they follow the sign
+of the velocity, which the noise flips near each reversal. Each replicate therefore takes
+them from its own velocity (:meth:`WeakSystem.friction_of`), so the jackknife's spread
+carries the sign's noise too; with the average's sign shared by every replicate it did
+not, and the friction's standard error came out 1.9-2.6 times too small over noise draws
+(docs/identify.md, "The number of cycles").
 """
 
 from __future__ import annotations
@@ -85,6 +91,10 @@ class WeakSystem:
         """int(weights . data) of every equation for every row of ``data`` (R, M): (R, E)."""
         out: FloatArray = np.sum(data[:, self.columns] * weights[None, :, :], axis=2)
         return out
+
+    def friction_of(self, velocity: FloatArray) -> FloatArray:
+        """int(phi sgn v) of every equation for every row of ``velocity`` (R, M): (R, E)."""
+        return self.integrals(np.sign(np.atleast_2d(velocity)), self.phi)
 
 
 def _simpson(intervals: int, step: float) -> FloatArray:
@@ -212,11 +222,14 @@ def weak_fit(
     *,
     mass: float | None,
     acceleration: FloatArray | None = None,
+    velocity: FloatArray | None = None,
 ) -> WeakFit:
     """Solve the weak-form equations for every replicate (row) of ``x`` and ``force`` (R, M).
 
     ``mass`` None makes m an unknown; ``acceleration`` (R, M), when measured, gives the
-    inertia integrals instead of int(phi'' x).
+    inertia integrals instead of int(phi'' x); ``velocity`` (R, M), each replicate's own,
+    gives its friction term's sign (without it every replicate takes the system's, the
+    sign of the velocity it was built with).
     """
     x2 = np.atleast_2d(x)
     f2 = np.atleast_2d(force)
@@ -238,7 +251,7 @@ def weak_fit(
     design[:, rows, 2 * system.stage] = i0
     design[:, rows, 2 * system.stage + 1] = i1
     design[:, :, 6] = ic
-    design[:, :, 7] = system.friction
+    design[:, :, 7] = system.friction if velocity is None else system.friction_of(velocity)
     if mass is None:
         design[:, :, 8] = inertia
     else:
