@@ -810,6 +810,111 @@ def old_against_new(old_src: str, bays: int, points: int) -> None:
     )
 
 
+#: --monodromy: BAYS:POINTS per mast, the curve whose every orbit both routes multiply
+#: (the 40-bay one cut short: the expm route costs about 10 s a point there).
+MONODROMY_BAYS = "5:300,10:300,20:300,40:12"
+
+
+def monodromy_routes(bays_list: str) -> None:
+    """The exact monodromy by both routes side by side on the same HB orbits, per bay count.
+
+    For each mast (examples/mast.toml with BAYS bays, H = 7, the --mast-sizes force) a
+    POINTS-point curve from 0.8 x the open first mode (no orbit check) gives the orbits;
+    then, on all of them in the curve's order (as frequency_response meets them), the plain
+    product of scipy.linalg.expm (``method="expm"``, the old route) and the cached
+    eigen-decompositions (the default), the cache emptied first so that its cold start
+    (every pattern decomposed) is in the time. Accuracy: the eigen route against the
+    expm product, beside expm on the balanced matrix against expm (how far the reference
+    itself is determined), and the largest multiplier's modulus by both.
+    """
+    import scipy.linalg
+
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.system import from_structure
+
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    print("the exact monodromy of each HB orbit (H = 7) of a mast's curve: expm, eigen route")
+    summary = []
+    for item in bays_list.split(","):
+        bays, points = (int(v) for v in item.split(":"))
+        s, pattern = example_mast(bays)
+        force = pattern * (MAST_FORCE_N / float(np.max(np.abs(pattern))))
+        f_open = float(s.modes("open").omega[0])
+        f_closed = float(s.modes("closed").omega[0])
+        started = time.perf_counter()
+        fr = frequency_response(
+            s,
+            force,
+            0.8 * f_open,
+            1.2 * f_closed,
+            harmonics=7,
+            max_points=points,
+            max_step=MAST_MAX_STEP,
+            check_points=0,
+        )
+        made = time.perf_counter() - started
+        model = from_structure(s)
+        basis = aft.Basis.make(7, int(fr.settings["samples"]))
+        orbits = list(zip(fr.coefficients, fr.omega, strict=True))  # type: ignore[arg-type]
+        segments = [monodromy.crossings(model, basis, c).size + 1 for c, _ in orbits]
+        started = time.perf_counter()
+        old = [monodromy.monodromy(model, basis, c, float(w), method="expm") for c, w in orbits]
+        t_old = time.perf_counter() - started
+        monodromy._FLOWS.clear()
+        monodromy._TRANSITIONS.clear()
+        started = time.perf_counter()
+        new = [monodromy.monodromy(model, basis, orbits[0][0], float(orbits[0][1]))]
+        t_first = time.perf_counter() - started
+        new += [monodromy.monodromy(model, basis, c, float(w)) for c, w in orbits[1:]]
+        t_new = time.perf_counter() - started
+        # the reference's own spread: expm of the balanced segment matrices, on the orbit
+        # with the most segments
+        most = int(np.argmax(segments))
+        widths, states = monodromy._segments(model, basis, orbits[most][0])
+        n = model.n_dof
+        a = np.zeros((2 * n, 2 * n))
+        a[:n, n:] = np.eye(n)
+        a[n:, n:] = -model.damping / np.diag(model.mass)[:, None]
+        balanced = np.eye(2 * n)
+        for width, state in zip(widths, states, strict=True):
+            a[n:, :n] = -monodromy._pattern_stiffness(model, state) / np.diag(model.mass)[:, None]
+            b, (d, _) = scipy.linalg.matrix_balance(
+                a * (width / orbits[most][1]), permute=False, separate=True
+            )
+            balanced = (d[:, None] * scipy.linalg.expm(b) / d[None, :]) @ balanced
+        spread = np.linalg.norm(balanced - old[most]) / np.linalg.norm(old[most])
+        gap = max(np.linalg.norm(x - y) / np.linalg.norm(y) for x, y in zip(new, old, strict=True))
+        mu_gap = max(
+            abs(np.max(np.abs(np.linalg.eigvals(x))) - np.max(np.abs(np.linalg.eigvals(y))))
+            / np.max(np.abs(np.linalg.eigvals(y)))
+            for x, y in zip(new, old, strict=True)
+        )
+        k = len(orbits)
+        line = (
+            f"{bays:2d} bays (2N = {2 * n}, {min(segments)} to {max(segments)} segments a "
+            f"period): expm {t_old / k:.3f} s/point, eigen {t_new / k:.3f} s/point "
+            f"({t_first:.3f} s the first, cold; {(t_new - t_first) / max(k - 1, 1):.3f} s "
+            f"after): {t_old / t_new:.1f}x over {k} points"
+        )
+        print(
+            f"  {line}; the {fr.omega.size}-point curve made in {made:.1f} s, load "
+            f"{os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+        there = np.linalg.norm(new[most] - old[most]) / np.linalg.norm(old[most])
+        print(
+            f"      eigen vs expm: largest relative difference {gap:.1e} (Frobenius), largest "
+            f"multiplier's modulus {mu_gap:.1e}; on the orbit with the most segments "
+            f"{there:.1e}, where expm on the balanced matrices differs from expm by {spread:.1e}",
+            flush=True,
+        )
+        summary.append(line)
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    print("summary (one run):")
+    for line in summary:
+        print(f"  {line}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
@@ -849,8 +954,19 @@ def main() -> None:
         help="time the 10-bay mast's curve (--mast-points) with another clearjoint src tree "
         "(e.g. main's: git archive main src | tar -x -C OLD) and with this one, in turn",
     )
+    parser.add_argument(
+        "--monodromy",
+        nargs="?",
+        const=MONODROMY_BAYS,
+        metavar="BAYS:POINTS,...",
+        help="the exact monodromy by scipy's expm product and by the cached eigen route, side "
+        f"by side on every orbit of a POINTS-point curve per mast (default {MONODROMY_BAYS})",
+    )
     parser.add_argument("--one-curve", help=argparse.SUPPRESS)  # BAYS:POINTS, for --old-src
     args = parser.parse_args()
+    if args.monodromy:
+        monodromy_routes(args.monodromy)
+        return
     if args.one_curve:
         one_curve(*(int(v) for v in args.one_curve.split(":")))
         return
