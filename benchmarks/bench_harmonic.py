@@ -346,10 +346,11 @@ def _curve_lines(
     return per_point
 
 
-def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
+def mast_sizes(sizes: str, points: int, force_n: float, modes: bool = True) -> list[str]:
     """The example mast's cost against bays and H: the frequency response (``points``
     points from 0.8 times the open first mode, the study's force pattern scaled to
-    ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes), one line each."""
+    ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes; not with
+    ``modes=False``), one line each."""
     from clearjoint.harmonic import nonlinear_modes
 
     print(
@@ -387,6 +388,9 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
         if fr is not None:
             took = time.perf_counter() - start
             per_point = _curve_lines(fr, bays, h, s, unknowns, took, points, asked, summary)
+        if not modes:
+            points = asked
+            continue
         amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
         start = time.perf_counter()
         nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
@@ -932,6 +936,9 @@ def main() -> None:
     )
     parser.add_argument("--mast-force", type=float, default=MAST_FORCE_N, help="N, --mast-sizes")
     parser.add_argument(
+        "--curves-only", action="store_true", help="--mast-sizes without the nonlinear modes"
+    )
+    parser.add_argument(
         "--mast-decay",
         type=int,
         metavar="BAYS",
@@ -994,7 +1001,7 @@ def main() -> None:
         mast_decay(args.mast_decay, 2e-5, args.decay_cycles)
         return
     if args.mast_sizes:
-        mast_sizes(args.mast_sizes, args.mast_points, args.mast_force)
+        mast_sizes(args.mast_sizes, args.mast_points, args.mast_force, not args.curves_only)
         return
     if args.samples:
         samples_error()
