@@ -21,7 +21,7 @@ runs the issue's whole speed section in one run (docs/harmonic.md, "Speed"): pyH
 case and its ratio, then the example mast's 300-point curve and 50-amplitude first mode
 at 10 bays, H = 7, and the same for 5, 20, 40 bays (H = 7) and H = 3, 15 (10 bays), each
 curve's stop reason said; the 40-bay curve is capped at 20 points (ISSUE_SIZES), with
-the time 300 would take. ``--old-src OLD/src`` times the 10-bay curve with another src
+the time 300 would take. ``--old-src OLD/src [--old-bays 10]`` times a mast curve with another src
 tree and this one in turn (a before/after ratio in one run).
 
     python benchmarks/bench_harmonic.py --mast [--mast-points 300]
@@ -356,7 +356,12 @@ def mast_sizes(sizes: str, points: int, force_n: float, modes: bool = True) -> l
     print(
         f"examples/mast.toml with other bay counts; force {force_n} N at the tip (x); "
         f"curves of {points} points at most from 0.8 x the open first mode, max_step "
-        f"{MAST_MAX_STEP}; modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
+        f"{MAST_MAX_STEP}; "
+        + (
+            "modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
+            if modes
+            else "no modes (--curves-only)"
+        )
     )
     print(f"  load before: {os.getloadavg()[0]:.2f} (1-min average)")
     summary: list[str] = []
@@ -958,7 +963,7 @@ def main() -> None:
     )
     parser.add_argument(
         "--old-src",
-        help="time the 10-bay mast's curve (--mast-points) with another clearjoint src tree "
+        help="time the mast's curve (--old-bays, --mast-points) with another clearjoint src tree "
         "(e.g. main's: git archive main src | tar -x -C OLD) and with this one, in turn",
     )
     parser.add_argument(
@@ -969,6 +974,7 @@ def main() -> None:
         help="the exact monodromy by scipy's expm product and by the cached eigen route, side "
         f"by side on every orbit of a POINTS-point curve per mast (default {MONODROMY_BAYS})",
     )
+    parser.add_argument("--old-bays", type=int, default=10, help="the mast's bays, --old-src")
     parser.add_argument("--one-curve", help=argparse.SUPPRESS)  # BAYS:POINTS, for --old-src
     args = parser.parse_args()
     if args.monodromy:
@@ -978,7 +984,7 @@ def main() -> None:
         one_curve(*(int(v) for v in args.one_curve.split(":")))
         return
     if args.old_src:
-        old_against_new(args.old_src, 10, args.mast_points)
+        old_against_new(args.old_src, args.old_bays, args.mast_points)
         return
     if args.issue:
         issue_run(args.pyharm, args.mast_points)
