@@ -24,6 +24,15 @@ curve's stop reason said; the 40-bay curve is capped at 20 points (ISSUE_SIZES),
 the time 300 would take. ``--old-src OLD/src [--old-bays 10]`` times a mast curve with another src
 tree and this one in turn (a before/after ratio in one run).
 
+    python benchmarks/bench_harmonic.py --monodromy [5:300,10:300,20:300,40:12]
+
+times the exact monodromy of every HB orbit of each mast's curve (BAYS:POINTS) by the
+plain product of scipy.linalg.expm and by the cached eigen-decompositions (the default
+route, harmonic/monodromy.py "Speed"), side by side on the same orbits, and prints how
+far apart they are beside how far expm on the balanced matrices is from expm.
+``--mast-sizes 5:7,10:7,20:7,40:7 --curves-only`` gives the growth of a whole curve with
+the bays without the nonlinear modes (which the monodromy does not touch).
+
     python benchmarks/bench_harmonic.py --mast [--mast-points 300]
 
 times the planar mast (clearjoint.structure.mast, hinge joints ClearanceJoint(1e-4, 1e8,
