@@ -158,26 +158,29 @@ _CACHE_BYTES = 256 * 2**20
 class _Flow:
     """expm(A t) = vectors @ expm(B t) @ inverse for one contact pattern's A (2N, 2N).
 
-    B is real block-diagonal: ``rate[k]`` on the diagonal, and for each pair starting at
-    column k = ``pairs[i]`` the block [[a, b], [-b, a]] with a = ``rate[k]``, b =
-    ``frequency[i]`` (the eigenvalue a + i b, eigenvector columns k, k + 1 = Re v, Im v).
+    The columns are the ``real`` real eigenvectors, then Re v of each pair a +- i b,
+    then Im v of each pair in the same order: B is ``rate`` on the diagonal, and for
+    pair i the block [[a, b], [-b, a]] on (real + i, real + p + i), p pairs, with a =
+    ``rate[real + i]`` and b = ``frequency[i]``.
     """
 
     vectors: FloatArray
     inverse: FloatArray
     rate: FloatArray
-    pairs: NDArray[np.intp]
+    real: int
     frequency: FloatArray
 
     def propagate(self, t: float, psi: FloatArray) -> FloatArray:
         """Return expm(B t) @ psi, psi (2N, m) in this pattern's eigen-coordinates."""
         out = psi * np.exp(self.rate * t)[:, None]
-        k = self.pairs
+        p = self.frequency.size
         c = np.cos(self.frequency * t)[:, None]
         s = np.sin(self.frequency * t)[:, None]
-        first, second = out[k], out[k + 1]
-        out[k] = c * first + s * second
-        out[k + 1] = c * second - s * first
+        first = out[self.real : self.real + p].copy()
+        second = out[self.real + p :]
+        out[self.real : self.real + p] = c * first + s * second
+        second *= c
+        second -= s * first
         return out
 
 
@@ -205,10 +208,10 @@ def _decompose(a: FloatArray) -> _Flow | None:
     rate = np.empty(lam.size)
     vectors[:, : real.size] = v[:, real].real
     rate[: real.size] = lam[real].real
-    pairs = real.size + 2 * np.arange(upper.size)
-    vectors[:, pairs] = v[:, upper].real
-    vectors[:, pairs + 1] = v[:, upper].imag
-    rate[pairs] = rate[pairs + 1] = lam[upper].real
+    p, r = upper.size, real.size
+    vectors[:, r : r + p] = v[:, upper].real
+    vectors[:, r + p :] = v[:, upper].imag
+    rate[r : r + p] = rate[r + p :] = lam[upper].real
     try:
         inverse = np.linalg.inv(vectors)
     except np.linalg.LinAlgError:
@@ -221,7 +224,7 @@ def _decompose(a: FloatArray) -> _Flow | None:
         vectors=scale[:, None] * vectors,
         inverse=inverse / scale[None, :],
         rate=rate,
-        pairs=pairs,
+        real=r,
         frequency=np.asarray(lam[upper].imag, dtype=np.float64),
     )
 
