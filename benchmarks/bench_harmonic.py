@@ -355,6 +355,38 @@ def _curve_lines(
     return per_point
 
 
+def _spent_in() -> Any:
+    """Time the exact monodromy and the orbit check from now on; the returned function
+    puts them back and says how long each took."""
+    from clearjoint.harmonic import check, monodromy
+
+    wrapped = {"monodromy": (monodromy, "multipliers"), "orbit check": (check, "check_orbits")}
+    spent = dict.fromkeys(wrapped, 0.0)
+    calls = dict.fromkeys(wrapped, 0)
+    originals = {name: getattr(module, attr) for name, (module, attr) in wrapped.items()}
+
+    def timer(name: str) -> Any:
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            started = time.perf_counter()
+            try:
+                return originals[name](*args, **kwargs)
+            finally:
+                spent[name] += time.perf_counter() - started
+                calls[name] += 1
+
+        return timed
+
+    for name, (module, attr) in wrapped.items():
+        setattr(module, attr, timer(name))
+
+    def report() -> str:
+        for name, (module, attr) in wrapped.items():
+            setattr(module, attr, originals[name])
+        return ", ".join(f"{k} {spent[k]:.1f} s ({calls[k]} calls)" for k in wrapped)
+
+    return report
+
+
 def mast_sizes(sizes: str, points: int, force_n: float, modes: bool = True) -> list[str]:
     """The example mast's cost against bays and H: the frequency response (``points``
     points from 0.8 times the open first mode, the study's force pattern scaled to
@@ -383,6 +415,7 @@ def mast_sizes(sizes: str, points: int, force_n: float, modes: bool = True) -> l
         f_open = float(s.modes("open").omega[0])
         f_closed = float(s.modes("closed").omega[0])
         unknowns = (2 * h + 1) * s.n_dof
+        spent = _spent_in() if not modes else None
         start = time.perf_counter()
         try:
             fr = frequency_response(
@@ -402,6 +435,10 @@ def mast_sizes(sizes: str, points: int, force_n: float, modes: bool = True) -> l
         if fr is not None:
             took = time.perf_counter() - start
             per_point = _curve_lines(fr, bays, h, s, unknowns, took, points, asked, summary)
+        if spent is not None:
+            line = spent()
+            print(f"      of which {line}", flush=True)
+            summary[-1] += f"; of which {line}"
         if not modes:
             points = asked
             continue
@@ -875,6 +912,10 @@ def monodromy_routes(bays_list: str) -> None:
         basis = aft.Basis.make(7, int(fr.settings["samples"]))
         orbits = list(zip(fr.coefficients, fr.omega, strict=True))  # type: ignore[arg-type]
         segments = [monodromy.crossings(model, basis, c).size + 1 for c, _ in orbits]
+        patterns = [
+            {x.tobytes() for x in monodromy._segments(model, basis, c)[1]} for c, _ in orbits
+        ]
+        in_all = len(set().union(*patterns))
         started = time.perf_counter()
         old = [monodromy.monodromy(model, basis, c, float(w), method="expm") for c, w in orbits]
         t_old = time.perf_counter() - started
@@ -910,9 +951,11 @@ def monodromy_routes(bays_list: str) -> None:
         k = len(orbits)
         line = (
             f"{bays:2d} bays (2N = {2 * n}, {min(segments)} to {max(segments)} segments a "
-            f"period): expm {t_old / k:.3f} s/point, eigen {t_new / k:.3f} s/point "
-            f"({t_first:.3f} s the first, cold; {(t_new - t_first) / max(k - 1, 1):.3f} s "
-            f"after): {t_old / t_new:.1f}x over {k} points"
+            f"period, {min(map(len, patterns))} to {max(map(len, patterns))} contact patterns, "
+            f"{in_all} over the curve): expm {t_old / k:.3f} s/point, eigen "
+            f"{t_new / k:.3f} s/point ({t_first:.3f} s the first, cold; "
+            f"{(t_new - t_first) / max(k - 1, 1):.3f} s after): {t_old / t_new:.1f}x over "
+            f"{k} points"
         )
         print(
             f"  {line}; the {fr.omega.size}-point curve made in {made:.1f} s, load "

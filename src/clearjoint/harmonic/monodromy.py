@@ -30,16 +30,19 @@ structures.
 
 Speed. Each segment's exponential depends on the contact pattern only through A, and
 the patterns recur: within one orbit (a joint opens and closes more than once) and,
-above all, from one continuation point to the next (a 20-bay mast's 300-point curve
-meets the same few dozen patterns at every point). So each pattern's A is decomposed
+above all, from one continuation point to the next (the first 30 points of the 20-bay
+mast's curve: 85 to 93 segments a period, 43 to 47 patterns each, 49 in all; the counts
+over whole curves are printed by ``benchmarks/bench_harmonic.py --monodromy``). So each
+pattern's A is decomposed
 once, A = V B V^-1 with B real block-diagonal (1 x 1 blocks for real eigenvalues,
 [[a, b], [-b, a]] for a pair a +- i b), after a diagonal balancing by powers of 2; then
 expm(A t) = V expm(B t) V^-1 exactly, expm(B t) is closed form (e^(a t) times a rotation
 by b t), and the product is carried in the patterns' eigen-coordinates: one (2N)^2
 scaling and one matrix product V_q^-1 V_p per segment, the transition V_q^-1 V_p cached
 per pair of patterns, instead of a Pade approximant with about log2(norm(A t))
-squarings. The decompositions live in a bounded cache (``_CACHE_BYTES``) keyed by the
-system's matrices and the pattern, so neighbouring curve points share them. A pattern
+squarings. The decompositions live in a bounded cache (``_FLOW_BYTES``) keyed by the
+system's matrices and the pattern, so neighbouring curve points share them
+(:func:`clear_cache` frees them). A pattern
 whose V is badly conditioned (1-norm condition above ``_MAX_CONDITION``: a defective A,
 e.g. a free mass with no damping, or nearly parallel eigenvectors) keeps
 ``scipy.linalg.expm``, and so does an orbit whose patterns would not fit in the cache.
@@ -148,10 +151,12 @@ def _at(basis: Basis, columns: FloatArray, tau: FloatArray) -> FloatArray:
 #: keeps scipy.linalg.expm. The similarity's rounding is about cond(V) eps per segment.
 _MAX_CONDITION = 1e6
 
-#: Bytes the decompositions may hold, and the transitions between patterns (each store drops
-#: its least recently used entries first). An orbit whose own patterns' decompositions
-#: would not fit keeps scipy.linalg.expm.
-_CACHE_BYTES = 256 * 2**20
+#: Bytes the decompositions may hold (the 40-bay mast's orbits need about 200 MiB each),
+#: and the transitions between patterns; each store drops its least recently used entries
+#: first. An orbit whose own patterns' decompositions would not fit keeps scipy.linalg.expm
+#: (a transition that does not fit only costs its one matrix product again).
+_FLOW_BYTES = 512 * 2**20
+_TRANSITION_BYTES = 256 * 2**20
 
 
 @dataclass(frozen=True)
@@ -266,8 +271,14 @@ class _Cache:
             self.held = 0
 
 
-_FLOWS = _Cache(_CACHE_BYTES)
-_TRANSITIONS = _Cache(_CACHE_BYTES)
+_FLOWS = _Cache(_FLOW_BYTES)
+_TRANSITIONS = _Cache(_TRANSITION_BYTES)
+
+
+def clear_cache() -> None:
+    """Free the cached decompositions and transitions (up to 768 MiB; module docstring)."""
+    _FLOWS.clear()
+    _TRANSITIONS.clear()
 
 
 def _fingerprint(system: LinearSystem) -> bytes:
