@@ -787,8 +787,9 @@ def pyharm_part(python: str | None) -> float | None:
 
 
 #: The issue's sizes, the 10-bay H = 7 mast first (the issue's mast part), then the growth
-#: (BAYS:H[:most points]): the 40-bay curve capped at 20 points, since its stability (the
-#: monodromy's 320 x 320 matrix exponentials, about 250 a point) costs about 10 s a point.
+#: (BAYS:H[:most points]): the 40-bay curve capped at 20 points: its stability cost about
+#: 10 s a point with expm's product, about 1.3 s with the cached eigen route, and 300 points
+#: still did not end within 34 minutes (docs/harmonic.md, "Speed").
 ISSUE_SIZES = "10:7,5:7,20:7,10:3,10:15,40:7:20"
 
 
