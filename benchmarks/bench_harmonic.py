@@ -21,8 +21,17 @@ runs the issue's whole speed section in one run (docs/harmonic.md, "Speed"): pyH
 case and its ratio, then the example mast's 300-point curve and 50-amplitude first mode
 at 10 bays, H = 7, and the same for 5, 20, 40 bays (H = 7) and H = 3, 15 (10 bays), each
 curve's stop reason said; the 40-bay curve is capped at 20 points (ISSUE_SIZES), with
-the time 300 would take. ``--old-src OLD/src`` times the 10-bay curve with another src
+the time 300 would take. ``--old-src OLD/src [--old-bays 10]`` times a mast curve with another src
 tree and this one in turn (a before/after ratio in one run).
+
+    python benchmarks/bench_harmonic.py --monodromy [5:300,10:300,20:300,40:12]
+
+times the exact monodromy of every HB orbit of each mast's curve (BAYS:POINTS) by the
+plain product of scipy.linalg.expm and by the cached eigen-decompositions (the default
+route, harmonic/monodromy.py "Speed"), side by side on the same orbits, and prints how
+far apart they are beside how far expm on the balanced matrices is from expm.
+``--mast-sizes 5:7,10:7,20:7,40:7 --curves-only`` gives the growth of a whole curve with
+the bays without the nonlinear modes (which the monodromy does not touch).
 
     python benchmarks/bench_harmonic.py --mast [--mast-points 300]
 
@@ -346,16 +355,54 @@ def _curve_lines(
     return per_point
 
 
-def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
+def _spent_in() -> Any:
+    """Time the exact monodromy and the orbit check from now on; the returned function
+    puts them back and says how long each took."""
+    from clearjoint.harmonic import check, monodromy
+
+    wrapped = {"monodromy": (monodromy, "multipliers"), "orbit check": (check, "check_orbits")}
+    spent = dict.fromkeys(wrapped, 0.0)
+    calls = dict.fromkeys(wrapped, 0)
+    originals = {name: getattr(module, attr) for name, (module, attr) in wrapped.items()}
+
+    def timer(name: str) -> Any:
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            started = time.perf_counter()
+            try:
+                return originals[name](*args, **kwargs)
+            finally:
+                spent[name] += time.perf_counter() - started
+                calls[name] += 1
+
+        return timed
+
+    for name, (module, attr) in wrapped.items():
+        setattr(module, attr, timer(name))
+
+    def report() -> str:
+        for name, (module, attr) in wrapped.items():
+            setattr(module, attr, originals[name])
+        return ", ".join(f"{k} {spent[k]:.1f} s ({calls[k]} calls)" for k in wrapped)
+
+    return report
+
+
+def mast_sizes(sizes: str, points: int, force_n: float, modes: bool = True) -> list[str]:
     """The example mast's cost against bays and H: the frequency response (``points``
     points from 0.8 times the open first mode, the study's force pattern scaled to
-    ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes), one line each."""
+    ``force_n`` at the tip) and the first nonlinear mode (50 amplitudes; not with
+    ``modes=False``), one line each."""
     from clearjoint.harmonic import nonlinear_modes
 
     print(
         f"examples/mast.toml with other bay counts; force {force_n} N at the tip (x); "
         f"curves of {points} points at most from 0.8 x the open first mode, max_step "
-        f"{MAST_MAX_STEP}; modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
+        f"{MAST_MAX_STEP}; "
+        + (
+            "modes at 50 amplitudes 0.1 to 20 mm x (bays / 10)^2 at the tip"
+            if modes
+            else "no modes (--curves-only)"
+        )
     )
     print(f"  load before: {os.getloadavg()[0]:.2f} (1-min average)")
     summary: list[str] = []
@@ -368,6 +415,7 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
         f_open = float(s.modes("open").omega[0])
         f_closed = float(s.modes("closed").omega[0])
         unknowns = (2 * h + 1) * s.n_dof
+        spent = _spent_in() if not modes else None
         start = time.perf_counter()
         try:
             fr = frequency_response(
@@ -387,6 +435,13 @@ def mast_sizes(sizes: str, points: int, force_n: float) -> list[str]:
         if fr is not None:
             took = time.perf_counter() - start
             per_point = _curve_lines(fr, bays, h, s, unknowns, took, points, asked, summary)
+        if spent is not None:
+            line = spent()
+            print(f"      of which {line}", flush=True)
+            summary[-1] += f"; of which {line}"
+        if not modes:
+            points = asked
+            continue
         amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
         start = time.perf_counter()
         nm = nonlinear_modes(s, 1, amplitudes, harmonics=h)
@@ -732,8 +787,9 @@ def pyharm_part(python: str | None) -> float | None:
 
 
 #: The issue's sizes, the 10-bay H = 7 mast first (the issue's mast part), then the growth
-#: (BAYS:H[:most points]): the 40-bay curve capped at 20 points, since its stability (the
-#: monodromy's 320 x 320 matrix exponentials, about 250 a point) costs about 10 s a point.
+#: (BAYS:H[:most points]): the 40-bay curve capped at 20 points: its stability cost about
+#: 10 s a point with expm's product, about 1.3 s with the cached eigen route, and 300 points
+#: still did not end within 34 minutes (docs/harmonic.md, "Speed").
 ISSUE_SIZES = "10:7,5:7,20:7,10:3,10:15,40:7:20"
 
 
@@ -810,6 +866,117 @@ def old_against_new(old_src: str, bays: int, points: int) -> None:
     )
 
 
+#: --monodromy: BAYS:POINTS per mast, the curve whose every orbit both routes multiply
+#: (the 40-bay one cut short: the expm route costs about 10 s a point there).
+MONODROMY_BAYS = "5:300,10:300,20:300,40:12"
+
+
+def monodromy_routes(bays_list: str) -> None:
+    """The exact monodromy by both routes side by side on the same HB orbits, per bay count.
+
+    For each mast (examples/mast.toml with BAYS bays, H = 7, the --mast-sizes force) a
+    POINTS-point curve from 0.8 x the open first mode (no orbit check) gives the orbits;
+    then, on all of them in the curve's order (as frequency_response meets them), the plain
+    product of scipy.linalg.expm (``method="expm"``, the old route) and the cached
+    eigen-decompositions (the default), the cache emptied first so that its cold start
+    (every pattern decomposed) is in the time. Accuracy: the eigen route against the
+    expm product, beside expm on the balanced matrix against expm (how far the reference
+    itself is determined), and the largest multiplier's modulus by both.
+    """
+    import scipy.linalg
+
+    from clearjoint.harmonic import aft, monodromy
+    from clearjoint.harmonic.system import from_structure
+
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    print("the exact monodromy of each HB orbit (H = 7) of a mast's curve: expm, eigen route")
+    summary = []
+    for item in bays_list.split(","):
+        bays, points = (int(v) for v in item.split(":"))
+        s, pattern = example_mast(bays)
+        force = pattern * (MAST_FORCE_N / float(np.max(np.abs(pattern))))
+        f_open = float(s.modes("open").omega[0])
+        f_closed = float(s.modes("closed").omega[0])
+        started = time.perf_counter()
+        fr = frequency_response(
+            s,
+            force,
+            0.8 * f_open,
+            1.2 * f_closed,
+            harmonics=7,
+            max_points=points,
+            max_step=MAST_MAX_STEP,
+            check_points=0,
+        )
+        made = time.perf_counter() - started
+        model = from_structure(s)
+        basis = aft.Basis.make(7, int(fr.settings["samples"]))
+        orbits = list(zip(fr.coefficients, fr.omega, strict=True))  # type: ignore[arg-type]
+        segments = [monodromy.crossings(model, basis, c).size + 1 for c, _ in orbits]
+        patterns = [
+            {x.tobytes() for x in monodromy._segments(model, basis, c)[1]} for c, _ in orbits
+        ]
+        in_all = len(set().union(*patterns))
+        started = time.perf_counter()
+        old = [monodromy.monodromy(model, basis, c, float(w), method="expm") for c, w in orbits]
+        t_old = time.perf_counter() - started
+        monodromy._FLOWS.clear()
+        monodromy._TRANSITIONS.clear()
+        started = time.perf_counter()
+        new = [monodromy.monodromy(model, basis, orbits[0][0], float(orbits[0][1]))]
+        t_first = time.perf_counter() - started
+        new += [monodromy.monodromy(model, basis, c, float(w)) for c, w in orbits[1:]]
+        t_new = time.perf_counter() - started
+        # the reference's own spread: expm of the balanced segment matrices, on the orbit
+        # with the most segments
+        most = int(np.argmax(segments))
+        widths, states = monodromy._segments(model, basis, orbits[most][0])
+        n = model.n_dof
+        a = np.zeros((2 * n, 2 * n))
+        a[:n, n:] = np.eye(n)
+        a[n:, n:] = -model.damping / np.diag(model.mass)[:, None]
+        balanced = np.eye(2 * n)
+        for width, state in zip(widths, states, strict=True):
+            a[n:, :n] = -monodromy._pattern_stiffness(model, state) / np.diag(model.mass)[:, None]
+            b, (d, _) = scipy.linalg.matrix_balance(
+                a * (width / orbits[most][1]), permute=False, separate=True
+            )
+            balanced = (d[:, None] * scipy.linalg.expm(b) / d[None, :]) @ balanced
+        spread = np.linalg.norm(balanced - old[most]) / np.linalg.norm(old[most])
+        gap = max(np.linalg.norm(x - y) / np.linalg.norm(y) for x, y in zip(new, old, strict=True))
+        mu_gap = max(
+            abs(np.max(np.abs(np.linalg.eigvals(x))) - np.max(np.abs(np.linalg.eigvals(y))))
+            / np.max(np.abs(np.linalg.eigvals(y)))
+            for x, y in zip(new, old, strict=True)
+        )
+        k = len(orbits)
+        line = (
+            f"{bays:2d} bays (2N = {2 * n}, {min(segments)} to {max(segments)} segments a "
+            f"period, {min(map(len, patterns))} to {max(map(len, patterns))} contact patterns, "
+            f"{in_all} over the curve): expm {t_old / k:.3f} s/point, eigen "
+            f"{t_new / k:.3f} s/point ({t_first:.3f} s the first, cold; "
+            f"{(t_new - t_first) / max(k - 1, 1):.3f} s after): {t_old / t_new:.1f}x over "
+            f"{k} points"
+        )
+        print(
+            f"  {line}; the {fr.omega.size}-point curve made in {made:.1f} s, load "
+            f"{os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+        there = np.linalg.norm(new[most] - old[most]) / np.linalg.norm(old[most])
+        print(
+            f"      eigen vs expm: largest relative difference {gap:.1e} (Frobenius), largest "
+            f"multiplier's modulus {mu_gap:.1e}; on the orbit with the most segments "
+            f"{there:.1e}, where expm on the balanced matrices differs from expm by {spread:.1e}",
+            flush=True,
+        )
+        summary.append(line)
+    print(f"uptime: {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+    print("summary (one run):")
+    for line in summary:
+        print(f"  {line}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pyharm", help="python interpreter that has pyHarm (pyharm-os)")
@@ -826,6 +993,9 @@ def main() -> None:
         help=f"the example mast's cost against bays and H, as BAYS:H,... (default {MAST_SIZES})",
     )
     parser.add_argument("--mast-force", type=float, default=MAST_FORCE_N, help="N, --mast-sizes")
+    parser.add_argument(
+        "--curves-only", action="store_true", help="--mast-sizes without the nonlinear modes"
+    )
     parser.add_argument(
         "--mast-decay",
         type=int,
@@ -846,16 +1016,28 @@ def main() -> None:
     )
     parser.add_argument(
         "--old-src",
-        help="time the 10-bay mast's curve (--mast-points) with another clearjoint src tree "
+        help="time the mast's curve (--old-bays, --mast-points) with another clearjoint src tree "
         "(e.g. main's: git archive main src | tar -x -C OLD) and with this one, in turn",
     )
+    parser.add_argument(
+        "--monodromy",
+        nargs="?",
+        const=MONODROMY_BAYS,
+        metavar="BAYS:POINTS,...",
+        help="the exact monodromy by scipy's expm product and by the cached eigen route, side "
+        f"by side on every orbit of a POINTS-point curve per mast (default {MONODROMY_BAYS})",
+    )
+    parser.add_argument("--old-bays", type=int, default=10, help="the mast's bays, --old-src")
     parser.add_argument("--one-curve", help=argparse.SUPPRESS)  # BAYS:POINTS, for --old-src
     args = parser.parse_args()
+    if args.monodromy:
+        monodromy_routes(args.monodromy)
+        return
     if args.one_curve:
         one_curve(*(int(v) for v in args.one_curve.split(":")))
         return
     if args.old_src:
-        old_against_new(args.old_src, 10, args.mast_points)
+        old_against_new(args.old_src, args.old_bays, args.mast_points)
         return
     if args.issue:
         issue_run(args.pyharm, args.mast_points)
@@ -878,7 +1060,7 @@ def main() -> None:
         mast_decay(args.mast_decay, 2e-5, args.decay_cycles)
         return
     if args.mast_sizes:
-        mast_sizes(args.mast_sizes, args.mast_points, args.mast_force)
+        mast_sizes(args.mast_sizes, args.mast_points, args.mast_force, not args.curves_only)
         return
     if args.samples:
         samples_error()

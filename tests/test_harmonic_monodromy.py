@@ -9,6 +9,7 @@ import pytest
 import scipy.linalg
 
 from clearjoint import ClearanceJoint
+from clearjoint.errors import ParameterError
 from clearjoint.harmonic import aft, frequency_response, monodromy
 from clearjoint.harmonic.system import build
 from clearjoint.structure import Structure, chain, time_response
@@ -137,3 +138,187 @@ def test_monodromy_equals_a_product_over_the_contact_patterns(three_links: Struc
     )
     np.testing.assert_allclose(phi, sol.y[:, -1].reshape(6, 6), atol=1e-5 * np.max(np.abs(phi)))
     assert scipy.linalg.norm(phi) > 0.0
+
+
+# --- the eigen-decomposition product (monodromy.py, "Speed") against its references ---
+
+
+def _chain_orbit(three_links: Structure, omega: float) -> tuple[object, aft.Basis, np.ndarray]:
+    fr = frequency_response(three_links, FORCE, omega, 1.001 * omega, harmonics=7, max_points=2)
+    assert fr.coefficients is not None
+    basis = aft.Basis.make(7, fr.settings["samples"])
+    return build(three_links, 0.0, None, 1.0), basis, fr.coefficients[0]
+
+
+def _no_expm(*args: object, **kwargs: object) -> np.ndarray:
+    raise AssertionError("scipy.linalg.expm called on a well-conditioned pattern")
+
+
+@pytest.mark.parametrize("omega", [200.0, 300.0, 600.0])
+def test_eigen_product_equals_the_expm_product(
+    three_links: Structure, omega: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The default route (cached eigen-decompositions, no expm at all: expm is made to fail)
+    gives the plain product of scipy.linalg.expm to 1e-10 relative, twice (the second call
+    from the cache), and the same multipliers."""
+    model, basis, coef = _chain_orbit(three_links, omega)
+    reference = monodromy.monodromy(model, basis, coef, omega, method="expm")
+    assert monodromy.crossings(model, basis, coef).size >= 2
+    monodromy._FLOWS.clear()
+    monkeypatch.setattr(monodromy.scipy.linalg, "expm", _no_expm)
+    for _ in range(2):
+        phi = monodromy.monodromy(model, basis, coef, omega)
+        error = np.linalg.norm(phi - reference) / np.linalg.norm(reference)
+        assert error < 1e-10
+    mu = np.linalg.eigvals(phi)
+    mu_ref = np.linalg.eigvals(reference)
+    np.testing.assert_allclose(np.sort(np.abs(mu)), np.sort(np.abs(mu_ref)), rtol=1e-10)
+
+
+def test_monodromy_against_solve_ivp_restarted_at_its_own_gap_edge_events(
+    three_links: Structure,
+) -> None:
+    """Phi and the multipliers against an independent integration of the variational
+    equation: DOP853 on M y'' + C y' + K_T(t) y = 0, with K_T read off the orbit's
+    relative displacements and the integration stopped at each gap-edge crossing by
+    solve_ivp's own events (no use of monodromy.crossings), to 1e-8 relative."""
+    from scipy.integrate import solve_ivp
+
+    omega = 600.0
+    model, basis, coef = _chain_orbit(three_links, omega)
+    phi = monodromy.monodromy(model, basis, coef, omega)
+    b = model.directions
+    rel = coef @ b.T
+    inv_m = 1.0 / np.diag(model.mass)
+    period = 2.0 * math.pi / omega
+
+    def delta(t: float) -> np.ndarray:
+        return basis.evaluate(rel, np.array([omega * t]))[0]
+
+    def edge_event(j: int, level: float, direction: float) -> object:
+        def event(t: float, y: np.ndarray) -> float:
+            return float(delta(t)[j] - level)
+
+        event.terminal = True  # type: ignore[attr-defined]
+        event.direction = direction  # type: ignore[attr-defined]
+        return event
+
+    t, y = 0.0, np.eye(6).ravel()
+    segments = 0
+    while t < period:
+        # this segment's tangent, read just after its start (constant until the next event),
+        # and each edge's next crossing: downward where delta is above it now, else upward
+        d = delta(t + 1e-9 * period)
+        k = model.k0 + model.k_c * (d > model.g_c) + model.k_t * (d < -model.g_t)
+        kt = model.stiffness + (b.T * k) @ b
+        events = [
+            edge_event(j, g, -1.0 if d[j] > g else 1.0)
+            for j in range(3)
+            for g in (model.g_c[j], -model.g_t[j])
+        ]
+
+        def rhs(_: float, z: np.ndarray, kt: np.ndarray = kt) -> np.ndarray:
+            z = z.reshape(6, 6)
+            return np.concatenate(
+                (z[3:], -inv_m[:, None] * (kt @ z[:3] + model.damping @ z[3:]))
+            ).ravel()
+
+        sol = solve_ivp(rhs, (t, period), y, method="DOP853", rtol=1e-12, atol=1e-14, events=events)
+        assert sol.success
+        t, y = float(sol.t[-1]), sol.y[:, -1]
+        segments += 1
+    exact = y.reshape(6, 6)
+    assert segments == monodromy.crossings(model, basis, coef).size + 1
+    assert np.linalg.norm(phi - exact) / np.linalg.norm(exact) < 1e-8
+    mu, mu_exact = np.linalg.eigvals(phi), np.linalg.eigvals(exact)
+    np.testing.assert_allclose(np.sort(np.abs(mu)), np.sort(np.abs(mu_exact)), rtol=1e-8)
+    assert float(np.max(np.abs(mu))) > 1.0  # 600 rad/s is the unstable point
+
+
+def _free_end_chain() -> tuple[object, aft.Basis, np.ndarray]:
+    """Two 1 kg masses, the outer held only by a joint with no gap stiffness and no damper:
+    while that joint is open the outer mass is free, A has a Jordan block at 0 (defective)."""
+    loose = ClearanceJoint(clearance=1e-4, compression_stiffness=1e6)
+    s = chain([1.0, 1.0], [1e6, math.inf], [None, loose], dampers=[10.0, 0.0])
+    model = build(s, 0.0, None, 1.0)
+    basis = aft.Basis.make(3, 64)
+    coef = np.zeros((7, 2))
+    coef[1] = [0.0, 3e-4]  # the outer mass swings 0.3 mm: the joint opens and closes
+    return model, basis, coef
+
+
+def test_a_defective_pattern_falls_back_to_expm(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The open pattern of the free-end chain is refused by the decomposition (its V is
+    singular); its segments take scipy.linalg.expm (counted), the closed ones do not; the
+    product equals the plain expm product."""
+    model, basis, coef = _free_end_chain()
+    n = model.n_dof
+    widths, states = monodromy._segments(model, basis, coef)
+    is_open = np.all(states == 0, axis=1)
+    assert is_open.any()
+    assert (~is_open).any()
+    a = np.zeros((2 * n, 2 * n))
+    a[:n, n:] = np.eye(n)
+    a[n:, n:] = -model.damping / np.diag(model.mass)[:, None]
+    a[n:, :n] = -monodromy._pattern_stiffness(model, states[np.argmax(is_open)])
+    assert monodromy._decompose(a) is None
+    a[n:, :n] = -monodromy._pattern_stiffness(model, states[np.argmin(is_open)])
+    assert monodromy._decompose(a) is not None
+    reference = monodromy.monodromy(model, basis, coef, 100.0, method="expm")
+    calls = []
+    expm = scipy.linalg.expm
+
+    def counted(m: np.ndarray) -> np.ndarray:
+        calls.append(1)
+        return np.asarray(expm(m))
+
+    monkeypatch.setattr(monodromy.scipy.linalg, "expm", counted)
+    phi = monodromy.monodromy(model, basis, coef, 100.0)
+    assert len(calls) == int(np.sum(is_open & (widths > 0)))
+    np.testing.assert_allclose(phi, reference, rtol=0, atol=1e-10 * np.linalg.norm(reference))
+
+
+def test_an_orbit_too_big_for_the_cache_keeps_expm(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Decompositions that would evict each other within one orbit are not made."""
+    model, basis, coef = _chain_orbit(three_links, 600.0)
+    monkeypatch.setattr(monodromy._FLOWS, "limit", 1000)
+    calls = []
+
+    def refuse(a: np.ndarray) -> None:
+        calls.append(1)
+
+    monkeypatch.setattr(monodromy, "_decompose", refuse)
+    phi = monodromy.monodromy(model, basis, coef, 600.0)
+    assert not calls
+    np.testing.assert_array_equal(
+        phi, monodromy.monodromy(model, basis, coef, 600.0, method="expm")
+    )
+
+
+def test_the_cache_tells_systems_apart(three_links: Structure) -> None:
+    """Two structures that differ only in the contact stiffness share no decomposition:
+    each gets its own expm product."""
+    model, basis, coef = _chain_orbit(three_links, 600.0)
+    stiffer = build(
+        chain(
+            [1.0, 1.0, 1.0],
+            [1e6] * 3,
+            [ClearanceJoint(clearance=1e-4, compression_stiffness=2e7, gap_stiffness=1e5)] * 3,
+            dampers=[150.0] * 3,
+        ),
+        0.0,
+        None,
+        1.0,
+    )
+    for system in (model, stiffer, model):
+        phi = monodromy.monodromy(system, basis, coef, 600.0)
+        reference = monodromy.monodromy(system, basis, coef, 600.0, method="expm")
+        assert np.linalg.norm(phi - reference) < 1e-10 * np.linalg.norm(reference)
+
+
+def test_an_unknown_method_is_refused(three_links: Structure) -> None:
+    model, basis, coef = _chain_orbit(three_links, 300.0)
+    with pytest.raises(ParameterError, match="method must be 'eigen' or 'expm'"):
+        monodromy.monodromy(model, basis, coef, 300.0, method="pade")  # type: ignore[arg-type]

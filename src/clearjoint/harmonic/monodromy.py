@@ -27,17 +27,43 @@ by scipy's adaptive DOP853, restarted at every gap-edge crossing (K_T jumps) and
 every zero of a rubbing joint's relative speed (the peak of c_j, which an adaptive
 step must not skip). Its cost grows as (2N)^2 states, so it is meant for small
 structures.
+
+Speed. Each segment's exponential depends on the contact pattern only through A, and
+the patterns recur: within one orbit (a joint opens and closes more than once) and,
+above all, from one continuation point to the next (the first 30 points of the 20-bay
+mast's curve: 85 to 93 segments a period, 43 to 47 patterns each, 49 in all; the counts
+over whole curves are printed by ``benchmarks/bench_harmonic.py --monodromy``). So each
+pattern's A is decomposed
+once, A = V B V^-1 with B real block-diagonal (1 x 1 blocks for real eigenvalues,
+[[a, b], [-b, a]] for a pair a +- i b), after a diagonal balancing by powers of 2; then
+expm(A t) = V expm(B t) V^-1 exactly, expm(B t) is closed form (e^(a t) times a rotation
+by b t), and the product is carried in the patterns' eigen-coordinates: one (2N)^2
+scaling and one matrix product V_q^-1 V_p per segment, the transition V_q^-1 V_p cached
+per pair of patterns, instead of a Pade approximant with about log2(norm(A t))
+squarings. The decompositions live in a bounded cache (``_FLOW_BYTES``) keyed by the
+system's matrices and the pattern, so neighbouring curve points share them
+(:func:`clear_cache` frees them). A pattern
+whose V is badly conditioned (1-norm condition above ``_MAX_CONDITION``: a defective A,
+e.g. a free mass with no damping, or nearly parallel eigenvectors) keeps
+``scipy.linalg.expm``, and so does an orbit whose patterns would not fit in the cache.
+``method="expm"`` forces the plain product (the reference the tests compare with).
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
+from clearjoint.errors import ParameterError
 from clearjoint.harmonic.aft import Basis
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
 
@@ -120,8 +146,175 @@ def _at(basis: Basis, columns: FloatArray, tau: FloatArray) -> FloatArray:
     return np.asarray(np.einsum("kc,ck->k", e, columns), dtype=np.float64)
 
 
+#: A pattern's A = V B V^-1 is used when V's 1-norm condition number (balanced
+#: coordinates) is at most this; above it (a defective or nearly defective A) the segment
+#: keeps scipy.linalg.expm. The similarity's rounding is about cond(V) eps per segment.
+_MAX_CONDITION = 1e6
+
+#: Bytes the decompositions may hold (the 40-bay mast's orbits need about 200 MiB each),
+#: and the transitions between patterns; each store drops its least recently used entries
+#: first. An orbit whose own patterns' decompositions would not fit keeps scipy.linalg.expm
+#: (a transition that does not fit only costs its one matrix product again).
+_FLOW_BYTES = 512 * 2**20
+_TRANSITION_BYTES = 256 * 2**20
+
+
+@dataclass(frozen=True)
+class _Flow:
+    """expm(A t) = vectors @ expm(B t) @ inverse for one contact pattern's A (2N, 2N).
+
+    The columns are the ``real`` real eigenvectors, then Re v of each pair a +- i b,
+    then Im v of each pair in the same order: B is ``rate`` on the diagonal, and for
+    pair i the block [[a, b], [-b, a]] on (real + i, real + p + i), p pairs, with a =
+    ``rate[real + i]`` and b = ``frequency[i]``.
+    """
+
+    vectors: FloatArray
+    inverse: FloatArray
+    rate: FloatArray
+    real: int
+    frequency: FloatArray
+
+    def propagate(self, t: float, psi: FloatArray) -> FloatArray:
+        """Return expm(B t) @ psi, psi (2N, m) in this pattern's eigen-coordinates."""
+        out = psi * np.exp(self.rate * t)[:, None]
+        p = self.frequency.size
+        c = np.cos(self.frequency * t)[:, None]
+        s = np.sin(self.frequency * t)[:, None]
+        first = out[self.real : self.real + p].copy()
+        second = out[self.real + p :]
+        out[self.real : self.real + p] = c * first + s * second
+        second *= c
+        second -= s * first
+        return out
+
+
+def _decompose(a: FloatArray) -> _Flow | None:
+    """Return A's real block eigen-decomposition, or None where it is not to be trusted.
+
+    Parameters
+    ----------
+    a : (2N, 2N) ndarray
+        The pattern's state matrix, 1/s.
+
+    Returns
+    -------
+    _Flow or None
+        None when A (balanced by powers of 2) has an eigenvector matrix whose 1-norm
+        condition number exceeds ``_MAX_CONDITION`` or cannot be inverted.
+    """
+    balanced, (scale, _) = scipy.linalg.matrix_balance(a, permute=False, separate=True)
+    lam, v = np.linalg.eig(balanced)
+    upper = np.flatnonzero(lam.imag > 0.0)
+    real = np.flatnonzero(lam.imag == 0.0)
+    if real.size + 2 * upper.size != lam.size:  # not in conjugate pairs: let expm decide
+        return None
+    vectors = np.empty_like(a)
+    rate = np.empty(lam.size)
+    vectors[:, : real.size] = v[:, real].real
+    rate[: real.size] = lam[real].real
+    p, r = upper.size, real.size
+    vectors[:, r : r + p] = v[:, upper].real
+    vectors[:, r + p :] = v[:, upper].imag
+    rate[r : r + p] = rate[r + p :] = lam[upper].real
+    try:
+        inverse = np.linalg.inv(vectors)
+    except np.linalg.LinAlgError:
+        return None
+    condition = np.linalg.norm(vectors, 1) * np.linalg.norm(inverse, 1)
+    if not condition <= _MAX_CONDITION:
+        return None
+    # back to the unbalanced coordinates: A = D balanced D^-1, D = diag(scale) (powers of 2)
+    return _Flow(
+        vectors=scale[:, None] * vectors,
+        inverse=inverse / scale[None, :],
+        rate=rate,
+        real=r,
+        frequency=np.asarray(lam[upper].imag, dtype=np.float64),
+    )
+
+
+class _Cache:
+    """A bounded, thread-safe least-recently-used store of decompositions and transitions."""
+
+    def __init__(self, limit: int) -> None:
+        self.limit = limit
+        self.held = 0
+        self._items: OrderedDict[tuple[bytes, ...], tuple[object, int]] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, key: tuple[bytes, ...]) -> tuple[bool, object]:
+        """Return (found, value), marking the key as recently used."""
+        with self._lock:
+            item = self._items.get(key)
+            if item is None:
+                return False, None
+            self._items.move_to_end(key)
+            return True, item[0]
+
+    def put(self, key: tuple[bytes, ...], value: object, size: int) -> None:
+        """Store ``value`` (``size`` bytes), evicting the least recently used beyond the limit."""
+        with self._lock:
+            old = self._items.pop(key, None)
+            if old is not None:
+                self.held -= old[1]
+            self._items[key] = (value, size)
+            self.held += size
+            while self.held > self.limit and len(self._items) > 1:
+                _, (_, freed) = self._items.popitem(last=False)
+                self.held -= freed
+
+    def clear(self) -> None:
+        """Forget everything."""
+        with self._lock:
+            self._items.clear()
+            self.held = 0
+
+
+_FLOWS = _Cache(_FLOW_BYTES)
+_TRANSITIONS = _Cache(_TRANSITION_BYTES)
+
+
+def clear_cache() -> None:
+    """Free the cached decompositions and transitions (up to 768 MiB; module docstring)."""
+    _FLOWS.clear()
+    _TRANSITIONS.clear()
+
+
+def _fingerprint(system: LinearSystem) -> bytes:
+    """A digest of what A depends on: M, C, K, the joint directions and tangents."""
+    digest = hashlib.blake2b(digest_size=16)
+    for array in (
+        system.mass,
+        system.damping,
+        system.stiffness,
+        system.directions,
+        system.k0,
+        system.k_c,
+        system.k_t,
+    ):
+        digest.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
+        digest.update(str(np.shape(array)).encode())
+    return digest.digest()
+
+
+def _segments(
+    system: LinearSystem, basis: Basis, coefficients: FloatArray
+) -> tuple[FloatArray, NDArray[np.int64]]:
+    """The phase widths (k + 1,) between gap-edge crossings and each one's contact state."""
+    rel = coefficients @ system.directions.T
+    edges = np.concatenate(([0.0], crossings(system, basis, coefficients), [2.0 * math.pi]))
+    middles = 0.5 * (edges[:-1] + edges[1:])
+    return np.diff(edges), _states(basis.evaluate(rel, middles), system)
+
+
 def monodromy(
-    system: LinearSystem, basis: Basis, coefficients: FloatArray, omega: float
+    system: LinearSystem,
+    basis: Basis,
+    coefficients: FloatArray,
+    omega: float,
+    *,
+    method: Literal["eigen", "expm"] = "eigen",
 ) -> FloatArray:
     """Return the monodromy matrix of the HB orbit's linearisation, (2N, 2N).
 
@@ -135,35 +328,76 @@ def monodromy(
         The HB orbit, m.
     omega : float
         w, rad/s.
+    method : {"eigen", "expm"}
+        ``"eigen"``: each contact pattern's cached eigen-decomposition, chained in
+        eigen-coordinates, ``scipy.linalg.expm`` where it is ill-conditioned (module
+        docstring, "Speed"). ``"expm"``: ``scipy.linalg.expm`` on every segment.
 
     Returns
     -------
     (2N, 2N) ndarray
         Phi, mapping (y(0), y'(0)) to (y(T), y'(T)), T = 2 pi / w.
+
+    Raises
+    ------
+    ParameterError
+        ``method`` is neither "eigen" nor "expm".
     """
+    if method not in ("eigen", "expm"):
+        raise ParameterError(f"method must be 'eigen' or 'expm', got {method!r}")
     n = system.n_dof
     inv_m = 1.0 / np.diag(system.mass)
-    b = system.directions
-    rel = coefficients @ b.T
-    cuts = crossings(system, basis, coefficients)
-    edges = np.concatenate(([0.0], cuts, [2.0 * math.pi]))
-    widths = np.diff(edges)
-    middles = 0.5 * (edges[:-1] + edges[1:])
-    states = _states(basis.evaluate(rel, middles), system)  # (k + 1, n_j)
+    widths, states = _segments(system, basis, coefficients)
     a = np.zeros((2 * n, 2 * n))
     a[:n, n:] = np.eye(n)
     a[n:, n:] = -inv_m[:, None] * system.damping
+    keys = [state.tobytes() for state in states]
+    # each decomposition holds two (2N, 2N) matrices; if the orbit's own would not fit,
+    # they would evict each other at every segment: expm is cheaper then
+    eigen = method == "eigen" and 2 * len(set(keys)) * a.nbytes <= _FLOWS.limit
+    system_key = _fingerprint(system) if eigen else b""
     phi = np.eye(2 * n)
-    cache: dict[bytes, FloatArray] = {}
-    for width, state in zip(widths, states, strict=True):
+    here: _Flow | None = None  # the pattern whose eigen-coordinates phi is in (None: plain)
+    here_key = b""
+    for width, state, key in zip(widths, states, keys, strict=True):
         if width <= 0.0:
             continue
-        key = state.tobytes()
-        if key not in cache:
-            cache[key] = -inv_m[:, None] * _pattern_stiffness(system, state)
-        a[n:, :n] = cache[key]
-        phi = scipy.linalg.expm(a * (width / omega)) @ phi
-    return phi
+        flow = None
+        if eigen:
+            found, cached = _FLOWS.get((system_key, key))
+            if not found:
+                a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, state)
+                cached = _decompose(a)
+                _FLOWS.put((system_key, key), cached, 2 * a.nbytes if cached else 0)
+            flow = cached if isinstance(cached, _Flow) else None
+        if flow is None:  # the plain exponential (the reference and the fallback)
+            if here is not None:
+                phi = here.vectors @ phi
+                here = None
+            a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, state)
+            phi = scipy.linalg.expm(a * (width / omega)) @ phi
+            continue
+        if here is None:
+            phi = flow.inverse @ phi
+        elif here_key != key:
+            phi = _transition(system_key, here_key, here, key, flow) @ phi
+        phi = flow.propagate(width / omega, phi)
+        here, here_key = flow, key
+    if here is not None:
+        phi = here.vectors @ phi
+    return np.asarray(phi, dtype=np.float64)
+
+
+def _transition(
+    system_key: bytes, source_key: bytes, source: _Flow, target_key: bytes, target: _Flow
+) -> FloatArray:
+    """V_target^-1 V_source (cached): from the eigen-coordinates of one pattern to the next's."""
+    found, cached = _TRANSITIONS.get((system_key, source_key, target_key))
+    if found and isinstance(cached, np.ndarray):
+        return cached
+    matrix = target.inverse @ source.vectors
+    _TRANSITIONS.put((system_key, source_key, target_key), matrix, matrix.nbytes)
+    return matrix
 
 
 def multipliers(
