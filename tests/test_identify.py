@@ -532,6 +532,65 @@ def test_force_control_without_a_mass_warns_and_estimates_it(
     assert result.row()["flag"] == "doubtful"
 
 
+LAB = Path(__file__).resolve().parents[1] / "examples" / "lab-csv"
+ADVICE = re.compile(
+    r"to use the known one, (?:"
+    r"add the line '(?P<under>[^']+)' \(your moving mass\) under the first line "
+    r"'(?P<magic>[^']+)' of (?P<file>\S+)"
+    r"|add the line '(?P<line>[^']+)' \(your moving mass\) to (?P<sidecar>\S+)"
+    r"|create (?P<new>\S+) holding the line '(?P<content>[^']+)' \(your moving mass\))$"
+)
+
+
+def follow(advice: str) -> None:
+    """Do literally what the missing-mass warning says, and nothing else."""
+    match = ADVICE.search(advice)
+    assert match, advice
+    if match["file"]:
+        path = Path(match["file"])
+        lines = path.read_text().splitlines(keepends=True)
+        assert lines[0].strip() == match["magic"]
+        path.write_text(lines[0] + match["under"] + "\n" + "".join(lines[1:]))
+    elif match["sidecar"]:
+        path = Path(match["sidecar"])
+        path.write_text(path.read_text().rstrip("\n") + "\n" + match["line"] + "\n")
+    else:
+        Path(match["new"]).write_text(match["content"] + "\n")
+
+
+@pytest.mark.parametrize("layout", ["lab csv and sidecar", "lab csv alone", "clearjoint csv"])
+def test_the_missing_mass_advice_followed_literally_adds_the_mass(
+    independent: dict[float, tuple[TrueJoint, dict[str, float]]],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    layout: str,
+) -> None:
+    # a lab CSV reads its metadata from NAME.toml only (a '# mass' line in it is a comment),
+    # a clearjoint CSV from its header only: the advice must name the one that works
+    if layout == "clearjoint csv":
+        path = write_record(independent[40.0][0], tmp_path / "nomass.csv", mass_in_metadata=False)
+    else:
+        path = tmp_path / "joint-1_40Hz_1600N.csv"
+        path.write_bytes((LAB / path.name).read_bytes())
+        if layout == "lab csv and sidecar":  # the tutorial's file with its mass line dropped
+            text = (LAB / "joint-1_40Hz_1600N.toml").read_text()
+            kept = [line for line in text.splitlines() if not line.startswith("mass")]
+            assert len(kept) < len(text.splitlines())
+            path.with_suffix(".toml").write_text("\n".join(kept) + "\n")
+    assert read_record(path).mass is None
+    out = tmp_path / "r.csv"
+    assert main(["identify", str(path), "--out", str(out), "--quiet"]) == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if "without a mass" in line]
+    assert len(warned) == 1
+    follow(warned[0])
+    assert read_record(path).mass == pytest.approx(1.5)
+    assert main(["identify", str(path), "--out", str(out), "--quiet", "--force"]) == 0
+    assert "without a mass" not in capsys.readouterr().err
+    with out.open() as handle:
+        (row,) = list(csv.DictReader(handle))
+    assert float(row["mass_kg"]) == pytest.approx(1.5)
+
+
 # ---- real records shipped with the tests ------------------------------------------------
 
 

@@ -89,7 +89,7 @@ from clearjoint.identify.segments import (
     _windows,
 )
 from clearjoint.joint import Joint
-from clearjoint.records import Record
+from clearjoint.records import Record, mass_advice
 
 FloatArray = NDArray[np.float64]
 
@@ -614,8 +614,8 @@ def _identify_stack(
     if mass_missing:
         warnings.append(
             f"{where}: force-controlled record without a mass: the mass was estimated from the "
-            f"record as {summary['mass_kg']:.4g} kg; add it to the record (CSV header line "
-            "'# mass = \"1.5 kg\"', netCDF attribute mass_kg) to use the known one"
+            f"record as {summary['mass_kg']:.4g} kg; to use the known one, "
+            f"{mass_advice(record.source)}"
         )
     head = fits[0]
     # each quantity's per-cycle values as Python floats at once (the same doubles as
