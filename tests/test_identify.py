@@ -18,6 +18,7 @@ import xarray as xr
 from clearjoint.cli import main
 from clearjoint.identify import IdentificationError, damper, identify, identify_files
 from clearjoint.records import Record, read_record
+from clearjoint.records import write_record as write_clearjoint_record
 from clearjoint.rig import load_campaign, run_campaign
 from independent_joint import TrueJoint, steady_truth, write_record
 
@@ -589,6 +590,57 @@ def test_the_missing_mass_advice_followed_literally_adds_the_mass(
     with out.open() as handle:
         (row,) = list(csv.DictReader(handle))
     assert float(row["mass_kg"]) == pytest.approx(1.5)
+
+
+def backlash_loop(gap: float, noise: float, seed: int = 3) -> Record:
+    """A displacement-controlled friction damper with backlash, written here: a slider
+    dragged through an elastic link (2 MN/m, slip at 2 kN) that acts only once the play
+    ``gap`` is taken up; 10 mm at 1 Hz, 6 cycles at 1 kHz, Gaussian noise of ``noise``
+    times each channel's standard deviation on force and displacement."""
+    t = np.arange(6000) / 1000.0
+    x = 10e-3 * np.sin(2 * np.pi * t)
+    k, slip, half = 2e6, 2000.0, 0.5 * gap
+    force = np.empty_like(x)
+    z = 0.0  # the slider
+    for i, xi in enumerate(x):
+        d = xi - z
+        e = k * (d - half) if d > half else k * (d + half) if d < -half else 0.0
+        if abs(e) > slip:
+            z = xi - math.copysign(half + slip / k, e)
+            e = math.copysign(slip, e)
+        force[i] = e
+    rng = np.random.default_rng(seed)
+    return Record(
+        time=t,
+        force=force + rng.normal(0.0, noise * float(np.std(force)), t.size),
+        displacement=x + rng.normal(0.0, noise * float(np.std(x)), t.size),
+        control="displacement",
+        frequency_hz=1.0,
+        joint_id="damper",
+    )
+
+
+def test_a_backlash_whose_interval_spans_zero_is_rejected_in_the_cli_csv(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a play of 0.2 mm under 3 % noise cannot be told from none; 4 mm at 1 % can
+    tiny = write_clearjoint_record(backlash_loop(0.2e-3, 0.03), tmp_path / "tiny.csv")
+    clear = write_clearjoint_record(backlash_loop(4e-3, 0.01), tmp_path / "clear.csv")
+    out = tmp_path / "r.csv"
+    assert main(["identify", str(tiny), str(clear), "--out", str(out), "--quiet"]) == 0
+    with out.open() as handle:
+        table = {Path(row["file"]).name: row for row in csv.DictReader(handle)}
+    row = table["tiny.csv"]
+    assert row["model"] == "damper"
+    assert row["flag"] == "rejected"
+    assert "its interval spans zero" in row["flag_reason"]
+    # the reason is the columns' own: the two-standard-error interval reaches below zero
+    assert float(row["clearance_m"]) - 2 * float(row["clearance_m_se"]) <= 0.0
+    row = table["clear.csv"]
+    assert row["model"] == "damper"
+    assert float(row["clearance_m"]) == pytest.approx(4e-3, rel=0.05)
+    assert row["flag"] != "rejected"
+    assert "spans zero" not in row["flag_reason"]
 
 
 # ---- real records shipped with the tests ------------------------------------------------
