@@ -533,6 +533,25 @@ def test_force_control_without_a_mass_warns_and_estimates_it(
     assert result.row()["flag"] == "doubtful"
 
 
+def test_an_estimated_mass_has_the_standard_error_of_its_scatter(tmp_path: Path) -> None:
+    # 100 Hz with a measured acceleration: the sample-by-sample fit, whose mass was one
+    # estimate for every jackknife replicate (a standard error of 0.0 on a fitted value).
+    # Checked against ten noise draws: the reported standard error is the estimates' scatter.
+    joint = TrueJoint(frequency_hz=100.0)
+    masses, errors = [], []
+    for seed in range(10):
+        path = tmp_path / f"nomass{seed}.csv"
+        write_record(joint, path, noise=0.01, mass_in_metadata=False, seed=seed)
+        result = identify(read_record(path))
+        assert result.model == "joint"
+        masses.append(result.summary["mass_kg"])
+        errors.append(result.row()["mass_kg_se"])
+    assert min(errors) > 0.0
+    assert np.mean(masses) == pytest.approx(joint.mass, rel=0.01)
+    scatter = float(np.std(masses, ddof=1))
+    assert 0.5 < float(np.median(errors)) / scatter < 2.0, (errors, scatter)
+
+
 LAB = Path(__file__).resolve().parents[1] / "examples" / "lab-csv"
 ADVICE = re.compile(
     r"to use the known one, (?:"

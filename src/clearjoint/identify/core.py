@@ -501,7 +501,12 @@ def _identify_stack(
                 reps_ad = reps_a
             if "v" in st.channels:
                 reps_v = np.broadcast_to(v, reps_x.shape)
-        reps_r = reps_f - m_guess * reps_ad if force_control else reps_f
+        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
+        if mass_missing:  # each replicate's own estimate, as the weak form's: a fitted mass
+            # has a standard error (the jackknife's), and its doubt reaches every replicate
+            for i in range(1, len(groups) + 1):
+                masses[i] = _estimate_mass(reps_x[i], reps_f[i], reps_v[i], reps_ad[i])
+        reps_r = reps_f - masses[:, None] * reps_ad if force_control else reps_f
         fits = []
         if model == "joint":
             assert first_fit is not None
@@ -534,7 +539,6 @@ def _identify_stack(
                 ]
             )
             residual = sample_fit_residual(reps_x[0], reps_r[0], reps_v[0], fits[0], noise)
-        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     values = [
         _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
         for i in range(len(groups) + 1)
