@@ -832,7 +832,16 @@ def test_the_steady_cycle_rule_is_stated_where_a_record_is_refused() -> None:
     with pytest.raises(IdentificationError) as refused:
         identify(short, tolerance=0.05)
     assert steady_rule(0.05) in str(refused.value)
-    assert "5%" in steady_rule(0.05)
+    # one rule, its percentages written alike: 5 % twice (the tolerance), 15 % and 90 %
+    rule = steady_rule(0.05)
+    assert rule.count("within 5 %") == 2
+    assert "at most 15 % of A" in rule
+    assert "at least 90 % of the largest" in rule
+    assert "%" not in rule.replace(" %", "")  # no "3%" beside "10 %"
+    # and docs/identify.md states it in the same words as the message (at --tolerance 3 %)
+    docs = (Path(__file__).resolve().parents[1] / "docs" / "identify.md").read_text()
+    flat = " ".join(docs.split()).lower()
+    assert steady_rule(0.03).lower() in flat
 
 
 def test_batched_replicate_fits_equal_the_fits_one_by_one(
