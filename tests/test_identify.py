@@ -348,6 +348,35 @@ def test_the_docs_rig_comparison_takes_the_contact_slope_k_s_plus_k0(
         assert quoted == pytest.approx(100 * value, abs=0.006), line
 
 
+def test_cli_loop_figure_of_a_damper_names_its_stages_in_mm_with_the_flag_reason(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import clearjoint.figures
+
+    made = []
+    drawn = clearjoint.figures.identified_loop_figure
+
+    def keep(*args: object, **kwargs: object) -> object:
+        made.append(drawn(*args, **kwargs))  # type: ignore[arg-type]
+        return made[-1]
+
+    monkeypatch.setattr(clearjoint.figures, "identified_loop_figure", keep)
+    record = SHIPPED / "2Hz0lbtension0.5amplitude.json"  # doubtful: backlash not one gap
+    out = tmp_path / "r.csv"
+    assert main(["identify", str(record), "--out", str(out), "--quiet", "--figures",
+                 str(tmp_path / "figs")]) == 0  # fmt: skip
+    (fig,) = made
+    (ax,) = fig.axes
+    assert ax.get_xlabel() == "displacement x (mm)"
+    labels = {text.get_text() for text in ax.get_legend().get_texts()}
+    assert "backlash (after a reversal)" in labels
+    assert "free-play" not in labels
+    assert "[doubtful]" in ax.get_title()
+    assert "not one gap" in rows(out)[0]["flag_reason"]
+    assert fig.texts[0].get_text().startswith("backlash ")
+    assert (tmp_path / "figs" / "2Hz0lbtension0.5amplitude_loop.png").stat().st_size > 0
+
+
 def test_cli_writes_csv_and_netcdf_and_says_why_a_file_was_not_used(
     campaign: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
