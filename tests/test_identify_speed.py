@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import math
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -64,3 +69,96 @@ def test_per_cycle_values_are_python_floats_of_their_own_cycle() -> None:
     assert np.all(np.diag(misfit) < 1e-4)
     for cycle in ident.cycles:
         assert all(type(v) is float for v in cycle.values.values())
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 256, 1001])
+def test_robust_rms_is_the_numpy_median_formula_bit_for_bit(n: int) -> None:
+    from clearjoint.identify.loopcheck import MAD_TO_RMS, _robust_rms
+
+    rng = np.random.default_rng(n)
+    for values in (rng.standard_normal(n) * 3e2, np.round(rng.standard_normal(n), 1)):
+        before = float(MAD_TO_RMS * np.median(np.abs(values - np.median(values))))
+        assert np.float64(_robust_rms(values)).tobytes() == np.float64(before).tobytes()
+
+
+def test_identifying_a_rig_record_does_not_import_numpy_ma(tmp_path: Path) -> None:
+    """The rig path's noise floor took numpy.median (numpy.ma's import, ~10 ms a process)."""
+    from clearjoint.rig import load_campaign, run_campaign
+
+    spec = tmp_path / "campaign.toml"
+    spec.write_text(
+        'seed = 3\nperiods = 12\n[grid]\nfrequencies = ["60Hz"]\nforce_amplitudes = ["2000N"]\n'
+    )
+    run_campaign(load_campaign(spec), tmp_path / "records", jobs=1)
+    record = sorted((tmp_path / "records").glob("*.nc"))[0]
+    code = (
+        "import sys\n"
+        "from clearjoint.identify import identify\n"
+        "from clearjoint.records import read_record\n"
+        f"identify(read_record({str(record)!r}))\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[:2] == ['numpy', 'ma']))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"
+
+
+def _dynamic_through_joint(
+    k_c: float, k_t: float, k0: float, c: float, a_c: float, m: float
+) -> float:
+    """The replicates' dynamic stiffness as it was: a validated Joint, then dynamic_stiffness."""
+    from clearjoint import Joint, stiffness
+    from clearjoint.errors import ClearjointError
+
+    if not m or not (k_c > k0 and k_t > k0 and a_c > 0):
+        return float("nan")
+    try:
+        joint = Joint(
+            mass=m,
+            clearance=max(c, 0.0),
+            compression_stiffness=k_c - k0,
+            tension_stiffness=k_t - k0,
+            gap_stiffness=k0,
+        )
+        return float(stiffness.dynamic_stiffness(joint, a_c))
+    except ClearjointError:
+        return float("nan")
+
+
+def test_replicate_dynamic_stiffness_is_the_validated_joints_bit_for_bit() -> None:
+    from clearjoint.identify.core import _dynamic
+    from clearjoint.identify.segments import _Fit
+
+    rng = np.random.default_rng(15)
+    cases = [
+        (8e7 * rng.uniform(0.2, 2), 8e7 * rng.uniform(0.2, 2), k0, c, a, m)
+        for k0 in (0.0, 2e5, 3e7)
+        for c in (0.0, 1.06e-4 * rng.uniform(0.5, 2), -1e-6)
+        for a in (1e-9, 2e-5 * rng.uniform(0.5, 2), 3e-3)
+        for m in (1.5, 0.02)
+    ]
+    nan, inf = float("nan"), float("inf")
+    # values a Joint refuses (NaN out) and those the guard stops first
+    cases += [
+        (8e7, 6e7, -1e5, 1e-4, 2e-5, 1.5),
+        (inf, 6e7, 0.0, 1e-4, 2e-5, 1.5),
+        (8e7, 6e7, 0.0, inf, 2e-5, 1.5),
+        (8e7, 6e7, 0.0, nan, 2e-5, 1.5),
+        (8e7, 6e7, 0.0, 1e-4, inf, 1.5),
+        (8e7, 6e7, 0.0, 1e-4, 2e-5, nan),
+        (8e7, 6e7, 0.0, 1e-4, 2e-5, -1.5),
+        (8e7, 6e7, 0.0, 1e-4, 2e-5, inf),
+        (8e7, 6e7, 0.0, 1e-4, 0.0, 1.5),
+        (8e7, 6e7, 9e7, 1e-4, 2e-5, 1.5),
+    ]
+    finite = 0
+    for k_c, k_t, k0, c, a, m in cases:
+        fit = _Fit(0.0, 0.0, np.float64(k_c), np.float64(k_t), np.float64(k0), 1.0)
+        new = _dynamic(fit, c, a, m)
+        old = _dynamic_through_joint(k_c, k_t, k0, c, a, m)
+        assert np.float64(new).tobytes() == np.float64(old).tobytes(), (k_c, k_t, k0, c, a, m)
+        finite += math.isfinite(new)
+    assert finite >= 40  # most regular cases have a value (not a comparison of NaNs)
+    # and k_d against MODEL.md eq 9's closed form, k0 = 0 and a symmetric joint
+    fit = _Fit(0.0, 0.0, 8e7, 8e7, 0.0, 1.0)
+    ratio = _dynamic(fit, 1.06e-4, 2e-5, 2.0) / 8e7
+    assert ratio == pytest.approx((math.pi * 2e-5 / (math.pi * 2e-5 + 1.06e-4)) ** 2, rel=1e-12)

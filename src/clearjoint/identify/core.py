@@ -44,13 +44,13 @@ import os
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint import stiffness
-from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.errors import ClearjointError
 from clearjoint.identify._stats import median
 from clearjoint.identify.cycles import (
     MIN_STEADY,
@@ -88,7 +88,6 @@ from clearjoint.identify.segments import (
     _line_fits,
     _windows,
 )
-from clearjoint.joint import Joint
 from clearjoint.records import Record, mass_advice
 
 FloatArray = NDArray[np.float64]
@@ -206,21 +205,45 @@ def _derived(x: FloatArray, fit: _Fit, mass: float | None) -> dict[str, float]:
     }
 
 
+class _Spring(NamedTuple):
+    """A joint's values as :class:`Joint` would store them, for ``stiffness._period``."""
+
+    mass: float
+    gap_stiffness: float
+    compression_stiffness: float
+    tension_stiffness: float
+    compression_gap: float
+    tension_gap: float
+
+
+def _finite(value: float, low: float, strict: bool) -> float | None:
+    """``float(value)`` when finite and above ``low`` (or at it, not ``strict``), else None."""
+    v = float(value)
+    return v if math.isfinite(v) and (v > low or (not strict and v == low)) else None
+
+
 def _dynamic(fit: _Fit, clearance: float, a_c: float, mass: float | None) -> float:
+    """k_d of the fitted joint at penetration ``a_c`` (MODEL.md eq 8), NaN where undefined.
+
+    The values :class:`Joint` and ``dynamic_stiffness`` would give, through the same
+    kernel (``stiffness._period``) and the same checks (a value that ``Joint`` would refuse
+    gives NaN), without building a validated ``Joint`` for every jackknife replicate.
+    """
     k0 = fit.k_gap
     if not mass or not (fit.k_compression > k0 and fit.k_tension > k0 and a_c > 0):
         return math.nan
-    try:
-        joint = Joint(
-            mass=mass,
-            clearance=max(clearance, 0.0),
-            compression_stiffness=fit.k_compression - k0,
-            tension_stiffness=fit.k_tension - k0,
-            gap_stiffness=k0,
-        )
-        return float(stiffness.dynamic_stiffness(joint, a_c))
-    except (ParameterError, ClearjointError):
+    m = _finite(mass, 0.0, True)
+    c = _finite(max(clearance, 0.0), 0.0, False)
+    k_c = _finite(fit.k_compression - k0, 0.0, True)
+    k_t = _finite(fit.k_tension - k0, 0.0, True)
+    g = _finite(k0, 0.0, False)
+    if m is None or c is None or k_c is None or k_t is None or g is None:
         return math.nan
+    if not math.isfinite(a_c):
+        return math.nan
+    spring = _Spring(m, g, k_c, k_t, 0.5 * c + 0.0, 0.5 * c - 0.0)
+    omega_n = (2.0 * math.pi) / stiffness._period(spring, np.asarray(a_c, dtype=np.float64))
+    return float(m * omega_n * omega_n)
 
 
 def _groups(n: int) -> list[NDArray[np.int64]]:

@@ -245,7 +245,8 @@ def channel_noise(
 
 def _robust_rms(values: FloatArray) -> float:
     """1.4826 times the median absolute deviation: the rms of Gaussian values."""
-    return float(MAD_TO_RMS * np.median(np.abs(values - np.median(values))))
+    # _stats.median: numpy.median's double without importing numpy.ma (about 10 ms a process)
+    return float(MAD_TO_RMS * median(np.abs(values - median(values))))
 
 
 def reading(
