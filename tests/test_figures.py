@@ -69,3 +69,44 @@ def test_structure_modes_draws_closed_and_open_side_by_side() -> None:
     s = chain([2.0, 1.5], [1e7, 6e7], [ClearanceJoint(1e-4, 8e7, gap_stiffness=1e6), None])
     fig = structure_modes(s.modes("closed"), s.modes("open"))
     assert [ax.get_title() for ax in fig.axes] == ["closed pattern", "open pattern"]
+
+
+def test_identified_loop_figure_of_a_damper_in_mm_with_its_own_stages_and_the_reason() -> None:
+    from clearjoint.figures import NOTE_CHARACTERS, identified_loop_figure
+
+    t = np.linspace(0.0, 1.0, 400, endpoint=False)
+    x = 12e-3 * np.sin(2 * np.pi * t)  # a damper's 12 mm stroke
+    force = 3000.0 * np.sign(np.cos(2 * np.pi * t))
+    stage = np.sign(force).astype(np.int8)
+    stage[::10] = 0
+    reason = "backlash 4.68 mm on the rising branch and 1.4 mm on the falling one " * 3
+    fig = identified_loop_figure(
+        x, force, stage, (2.8e-3, -0.2e-3), (), model="damper",
+        slip_levels=(3000.0, -2500.0), note=reason,
+    )  # fmt: skip
+    (ax,) = fig.axes
+    assert ax.get_xlabel() == "displacement x (mm)"
+    marks = [line for line in ax.get_lines() if line.get_linestyle() == "None"]
+    np.testing.assert_allclose(np.sort(np.concatenate([m.get_xdata() for m in marks])),
+                               np.sort(x * 1e3))  # fmt: skip
+    labels = {text.get_text() for text in ax.get_legend().get_texts()}
+    assert {"positive force", "backlash (after a reversal)", "negative force"} <= labels
+    assert not labels & {"tension", "free-play", "compression"}
+    # no gap lines at fixed x (a damper's backlash follows each reversal), its slip levels
+    vertical = [line for line in ax.get_lines() if np.ptp(line.get_xdata()) == 0]
+    assert not vertical
+    levels = sorted(line.get_ydata()[0] for line in ax.get_lines() if "slip" in line.get_label())
+    assert levels == [-2500.0, 3000.0]
+    (note,) = fig.texts
+    assert note.get_text().startswith("backlash 4.68 mm on the rising branch")
+    assert note.get_text().endswith("…")
+    assert len(note.get_text()) <= NOTE_CHARACTERS + 2
+    # a joint's loop of 0.2 mm stays in µm with its gap edges and stage names
+    fig = identified_loop_figure(x / 60, force, stage, (0.05e-3, -0.05e-3))
+    (ax,) = fig.axes
+    assert ax.get_xlabel() == "displacement x (µm)"
+    assert {"tension", "free-play", "compression"} <= {
+        t.get_text() for t in ax.get_legend().get_texts()
+    }
+    assert len([line for line in ax.get_lines() if np.ptp(line.get_xdata()) == 0]) == 2
+    assert not fig.texts

@@ -17,6 +17,7 @@ from clearjoint.records import (
     Record,
     RecordError,
     RecordWarning,
+    mass_advice,
     read_brfd,
     read_record,
     resample,
@@ -184,6 +185,24 @@ def test_plain_csv_with_a_sidecar_toml(tmp_path: Path) -> None:
     assert r.joint_id == "side"
     assert r.mass == 2.0
     np.testing.assert_allclose(r.displacement, 1e-6 * t)
+
+
+def test_mass_advice_in_a_sidecar_with_a_record_table_and_in_netcdf(tmp_path: Path) -> None:
+    path = tmp_path / "plain.csv"
+    t = np.arange(100) / 100.0
+    path.write_text("time [s],force [N],displacement [m]\n" + "".join(f"{v},1,1\n" for v in t))
+    sidecar = tmp_path / "plain.toml"
+    sidecar.write_text('[record]\njoint_id = "side"\n')
+    advice = mass_advice(str(path))
+    line = "add the line 'mass = \"1.5 kg\"' (your moving mass)"
+    assert advice == f"{line} to the [record] table of {sidecar}"
+    sidecar.write_text(sidecar.read_text() + 'mass = "1.5 kg"\n')  # [record] is its last table
+    assert read_record(path).mass == 1.5
+    nc = write_record(record(mass=None), tmp_path / "r.nc")
+    expected = f"set the global attribute mass_kg (your moving mass), in kg, in {nc}"
+    assert mass_advice(str(nc)) == expected
+    # a record not from a file: every way, each where it works
+    assert "sidecar NAME.toml" in mass_advice("")
 
 
 def write_csv(tmp_path: Path, body: str, name: str = "bad.csv") -> Path:

@@ -810,6 +810,12 @@ def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
             (first.upper_edge, first.lower_edge),
             first.lines,
             title=title,
+            model=ident.model,
+            slip_levels=(
+                ident.summary["friction_force_positive_n"],
+                ident.summary["friction_force_negative_n"],
+            ),
+            note=ident.flag_reason,
         )
         fig.savefig(targets[1], dpi=100)
 

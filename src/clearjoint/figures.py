@@ -228,6 +228,17 @@ def agreement_map_figure(
     return fig
 
 
+#: A flag reason is cut to this many characters in a figure (the CSV has it whole).
+NOTE_CHARACTERS = 110
+
+
+def _short(text: str, limit: int = NOTE_CHARACTERS) -> str:
+    """``text`` cut at a word before ``limit`` characters, with an ellipsis when cut."""
+    if len(text) <= limit:
+        return text
+    return text[:limit].rsplit(" ", 1)[0].rstrip(",;:") + " …"
+
+
 def identified_loop_figure(
     displacement: NDArray[np.float64],
     force: NDArray[np.float64],
@@ -236,24 +247,58 @@ def identified_loop_figure(
     lines: Sequence[tuple[float, float]] = (),
     *,
     title: str | None = None,
+    model: str = "joint",
+    slip_levels: tuple[float, float] | None = None,
+    note: str = "",
 ) -> Figure:
     """Return a record's loop, its samples marked by stage, the gap edges and fitted lines.
 
-    ``stage`` is -1 (tension), 0 (free-play) or 1 (compression) per sample; ``lines``
-    the (intercept, slope) of the fitted tension, free-play and compression lines.
+    Parameters
+    ----------
+    displacement, force : (n,) ndarray
+        The record's displacement, m, and restoring force, N.
+    stage : (n,) ndarray of int8
+        -1, 0 or 1 per sample: a joint's tension, free play and compression; a damper's
+        negative force, backlash (abs(F) small, after a reversal) and positive force.
+    edges : tuple of float
+        A joint's gap edges, m (dashed lines); not drawn for a damper, whose backlash
+        follows each reversal, not a place in x.
+    lines : sequence of (float, float)
+        The (intercept N, slope N/m) of a joint's fitted tension, free-play and
+        compression lines.
+    title : str, optional
+    model : {"joint", "damper", "line"}
+        The identified model: it names the stages in the legend.
+    slip_levels : tuple of float, optional
+        A damper's two slip levels, N (dotted lines).
+    note : str
+        The flag reason, shown shortened under the axes.
+
+    Returns
+    -------
+    Figure
+        The displacement in mm when the loop spans a millimetre or more, else in µm.
     """
     fig = Figure(figsize=(6.0, 4.6), layout="constrained")
     ax = fig.add_subplot()
+    damper = model == "damper"
+    big = float(np.ptp(displacement)) >= 1e-3
+    scale, unit = (1e3, "mm") if big else (1e6, "µm")
+    names = (
+        ("negative force", "backlash (after a reversal)", "positive force")
+        if damper
+        else ("tension", "free-play", "compression")
+    )
     marks = {
-        -1: ("tension", "v", "0.55"),
-        0: ("free-play", ".", "0.75"),
-        1: ("compression", "^", "0.25"),
+        -1: (names[0], "v", "0.55"),
+        0: (names[1], ".", "0.75"),
+        1: (names[2], "^", "0.25"),
     }
     for value, (name, marker, colour) in marks.items():
         sel = stage == value
         if sel.any():
             ax.plot(
-                displacement[sel] * 1e6,
+                displacement[sel] * scale,
                 force[sel],
                 linestyle="none",
                 marker=marker,
@@ -266,14 +311,22 @@ def identified_loop_figure(
         lines, ((span[0], edges[1]), (edges[1], edges[0]), (edges[0], span[1])), strict=False
     ):
         xs = np.array([low, high])
-        ax.plot(xs * 1e6, intercept + slope * xs, color="black", lw=1.4)
-    for edge in edges:
-        ax.axvline(edge * 1e6, color="black", lw=0.8, linestyle="--")
-    ax.set_xlabel("displacement x (µm)")
+        ax.plot(xs * scale, intercept + slope * xs, color="black", lw=1.4)
+    if damper:
+        for level, which in zip(slip_levels or (), ("positive", "negative"), strict=False):
+            style = ":" if which == "positive" else "-."
+            ax.axhline(level, color="black", lw=0.8, linestyle=style, label=f"{which} slip level")
+    else:
+        for edge in edges:
+            ax.axvline(edge * scale, color="black", lw=0.8, linestyle="--")
+    ax.set_xlabel(f"displacement x ({unit})")
     ax.set_ylabel("restoring force (N)")
     ax.legend(frameon=False, fontsize="small")
     if title:
         ax.set_title(title)
+    if note:
+        fig.text(0.01, 0.0, _short(note), fontsize="x-small", ha="left", va="bottom", wrap=True)
+        fig.get_layout_engine().set(rect=(0.0, 0.05, 1.0, 0.95))  # type: ignore[union-attr,call-arg]
     return fig
 
 

@@ -1047,6 +1047,51 @@ def read_record(path: str | Path, *, resample: bool = False) -> Record:
         raise RecordError(f"{path}: cannot read it ({exc.strerror or exc})") from None
 
 
+def mass_advice(source: str) -> str:
+    """How to add the moving mass to the record file ``source``, in words a user can follow.
+
+    The fix depends on where that file's metadata is read from: a clearjoint CSV (first
+    line :data:`CSV_MAGIC`) reads its ``#`` header; a lab CSV reads only its sidecar
+    ``NAME.toml`` (a ``# mass`` line in it would be a comment); a netCDF file reads its
+    global attribute ``mass_kg``.
+
+    Parameters
+    ----------
+    source : str
+        The record's file (``Record.source``); empty or unknown gives every way.
+
+    Returns
+    -------
+    str
+        One clause, e.g. ``add the line 'mass = "1.5 kg"' (your moving mass) to x.toml``.
+    """
+    path = Path(source)
+    value = '"1.5 kg"'
+    mine = " (your moving mass)"
+    suffix = path.suffix.lower()
+    if suffix in (".nc", ".h5", ".hdf5"):
+        return f"set the global attribute mass_kg{mine}, in kg, in {path}"
+    if suffix != ".csv" or not path.is_file():
+        return (
+            f"a clearjoint CSV: the header line '# mass = {value}'; a lab CSV: the line "
+            f"'mass = {value}' in its sidecar NAME.toml; netCDF: the attribute mass_kg"
+        )
+    lines = _decode(source, path.read_bytes()).splitlines()  # as _read_csv decodes it
+    if lines and lines[0].strip() == CSV_MAGIC:
+        return f"add the line '# mass = {value}'{mine} under the first line '{CSV_MAGIC}' of {path}"
+    sidecar = path.with_suffix(".toml")
+    if not sidecar.exists():
+        return f"create {sidecar} holding the line 'mass = {value}'{mine}"
+    from clearjoint.io_toml import read_toml
+
+    try:
+        table = read_toml(sidecar, what="record metadata", error=RecordError)
+    except RecordError:
+        table = {}
+    where = "the [record] table of " if isinstance(table.get("record"), dict) else ""
+    return f"add the line 'mass = {value}'{mine} to {where}{sidecar}"
+
+
 def write_record(record: Record, path: str | Path, *, force: bool = False) -> Path:
     """Write ``record`` to ``path``: ``.csv`` or ``.nc`` by the suffix. Never overwrites
     an existing file unless ``force``."""

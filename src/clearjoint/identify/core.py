@@ -88,7 +88,7 @@ from clearjoint.identify.segments import (
     _line_fits,
     _windows,
 )
-from clearjoint.records import Record
+from clearjoint.records import Record, mass_advice
 
 FloatArray = NDArray[np.float64]
 
@@ -524,7 +524,12 @@ def _identify_stack(
                 reps_ad = reps_a
             if "v" in st.channels:
                 reps_v = np.broadcast_to(v, reps_x.shape)
-        reps_r = reps_f - m_guess * reps_ad if force_control else reps_f
+        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
+        if mass_missing:  # each replicate's own estimate, as the weak form's: a fitted mass
+            # has a standard error (the jackknife's), and its doubt reaches every replicate
+            for i in range(1, len(groups) + 1):
+                masses[i] = _estimate_mass(reps_x[i], reps_f[i], reps_v[i], reps_ad[i])
+        reps_r = reps_f - masses[:, None] * reps_ad if force_control else reps_f
         fits = []
         if model == "joint":
             assert first_fit is not None
@@ -557,7 +562,6 @@ def _identify_stack(
                 ]
             )
             residual = sample_fit_residual(reps_x[0], reps_r[0], reps_v[0], fits[0], noise)
-        masses = np.full(len(groups) + 1, m_guess if force_control else math.nan)
     values = [
         _derived(reps_x[i], fits[i], float(masses[i]) if force_control else None)
         for i in range(len(groups) + 1)
@@ -637,8 +641,8 @@ def _identify_stack(
     if mass_missing:
         warnings.append(
             f"{where}: force-controlled record without a mass: the mass was estimated from the "
-            f"record as {summary['mass_kg']:.4g} kg; add it to the record (CSV header line "
-            "'# mass = \"1.5 kg\"', netCDF attribute mass_kg) to use the known one"
+            f"record as {summary['mass_kg']:.4g} kg; to use the known one, "
+            f"{mass_advice(record.source)}"
         )
     head = fits[0]
     # each quantity's per-cycle values as Python floats at once (the same doubles as

@@ -32,16 +32,23 @@ MIN_STEADY = 3
 #: A steady cycle's first and last displacement differ by at most this part of its
 #: amplitude: a cycle that starts on the ramp is not steady even if it ends on the plateau.
 CLOSURE = 0.15
+#: The plateau: the cycles whose amplitude is at least this part of the largest one.
+PLATEAU = 0.9
+
+
+def _percent(part: float) -> str:
+    return f"{100 * part:.3g} %"
 
 
 def steady_rule(tolerance: float) -> str:
     """The steady-cycle rule in words, for the docs and every error message."""
     return (
-        f"a cycle (minimum to minimum of the fundamental) is steady when its amplitude and "
-        f"its mean position lie within {tolerance:.0%} of the plateau's (the median over the "
-        f"cycles within 10 % of the largest amplitude) and it closes (its first and last "
-        f"displacement differ by at most {CLOSURE:.0%} of the amplitude); a record needs at "
-        f"least {MIN_STEADY} steady cycles, and all of them are used"
+        f"a cycle (minimum to minimum of the fundamental) is steady when its amplitude is "
+        f"within {_percent(tolerance)} of the plateau amplitude A, its mean position within "
+        f"{_percent(tolerance)} of A from the plateau mean, and its first and last displacement "
+        f"differ by at most {_percent(CLOSURE)} of A (A and the plateau mean are the medians "
+        f"over the cycles whose amplitude is at least {_percent(PLATEAU)} of the largest); "
+        f"a record needs at least {MIN_STEADY} steady cycles, and all of them are used"
     )
 
 
@@ -124,7 +131,7 @@ def steady(x: FloatArray, bounds: list[tuple[int, int]], tolerance: float) -> li
         low = np.array([x[i:j].min() for i, j in bounds])
     amp = 0.5 * (high - low)
     mid = 0.5 * (high + low)
-    top = amp >= 0.9 * amp.max()
+    top = amp >= PLATEAU * amp.max()
     reference = median(amp[top])
     centre = median(mid[top])
     closure = np.abs(x[starts] - x[stops - 1])
