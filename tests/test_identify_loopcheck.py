@@ -98,22 +98,45 @@ def test_a_smooth_loop_with_no_gap_is_not_called_ok(noise: float, seed: int) -> 
     assert "fit residual" in result.flag_reason
 
 
-def _spy_residual(monkeypatch: pytest.MonkeyPatch) -> list[Reading]:
-    """Record every residual of a per-sample fit (a joint's or a line's) identify takes."""
+def _spy_residual(
+    monkeypatch: pytest.MonkeyPatch, name: str = "sample_fit_residual"
+) -> list[Reading]:
+    """Record every residual identify takes by ``core.<name>``: a per-sample fit's (a
+    joint's or a line's) by default, the weak form's with "weak_residual"."""
     seen: list[Reading] = []
-    original = core.sample_fit_residual
+    original = getattr(core, name)
 
-    def spy(*args: object) -> Reading:
-        value = original(*args)  # type: ignore[arg-type]
+    def spy(*args: object, **kwargs: object) -> Reading:
+        value = original(*args, **kwargs)
         seen.append(value)
         return value
 
-    monkeypatch.setattr(core, "sample_fit_residual", spy)
+    monkeypatch.setattr(core, name, spy)
     return seen
 
 
 def _no_damper(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(core, "_damper_fit", lambda *args: None)
+
+
+def _joint_stages(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Read any loop as a joint's tension, free play and compression (stage windows at
+    70-100 % of the stroke each way and the middle half), no damper and no competing model."""
+    _no_damper(monkeypatch)
+    fit = core._joint_fit
+
+    def windows(x: np.ndarray, y: np.ndarray, n: int) -> list[tuple[bool, float, float]]:
+        a, m = 0.5 * float(np.ptp(x)), 0.5 * float(x.max() + x.min())
+        return [
+            (True, m - a, m - 0.7 * a),
+            (False, m - 0.5 * a, m + 0.5 * a),
+            (True, m + 0.7 * a, m + a),
+        ]
+
+    monkeypatch.setattr(core, "_windows", windows)
+    monkeypatch.setattr(
+        core, "_joint_fit", lambda x, r, v, parts, w, compete=True: fit(x, r, v, parts, w, False)
+    )
 
 
 @pytest.mark.parametrize(("noise", "seed"), [(0.0, 0), (0.01, 1)])
@@ -145,21 +168,7 @@ def test_a_smooth_loop_forced_into_the_joint_path_is_flagged(
     """The Bouc-Wen loop read as tension, free play and compression (stage windows at
     70-100 % of the stroke each way and the middle half) by the joint's per-sample fit (the
     weak form, which would take this record, held off as for a contact too short for it)."""
-    _no_damper(monkeypatch)
-    fit = core._joint_fit
-
-    def windows(x: np.ndarray, y: np.ndarray, n: int) -> list[tuple[bool, float, float]]:
-        a, m = 0.5 * float(np.ptp(x)), 0.5 * float(x.max() + x.min())
-        return [
-            (True, m - a, m - 0.7 * a),
-            (False, m - 0.5 * a, m + 0.5 * a),
-            (True, m + 0.7 * a, m + a),
-        ]
-
-    monkeypatch.setattr(core, "_windows", windows)
-    monkeypatch.setattr(
-        core, "_joint_fit", lambda x, r, v, parts, w, compete=True: fit(x, r, v, parts, w, False)
-    )
+    _joint_stages(monkeypatch)
     seen = _spy_residual(monkeypatch)
     monkeypatch.setattr(core, "MIN_EQUATIONS", 10**9)
     result = identify(bouc_wen(noise, seed))
@@ -362,30 +371,8 @@ def test_a_smooth_loop_forced_into_the_weak_form_is_flagged(
     weak form (its interpolated stack goes there): doubtful on every fitted quantity,
     noise-free for its residual (36 times its floor), at 1 % noise because the spectral
     velocity's sign is noise on most samples (the floor then covers the residual)."""
-    _no_damper(monkeypatch)
-    fit = core._joint_fit
-
-    def windows(x: np.ndarray, y: np.ndarray, n: int) -> list[tuple[bool, float, float]]:
-        a, m = 0.5 * float(np.ptp(x)), 0.5 * float(x.max() + x.min())
-        return [
-            (True, m - a, m - 0.7 * a),
-            (False, m - 0.5 * a, m + 0.5 * a),
-            (True, m + 0.7 * a, m + a),
-        ]
-
-    monkeypatch.setattr(core, "_windows", windows)
-    monkeypatch.setattr(
-        core, "_joint_fit", lambda x, r, v, parts, w, compete=True: fit(x, r, v, parts, w, False)
-    )
-    seen: list[Reading] = []
-    original = core.weak_residual
-
-    def spy(*args: object, **kwargs: object) -> Reading:
-        value = original(*args, **kwargs)  # type: ignore[arg-type]
-        seen.append(value)
-        return value
-
-    monkeypatch.setattr(core, "weak_residual", spy)
+    _joint_stages(monkeypatch)
+    seen = _spy_residual(monkeypatch, "weak_residual")
     result = identify(bouc_wen(noise, seed))
     assert result.model == "joint"
     assert len(seen) == 1  # the weak form
