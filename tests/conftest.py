@@ -13,6 +13,9 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+from clearjoint import ClearanceJoint
+from clearjoint.structure import Structure, chain
+
 settings.register_profile("repeatable", derandomize=True, print_blob=True)
 settings.register_profile("explore", derandomize=False, max_examples=200)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
@@ -39,3 +42,11 @@ def reproduction(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = folder / "out"
     assert main(["reproduce", "--out", str(out), "--campaign", str(campaign), "--jobs", "2"]) == 0
     return out
+
+
+@pytest.fixture(scope="module")
+def three_links() -> Structure:
+    """Three 1 kg masses on 1 MN/m links, each with a 0.1 mm joint (1e7 N/m in contact, 1e5
+    in the gap), dashpots across: the harmonic tests' 3-link chain."""
+    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
+    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)

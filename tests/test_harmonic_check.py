@@ -7,20 +7,13 @@ import dataclasses
 import numpy as np
 import pytest
 
-from clearjoint import ClearanceJoint, Joint, ParameterError
+from clearjoint import Joint, ParameterError
 from clearjoint.harmonic import frequency_response
 from clearjoint.harmonic.check import RESIDUAL_TOLERANCE, check_orbits, untrusted_events
 from clearjoint.periodic import FrequencyResponse
-from clearjoint.structure import Structure, chain
+from clearjoint.structure import Structure
 
 FORCE = np.array([0.0, 0.0, 40.0])
-
-
-@pytest.fixture(scope="module")
-def three_links() -> Structure:
-    """Three 1 kg masses on 1 MN/m links, each with a 0.1 mm joint, dashpots across."""
-    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
-    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
 
 
 def test_residual_is_small_and_shrinks_with_harmonics(three_links: Structure) -> None:

@@ -25,13 +25,6 @@ from test_harmonic_aft import PYHARM, PYHARM_ZETA
 FORCE = np.array([0.0, 0.0, 40.0])
 
 
-@pytest.fixture(scope="module")
-def three_links() -> Structure:
-    """The 3-link chain of tests/test_harmonic_structure.py (joints 0.1 mm, 1e7 N/m)."""
-    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
-    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
-
-
 def _set_distance(a: np.ndarray, b: np.ndarray) -> float:
     """Largest distance between two sets of multipliers, paired to minimise it."""
     cost = np.abs(a[:, None] - b[None, :])
@@ -52,16 +45,27 @@ def test_centroid_of_single_harmonics_by_hand() -> None:
     np.testing.assert_allclose(hill.centroids(basis, v, 1), [2.0, 0.0, 0.0, 1.0], atol=1e-15)
 
 
+def _stiff_mast() -> Structure:
+    """A 2-bay mast whose joints (0.1 mm) close onto 1e8 N/m: contact modes far above H w."""
+    return mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0.0, 2e-6))
+
+
+def _tip_x(s: Structure, newtons: float) -> np.ndarray:
+    """A force of ``newtons`` N on the x DOF of the mast's tip node (the second-last DOF)."""
+    force = np.zeros(s.n_dof)
+    force[-2] = newtons
+    return force
+
+
 def test_linear_orbit_gives_the_closed_form_exponents() -> None:
     """A 2-bay mast forced gently stays inside every gap: the perturbation equation has
     constant coefficients, its exponents are the eigenvalues of [[0, I], [-M^-1 K, -M^-1 C]]
     (closed form), several of them far above H w. The centroid picks the natural member of
     each family; the smallest-abs(Im) sorting cannot (those families have no member in its
     strip) and gets other multipliers."""
-    s = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0.0, 2e-6))
+    s = _stiff_mast()
     model = build(s, 0.0, None, 1.0)
-    force = np.zeros(s.n_dof)
-    force[-2] = 1.0
+    force = _tip_x(s, 1.0)
     w = 2.0 * math.pi * 45.0
     fr = frequency_response(s, force, w, 1.0001 * w, harmonics=7, max_points=2, check_points=0)
     assert fr.coefficients is not None
@@ -117,10 +121,9 @@ def test_stiff_contact_needs_many_more_harmonics_in_the_perturbation() -> None:
     orbit's own H = 7 Hill's multipliers miss the exact monodromy's by order 1 (the
     reason structures keep the monodromy by default); carrying the perturbation with
     H' = 31 on the same orbit brings them within 0.15 (docs/harmonic.md, "Stability")."""
-    s = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0.0, 2e-6))
+    s = _stiff_mast()
     model = build(s, 0.0, None, 1.0)
-    force = np.zeros(s.n_dof)
-    force[-2] = 5.0
+    force = _tip_x(s, 5.0)
     w = 2.0 * math.pi * 51.92
     fr = frequency_response(s, force, w, 1.0001 * w, harmonics=7, max_points=2, check_points=0)
     assert fr.coefficients is not None
@@ -258,9 +261,8 @@ def test_hill_on_stiff_contact_flags_the_points_the_monodromy_contradicts() -> N
     """stability="hill" on the 2-bay mast in contact at H = 7 (largest multiplier 0.80 by
     Hill, 1.43 by the exact monodromy of the same orbit): the point is flagged, naming
     both numbers; the default (the monodromy) calls it unstable."""
-    s = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0.0, 2e-6))
-    force = np.zeros(s.n_dof)
-    force[-2] = 5.0
+    s = _stiff_mast()
+    force = _tip_x(s, 5.0)
     w = 2.0 * math.pi * 51.92
     curve = dict(harmonics=7, max_points=2, check_points=0)
     by_hill = frequency_response(s, force, w, 1.0001 * w, stability="hill", **curve)

@@ -17,13 +17,6 @@ from clearjoint.structure import Structure, chain, time_response
 FORCE = np.array([0.0, 0.0, 40.0])
 
 
-@pytest.fixture(scope="module")
-def three_links() -> Structure:
-    """Three 1 kg masses on 1 MN/m links, each with a 0.1 mm joint, dashpots across."""
-    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
-    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
-
-
 def _state_at_period(structure: Structure, omega: float, start: np.ndarray) -> np.ndarray:
     """(u(T), u'(T)) of the exact event-driven motion from ``start`` = (u(0), u'(0))."""
     n = structure.n_dof

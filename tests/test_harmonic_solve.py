@@ -16,13 +16,6 @@ from clearjoint.structure import Structure, chain, mast
 FORCE = np.array([0.0, 0.0, 40.0])
 
 
-@pytest.fixture(scope="module")
-def three_links() -> Structure:
-    """Three 1 kg masses on 1 MN/m links, each with a 0.1 mm joint, dashpots across."""
-    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
-    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
-
-
 def _friction_chain() -> Structure:
     rub = Friction(coefficient=0.2, lateral_load=100.0)
     j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5, friction=rub)
@@ -59,12 +52,8 @@ def test_sparse_jacobian_is_the_dense_one(three_links: Structure, case: str) -> 
         assert sparse.nnz < 0.5 * dense.size  # it is sparse
 
 
-def test_sparse_and_dense_tangents_follow_the_same_branch(
-    three_links: Structure, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """Above solve.SPARSE_ABOVE unknowns the Jacobian, the corrector and the continuation
-    tangent are sparse; the same curve through the resonance as the dense route."""
-    dense = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
+def _count_sparse_tangents(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """Count the continuation's sparse tangents (one entry per call) from now on."""
     calls: list[int] = []
     original = cont._sparse_tangent
 
@@ -73,6 +62,16 @@ def test_sparse_and_dense_tangents_follow_the_same_branch(
         return original(a, previous)
 
     monkeypatch.setattr(cont, "_sparse_tangent", counted)
+    return calls
+
+
+def test_sparse_and_dense_tangents_follow_the_same_branch(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Above solve.SPARSE_ABOVE unknowns the Jacobian, the corrector and the continuation
+    tangent are sparse; the same curve through the resonance as the dense route."""
+    dense = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
+    calls = _count_sparse_tangents(monkeypatch)
     again = frequency_response(three_links, FORCE, 300.0, 700.0, harmonics=5, max_points=25)
     assert not calls  # 33 unknowns: the dense route
     monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
@@ -99,14 +98,7 @@ def test_sparse_start_homotopy_is_the_dense_one(
     k_ref = model.reference_stiffness
     monkeypatch.setattr(response, "newton", lambda *args, **kwargs: None)
     dense = response._start_plain(model, basis, 400.0, FORCE, k_ref)
-    calls: list[int] = []
-    original = cont._sparse_tangent
-
-    def counted(a: object, previous: np.ndarray) -> np.ndarray:
-        calls.append(1)
-        return original(a, previous)
-
-    monkeypatch.setattr(cont, "_sparse_tangent", counted)
+    calls = _count_sparse_tangents(monkeypatch)
     monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
     sparse = response._start_plain(model, basis, 400.0, FORCE, k_ref)
     assert calls

@@ -8,20 +8,13 @@ import logging
 import numpy as np
 import pytest
 
-from clearjoint import ClearanceJoint
 from clearjoint.harmonic import HarmonicError, frequency_response, response
-from clearjoint.structure import Structure, chain
+from clearjoint.structure import Structure
 
 FORCE = np.array([0.0, 0.0, 40.0])
 #: At 800 rad/s Newton from the linear responses misses this chain's orbit; the start's
 #: force continuation reaches it in 45 points (measured).
 OMEGA = 800.0
-
-
-@pytest.fixture(scope="module")
-def three_links() -> Structure:
-    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
-    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
 
 
 def test_the_force_continuation_reports_progress_and_finds_the_start(

@@ -16,13 +16,6 @@ FORCE = np.array([0.0, 0.0, 40.0])
 SAMPLES = 256
 
 
-@pytest.fixture(scope="module")
-def three_links() -> Structure:
-    """Three 1 kg masses on 1 MN/m links, each with a 0.1 mm joint, dashpots across."""
-    j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
-    return chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
-
-
 def _exact_from(structure: Structure, omega: float, state: np.ndarray, periods: int) -> np.ndarray:
     n = structure.n_dof
     motion = time_response(
