@@ -1,4 +1,4 @@
-"""_jit.py: the compiled kernels survive an install where numba cannot write its cache."""
+"""jit.py: the compiled kernels survive an install where numba cannot write its cache."""
 
 from __future__ import annotations
 

@@ -331,7 +331,7 @@ def _save_figure(fig: Any, path: Path, *, quiet: bool) -> None:
 
 def _netcdf_target(args: argparse.Namespace) -> Path:
     """The --out netCDF file, checked before any work: a .nc suffix, not overwritten unasked."""
-    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.checks import refuse_to_overwrite
 
     path = Path(args.out)
     if path.suffix.lower() != ".nc":
@@ -703,7 +703,7 @@ def _run_rig(args: argparse.Namespace) -> int:
 
 
 def _run_identify(args: argparse.Namespace) -> int:
-    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.checks import refuse_to_overwrite
     from clearjoint.identify import identify_files
 
     out = Path(args.out)
@@ -789,7 +789,7 @@ def _figure_files(ident: Any, folder: Path) -> list[Path]:
 
 
 def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
-    from clearjoint._checks import refuse_to_overwrite
+    from clearjoint.checks import refuse_to_overwrite
     from clearjoint.figures import displacement_stages_figure, identified_loop_figure
 
     folder.mkdir(parents=True, exist_ok=True)
@@ -825,7 +825,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
 
     study = load_study(args.study)
     if args.out:
-        from clearjoint._checks import refuse_to_overwrite
+        from clearjoint.checks import refuse_to_overwrite
 
         if Path(args.out).suffix.lower() != ".nc":
             raise ParameterError(

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
+from clearjoint import checks as _checks
 from clearjoint.joint import Pin
 
 #: Largest contact half-angle theta0 (rad) for which Hertz's solution is used without a warning.

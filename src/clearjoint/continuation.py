@@ -47,8 +47,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from clearjoint._jit import njit  # numba.njit that survives a read-only install
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.jit import njit  # numba.njit that survives a read-only install
 
 __all__ = [
     "Branch",

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
+from clearjoint import checks as _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
@@ -366,7 +366,7 @@ class Energies(Mapping[str, FloatArray]):
         """
         import xarray as xr
 
-        from clearjoint._plotting import one_dimensional
+        from clearjoint.plotting import one_dimensional
 
         a = one_dimensional("amplitude", self.amplitude)
         return xr.Dataset(
@@ -388,7 +388,7 @@ class Energies(Mapping[str, FloatArray]):
         """
         import pandas as pd
 
-        from clearjoint._plotting import one_dimensional
+        from clearjoint.plotting import one_dimensional
 
         a = one_dimensional("amplitude", self.amplitude)
         return pd.DataFrame(
@@ -410,7 +410,7 @@ class Energies(Mapping[str, FloatArray]):
             One line per mechanism that dissipates anything, labelled as in the
             legend (``"total E_Z"`` last, thicker).
         """
-        from clearjoint._plotting import axes_or_new, one_dimensional
+        from clearjoint.plotting import axes_or_new, one_dimensional
 
         axes: Axes = axes_or_new(ax)
         a = one_dimensional("amplitude", self.amplitude)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
+from clearjoint import checks as _checks
 from clearjoint.errors import ParameterError, ParameterTypeError
 
 

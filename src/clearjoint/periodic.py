@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
+from clearjoint import checks as _checks
 from clearjoint.continuation import Branch, ContinuationSettings, continue_branch
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint

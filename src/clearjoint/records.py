@@ -30,7 +30,7 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint._checks import refuse_to_overwrite
+from clearjoint.checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.units import SI_UNITS, is_quantity, registry, to_si
 

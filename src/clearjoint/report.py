@@ -30,8 +30,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from clearjoint import fit
-from clearjoint._checks import refuse_to_overwrite
 from clearjoint.analysis import Analysis
+from clearjoint.checks import refuse_to_overwrite
 from clearjoint.findings import Finding, Timing, testable
 
 #: What the study assumes, stated in every report.

@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from clearjoint._checks import refuse_to_overwrite
 from clearjoint.analysis import Analysis, analyse
+from clearjoint.checks import refuse_to_overwrite
 from clearjoint.figures import identification_accuracy_figure, report_figures
 from clearjoint.findings import findings_table, law_timing
 from clearjoint.identify import identify_files

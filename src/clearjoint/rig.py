@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import signal
 
-from clearjoint._checks import refuse_to_overwrite
+from clearjoint.checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import quantity, read_toml
 from clearjoint.joint import Friction, Joint, Pin

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Literal, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
+from clearjoint import checks as _checks
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Joint
 
@@ -571,7 +571,7 @@ class StiffnessCurve:
         """
         import xarray as xr
 
-        from clearjoint._plotting import one_dimensional
+        from clearjoint.plotting import one_dimensional
 
         a = one_dimensional("amplitude", self.amplitude)
         j = self.joint
@@ -604,7 +604,7 @@ class StiffnessCurve:
         """
         import pandas as pd
 
-        from clearjoint._plotting import one_dimensional
+        from clearjoint.plotting import one_dimensional
 
         a = one_dimensional("amplitude", self.amplitude)
         names = {
@@ -631,7 +631,7 @@ class StiffnessCurve:
         matplotlib.axes.Axes
             Its last line is c_d against A in um, labelled with the clearance.
         """
-        from clearjoint._plotting import axes_or_new, one_dimensional
+        from clearjoint.plotting import axes_or_new, one_dimensional
 
         axes: Axes = axes_or_new(ax)
         a = one_dimensional("amplitude", self.amplitude)

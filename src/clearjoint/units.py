@@ -1,6 +1,6 @@
 """Engineering units at the edges: "0.106mm", "5um", "2513rad/s", "400rpm" into SI floats (pint).
 
-The command line, the file readers and the Python API's checks (``_checks``) use
+The command line, the file readers and the Python API's checks (``clearjoint.checks``) use
 this module; the physics never sees a unit. Every quantity is converted by its
 dimension. Frequencies keep their 2 pi: an angular unit (rad/s, deg/s, rpm) is
 an angular frequency, so "2513rad/s" is 400 Hz and "400rpm" is 6.667 Hz, while
@@ -248,7 +248,7 @@ def to_si(value: Any, unit: str, *, name: str) -> Any:
     command line: a bare *number* is SI, bare *text* is ambiguous.
 
     This is the one helper through which the Python API accepts units: the
-    validators of ``clearjoint._checks`` call it, so ``Joint(mass="2kg", ...)`` and
+    validators of ``clearjoint.checks`` call it, so ``Joint(mass="2kg", ...)`` and
     ``steady_state(joint, "1kN", "400Hz")`` work. ``unit`` is an SI unit of
     :data:`SI_UNITS` ("m", "N/m", "rad/s", "" for dimensionless).
 

@@ -35,8 +35,8 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
-from clearjoint._jit import njit  # numba.njit that survives a read-only install
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
+from clearjoint.jit import njit  # numba.njit that survives a read-only install
 
 FloatArray = NDArray[np.float64]
 

@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
-from clearjoint._jit import njit  # numba.njit that survives a read-only install
+from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
+from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.joint import ClearanceJoint, Friction, Joint
 from clearjoint.stiffness import viscous_coefficient
 

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from clearjoint._jit import njit  # numba.njit that survives a read-only install
+from clearjoint.jit import njit  # numba.njit that survives a read-only install
 
 # ---- parameter vector layout -------------------------------------------------------------
 P_MASS, P_DAMP, P_K0, P_KC, P_KT, P_GC, P_GT, P_F0, P_W, P_FF, P_E, P_FMODE, P_TF = range(13)

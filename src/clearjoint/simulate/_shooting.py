@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from clearjoint._jit import njit  # numba.njit that survives a read-only install
 from clearjoint.continuation import _extrapolate, _tangent_solve
+from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.simulate import _kernel as kn
 
 FloatArray = NDArray[np.float64]

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
+from clearjoint import checks as _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
@@ -257,7 +257,7 @@ class Motion:
         matplotlib.axes.Axes
             Its first line is x (um) against t (ms).
         """
-        from clearjoint._plotting import axes_or_new
+        from clearjoint.plotting import axes_or_new
 
         axes: Axes = axes_or_new(ax)
         axes.plot(self.time * 1e3, self.displacement * 1e6, color="black", lw=1.4, label="x")

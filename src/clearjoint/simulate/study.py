@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from clearjoint._checks import refuse_to_overwrite
+from clearjoint.checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import read_table, read_toml
 from clearjoint.joint import Friction, Joint, Losses, Pin

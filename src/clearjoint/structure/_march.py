@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from clearjoint._jit import njit  # numba.njit that survives a read-only install
+from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.simulate._kernel import certified_step
 
 #: Most Taylor terms per step; a step that needs more is halved.

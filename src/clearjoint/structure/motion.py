@@ -40,7 +40,7 @@ import scipy.linalg
 import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
-from clearjoint import _checks
+from clearjoint import checks as _checks
 from clearjoint.simulate.core import EnergyLedger, SimulationError
 from clearjoint.structure import _march
 from clearjoint.structure.model import (
