@@ -22,7 +22,15 @@ from pathlib import Path
 
 from clearjoint.checks import refuse_to_overwrite
 from clearjoint.records.brfd import read_brfd
-from clearjoint.records.lab_csv import _UTF16_BOMS, CSV_MAGIC, _decode, _read_csv, _write_csv
+from clearjoint.records.lab_csv import (
+    _UTF16_BOMS,
+    CSV_MAGIC,
+    SIDECAR_SUFFIX,
+    _decode,
+    _read_csv,
+    _write_csv,
+    sidecar_path,
+)
 from clearjoint.records.netcdf import _read_netcdf, _write_netcdf
 from clearjoint.records.record import Record, RecordError
 
@@ -131,7 +139,7 @@ def sniff(path: str | Path) -> str:
         raise RecordError(f"{where}: cannot read it ({exc.strerror})") from None
     if not head:
         raise RecordError(f"{where}: empty file")
-    if path.suffix.lower() == ".toml":  # else read as a CSV whose sidecar is itself
+    if path.suffix.lower() == SIDECAR_SUFFIX:  # else read as a CSV whose sidecar is itself
         raise RecordError(
             f"{where}: a TOML file is not a record; give the record file (a .toml beside a "
             "CSV of the same name holds that CSV's metadata)"
@@ -202,7 +210,7 @@ def mass_advice(source: str) -> str:
     lines = _decode(source, path.read_bytes()).splitlines()  # as _read_csv decodes it
     if lines and lines[0].strip() == CSV_MAGIC:
         return f"add the line '# mass = {value}'{mine} under the first line '{CSV_MAGIC}' of {path}"
-    sidecar = path.with_suffix(".toml")
+    sidecar = sidecar_path(path)
     if not sidecar.exists():
         return f"create {sidecar} holding the line 'mass = {value}'{mine}"
     from clearjoint.io_toml import read_toml

@@ -33,6 +33,14 @@ from clearjoint.records.record import (
 from clearjoint.units import SI_UNITS, registry
 
 CSV_MAGIC = "# clearjoint record 1"
+#: The ending of a lab CSV's sidecar: ``test.csv`` keeps its metadata in ``test.toml``.
+SIDECAR_SUFFIX = ".toml"
+
+
+def sidecar_path(path: Path) -> Path:
+    """Return the sidecar TOML file that holds a lab CSV's metadata (it may not exist)."""
+    return path.with_suffix(SIDECAR_SUFFIX)
+
 
 #: Metadata keys of the CSV header and sidecar, with the kind of quantity (or text).
 #: A quantity takes its unit (``clearance = "0.106mm"``), or a bare number in a key that
@@ -195,7 +203,7 @@ def _read_csv(path: Path, resample_: bool) -> Record:
         table = parse_toml("\n".join(block), where=where, what="record header", error=RecordError)
         meta = _metadata_from_toml(where, table)
     else:
-        sidecar = path.with_suffix(".toml")
+        sidecar = sidecar_path(path)
         if sidecar.exists():
             from clearjoint.io_toml import read_toml
 
