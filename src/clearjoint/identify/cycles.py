@@ -25,30 +25,14 @@ from numpy.typing import NDArray
 
 from clearjoint.errors import ClearjointError
 from clearjoint.identify._stats import median
-from clearjoint.records import (
-    CLOSURE,
-    MIN_STEADY,
-    PLATEAU,
-    STEADY_RULE,
-    Record,
-    steady_rule,
-)
+from clearjoint.records import CLOSURE as CLOSURE
+from clearjoint.records import MIN_STEADY as MIN_STEADY
+from clearjoint.records import PLATEAU as PLATEAU
+from clearjoint.records import STEADY_RULE as STEADY_RULE
+from clearjoint.records import Record
+from clearjoint.records import steady_rule as steady_rule
 
 FloatArray = NDArray[np.float64]
-
-__all__ = [
-    "CLOSURE",
-    "MIN_STEADY",
-    "PLATEAU",
-    "STEADY_RULE",
-    "IdentificationError",
-    "Stack",
-    "cycle_bounds",
-    "excitation_frequency",
-    "stack",
-    "steady",
-    "steady_rule",
-]
 
 
 class IdentificationError(ClearjointError, ValueError):

@@ -16,6 +16,11 @@ import numpy as np
 
 from clearjoint.records.record import FloatArray, Record, RecordError, _assemble, _factor
 
+__all__ = [
+    "BRFD_CITATION",
+    "read_brfd",
+]
+
 _BRFD_NAME = re.compile(
     r"(?P<frequency>[\d.]+)Hz(?P<tension>\d+)lbtension(?P<amplitude>[\d.]+)amplitude"
 )

@@ -34,6 +34,21 @@ from clearjoint.records.lab_csv import (
 from clearjoint.records.netcdf import _read_netcdf, _write_netcdf
 from clearjoint.records.record import Record, RecordError
 
+__all__ = [
+    "FORMATS",
+    "Reader",
+    "RecordFormat",
+    "Writer",
+    "import_readers",
+    "is_record_file",
+    "mass_advice",
+    "read_record",
+    "record_format",
+    "record_suffixes",
+    "sniff",
+    "write_record",
+]
+
 #: A reader: (path, resample) -> the file's Record.
 Reader = Callable[[Path, bool], Record]
 #: A writer: (record, path) -> None; the path is checked and its folder made by the caller.

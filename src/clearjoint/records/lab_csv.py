@@ -32,6 +32,13 @@ from clearjoint.records.record import (
 )
 from clearjoint.units import SI_UNITS, registry
 
+__all__ = [
+    "CSV_MAGIC",
+    "SIDECAR_SUFFIX",
+    "regular_time",
+    "sidecar_path",
+]
+
 CSV_MAGIC = "# clearjoint record 1"
 #: The ending of a lab CSV's sidecar: ``test.csv`` keeps its metadata in ``test.toml``.
 SIDECAR_SUFFIX = ".toml"

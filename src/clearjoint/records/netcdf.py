@@ -23,6 +23,10 @@ from clearjoint.records.record import (
     _factor,
 )
 
+__all__ = [
+    "record_dataset",
+]
+
 _NC_META = {
     "joint_id": "joint_id",
     "control": "control",

@@ -21,6 +21,26 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.units import is_quantity, registry, to_si
 
+__all__ = [
+    "CHANNELS",
+    "CLOSURE",
+    "FAST_FACTORS",
+    "GRAVITY_UNITS",
+    "MIN_CYCLES",
+    "MIN_SAMPLES",
+    "MIN_STEADY",
+    "PLATEAU",
+    "SI",
+    "STANDARD_GRAVITY",
+    "STEADY_RULE",
+    "UNIFORM_TOLERANCE",
+    "Record",
+    "RecordError",
+    "RecordWarning",
+    "resample",
+    "steady_rule",
+]
+
 FloatArray = NDArray[np.float64]
 
 CHANNELS = ("force", "displacement", "velocity", "acceleration")
