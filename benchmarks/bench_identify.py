@@ -45,7 +45,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from clearjoint.records import _brfd_json, read_record
+from clearjoint.records import read_record
+from clearjoint.records.brfd import _brfd_json
 from clearjoint.rig import load_campaign, run_campaign
 
 TARGET = 1e6
@@ -127,7 +128,7 @@ def _orjson_fromiter(raw: bytes) -> np.ndarray:
 
     import orjson
 
-    from clearjoint.records import _json_matrix
+    from clearjoint.records.brfd import _json_matrix
 
     gc.disable()
     try:

@@ -25,6 +25,7 @@ from clearjoint.checks import refuse_to_overwrite
 from clearjoint.figures import identification_accuracy_figure, report_figures
 from clearjoint.findings import findings_table, law_timing
 from clearjoint.identify import identify_files
+from clearjoint.records import RecordError, is_record_file, record_suffixes
 from clearjoint.report import Study, write_report
 from clearjoint.rig import Campaign, load_campaign, run_campaign
 from clearjoint.verification import identification_accuracy, model_checks, stiffness_study
@@ -36,9 +37,7 @@ def _record_files(folder: Path) -> list[str]:
     return sorted(
         str(p)
         for p in folder.iterdir()
-        if p.is_file()
-        and p.suffix.lower() in (".nc", ".csv", ".json", ".h5")
-        and p.name != "manifest.csv"
+        if p.is_file() and is_record_file(p) and p.name != "manifest.csv"
     )
 
 
@@ -72,9 +71,8 @@ def report_records(
     folder = Path(folder)
     files = _record_files(folder)
     if not files:
-        from clearjoint.records import RecordError
-
-        raise RecordError(f"{folder}: no record files (.nc, .csv, .json) in it")
+        endings = ", ".join(record_suffixes())
+        raise RecordError(f"{folder}: no record files ({endings}) in it")
     refuse_to_overwrite([Path(out_dir) / n for n in ("report.html", "results.json")], force=force)
     say(f"identifying {len(files)} records")
     results, failures = identify_files(files)

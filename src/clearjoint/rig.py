@@ -36,7 +36,7 @@ from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import quantity, read_toml
 from clearjoint.joint import Friction, Joint, Pin
 from clearjoint.parallel import process_pool, run_ordered
-from clearjoint.records import Record, write_record
+from clearjoint.records import Record, record_suffixes, write_record
 from clearjoint.simulate import SimulationError, steady_state, time_response
 
 FloatArray = NDArray[np.float64]
@@ -313,8 +313,10 @@ def _build(values: dict[str, Any], where: str) -> Campaign:
             f"{where}: grid.frequencies and grid.force_amplitudes must be non-empty and positive"
         )
     fmt = str(values["format"])
-    if fmt not in ("nc", "csv"):
-        raise CampaignError(f"{where}: format must be 'nc' or 'csv', got {fmt!r}")
+    writable = [suffix.lstrip(".") for suffix in record_suffixes(writable=True)]
+    if fmt not in writable:
+        choices = " or ".join(repr(name) for name in writable)
+        raise CampaignError(f"{where}: format must be {choices}, got {fmt!r}")
     return Campaign(
         rig=rig,
         structures=tuple(structures),

@@ -88,7 +88,7 @@ from clearjoint.identify.segments import (
     _line_fits,
     _windows,
 )
-from clearjoint.records import Record, mass_advice
+from clearjoint.records import Record, import_readers, mass_advice
 
 FloatArray = NDArray[np.float64]
 
@@ -813,16 +813,6 @@ def _identify_path(args: tuple[str, bool, float]) -> tuple[Record, Identificatio
 Outcome = tuple[Record, Identification] | str
 
 
-def _warm_readers(paths: list[str]) -> None:
-    """Import the readers these files need before the workers fork, so that each starts
-    with them loaded instead of importing them again."""
-    suffixes = {Path(path).suffix.lower() for path in paths}
-    if suffixes & {".nc", ".h5", ".hdf5"}:
-        import h5py  # noqa: F401
-    if ".json" in suffixes:
-        import simdjson  # noqa: F401
-
-
 def _size(path: str) -> int:
     try:
         return Path(path).stat().st_size
@@ -877,7 +867,7 @@ def identify_files(
     if jobs > 1 and len(tasks) > 1 and hasattr(os, "fork"):
         from clearjoint.identify._pool import run_forked
 
-        _warm_readers([path for path, _, _ in tasks])
+        import_readers([path for path, _, _ in tasks])  # before the workers fork
         sizes = [_size(path) for path, _, _ in tasks]
         order = sorted(range(len(tasks)), key=lambda i: (-sizes[i], i))
         run_forked(_identify_path, tasks, order, jobs, finished)

@@ -2,7 +2,9 @@
 
 MODEL.md section 3 ("per test record and per cycle"). The one rule for steady cycles,
 used by every path of the identification (joint, damper, line) and quoted in its
-error messages, is :data:`STEADY_RULE`.
+error messages, is :data:`STEADY_RULE`: it is stated beside the record it judges
+(:mod:`clearjoint.records.record`, which refuses a record too short for it) and applied
+here by :func:`steady`; this module re-exports it and its constants.
 
 The steady cycles are stacked on a common phase grid, shape (n_cycles, M): sample for
 sample when the sampling rate is a multiple of the frequency (as in most test rigs),
@@ -23,36 +25,14 @@ from numpy.typing import NDArray
 
 from clearjoint.errors import ClearjointError
 from clearjoint.identify._stats import median
+from clearjoint.records import CLOSURE as CLOSURE
+from clearjoint.records import MIN_STEADY as MIN_STEADY
+from clearjoint.records import PLATEAU as PLATEAU
+from clearjoint.records import STEADY_RULE as STEADY_RULE
 from clearjoint.records import Record
+from clearjoint.records import steady_rule as steady_rule
 
 FloatArray = NDArray[np.float64]
-
-#: Steady cycles a record needs.
-MIN_STEADY = 3
-#: A steady cycle's first and last displacement differ by at most this part of its
-#: amplitude: a cycle that starts on the ramp is not steady even if it ends on the plateau.
-CLOSURE = 0.15
-#: The plateau: the cycles whose amplitude is at least this part of the largest one.
-PLATEAU = 0.9
-
-
-def _percent(part: float) -> str:
-    return f"{100 * part:.3g} %"
-
-
-def steady_rule(tolerance: float) -> str:
-    """The steady-cycle rule in words, for the docs and every error message."""
-    return (
-        f"a cycle (minimum to minimum of the fundamental) is steady when its amplitude is "
-        f"within {_percent(tolerance)} of the plateau amplitude A, its mean position within "
-        f"{_percent(tolerance)} of A from the plateau mean, and its first and last displacement "
-        f"differ by at most {_percent(CLOSURE)} of A (A and the plateau mean are the medians "
-        f"over the cycles whose amplitude is at least {_percent(PLATEAU)} of the largest); "
-        f"a record needs at least {MIN_STEADY} steady cycles, and all of them are used"
-    )
-
-
-STEADY_RULE = steady_rule(0.03)
 
 
 class IdentificationError(ClearjointError, ValueError):
