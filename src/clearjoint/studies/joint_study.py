@@ -25,6 +25,7 @@ from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import read_table, read_toml
 from clearjoint.joint import Friction, Joint, Losses, Pin
 from clearjoint.simulate.core import Motion, SteadyState, steady_state, time_response
+from clearjoint.studies.rules import hole_radius
 
 #: Every key a study may give, with its default (None: required) and the kind of quantity.
 DEFAULT_STUDY: dict[str, dict[str, tuple[Any, str]]] = {
@@ -212,7 +213,9 @@ def _build(
         hole = pv["hole_radius"]
         pin = Pin(
             radius=pv["radius"],
-            hole_radius=pv["radius"] + 0.5 * joint.clearance if isinstance(hole, str) else hole,
+            hole_radius=(
+                hole_radius(pv["radius"], joint.clearance) if isinstance(hole, str) else hole
+            ),
             length=pv["length"],
             youngs_modulus=pv["youngs_modulus"],
             poisson_ratio=pv["poisson_ratio"],
@@ -247,11 +250,7 @@ def _build(
 def run_study(study: Study) -> Motion:
     """Run the study: the steady state (default) or the transient response."""
     common: dict[str, Any] = {
-        "damping_ratio": study.damping_ratio,
-        "friction": study.friction,
-        "restitution": study.restitution,
-        "pin": study.pin,
-        "contact_friction_coefficient": study.contact_friction_coefficient,
+        "losses": study.losses,
         "samples_per_period": study.samples_per_period,
         "initial": study.initial,
     }
