@@ -456,46 +456,72 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     return values
 
 
-def _json_value(values: np.ndarray, several: bool) -> Any:
-    """A JSON number for one amplitude, a list for several; inf becomes null."""
-    cleaned = [float(v) if np.isfinite(v) else None for v in np.atleast_1d(values)]
-    return cleaned if several else cleaned[0]
-
-
 def _run_stiffness(args: argparse.Namespace) -> int:
     from clearjoint import stiffness
     from clearjoint.studies import joint_at
+    from clearjoint.studies.text import json_value, stiffness_lines, stiffness_table
 
     joint = joint_at(None, _overrides(args), _NAMES)
     amplitudes = _amplitudes(args)
     plot = _plot_target(args)
     _save_plot(stiffness.stiffness_curve(joint, amplitudes), plot, quiet=args.json)
-    period = stiffness.period(joint, amplitudes)
-    with np.errstate(divide="ignore"):
-        frequency_hz = 1.0 / period
-    k_d = stiffness.dynamic_stiffness(joint, amplitudes)
-    c_d = stiffness.stiffness_coefficient(joint, amplitudes)
+    table = stiffness_table(joint, amplitudes)
     several = amplitudes.size > 1
     if args.json:
-        out = {
-            "amplitude_m": _json_value(amplitudes, several),
-            "period_s": _json_value(period, several),
-            "natural_frequency_hz": _json_value(frequency_hz, several),
-            "dynamic_stiffness_n_per_m": _json_value(k_d, several),
-            "stiffness_coefficient": _json_value(c_d, several),
-        }
+        print(json.dumps({key: json_value(val, several) for key, val in table.items()}))
+    else:
+        print("\n".join(stiffness_lines(joint, table)))
+    return 0
+
+
+def _run_dissipation(args: argparse.Namespace) -> int:
+    from clearjoint import dissipation
+    from clearjoint.studies import joint_at, load_study, losses_at
+    from clearjoint.studies.text import dissipation_lines, json_value
+
+    base = load_study(args.study) if args.study else None
+    given = _overrides(args)
+    joint = joint_at(base.joint if base is not None else None, given, _NAMES)
+    losses = losses_at(base, joint, given, _NAMES)
+    amplitudes = _amplitudes(args)
+    plot = _plot_target(args)
+    values = dissipation.energies(joint, amplitudes, losses=losses)
+    _save_plot(values, plot, quiet=args.json)
+    several = amplitudes.size > 1
+    if args.json:
+        out = {"amplitude_m": json_value(amplitudes, several)}
+        out.update({key: json_value(val, several) for key, val in values.items()})
         print(json.dumps(out))
+    else:
+        print("\n".join(dissipation_lines(joint, losses, amplitudes, values)))
+    return 0
+
+
+def _run_simulate(args: argparse.Namespace) -> int:
+    from clearjoint.studies import load_study, run_study, summary, write_netcdf
+    from clearjoint.studies.text import simulation_lines
+
+    study = load_study(args.study)
+    if args.out:
+        from clearjoint.checks import refuse_to_overwrite
+
+        if Path(args.out).suffix.lower() != ".nc":
+            raise ParameterError(
+                f"--out {args.out}: simulate writes netCDF; name the file .nc, e.g. result.nc"
+            )
+        refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    plot = _plot_target(args)
+    motion = run_study(study)
+    _save_plot(motion, plot, quiet=args.json)
+    result = summary(study, motion)
+    if args.out:
+        write_netcdf(study, motion, args.out, force=args.force)
+    if args.json:
+        print(json.dumps(result))
         return 0
-    print(
-        f"joint: m = {joint.mass:g} kg, c = {joint.clearance * 1e3:g} mm, "
-        f"k_c = {joint.compression_stiffness:.4g} N/m, k_t = {joint.tension_stiffness:.4g} N/m, "
-        f"k0 = {joint.gap_stiffness:.4g} N/m, k_inf = {joint.large_amplitude_stiffness:.4g} N/m"
-    )
-    header = f"{'A (um)':>12} {'T (ms)':>12} {'f_n (Hz)':>12} {'k_d (N/m)':>12} {'c_d':>8}"
-    print(header)
-    print("-" * len(header))
-    for a, t, f, k, c in zip(amplitudes, period, frequency_hz, k_d, c_d, strict=True):
-        print(f"{a * 1e6:12.4g} {t * 1e3:12.5g} {f:12.5g} {k:12.5g} {c:8.4f}")
+    lines = simulation_lines(study.source, study.mode, result)
+    print("\n".join(lines + ([f"wrote {args.out}"] if args.out else [])))
     return 0
 
 
@@ -504,52 +530,6 @@ def _amplitudes(args: argparse.Namespace) -> Any:
 
     values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
     return np.array(values)
-
-
-def _run_dissipation(args: argparse.Namespace) -> int:
-    from clearjoint import dissipation
-    from clearjoint.studies import joint_at, load_study, losses_at
-
-    base = load_study(args.study) if args.study else None
-    values = _overrides(args)
-    joint = joint_at(base.joint if base is not None else None, values, _NAMES)
-    losses = losses_at(base, joint, values, _NAMES)
-    amplitudes = _amplitudes(args)
-    plot = _plot_target(args)
-    values = dissipation.energies(joint, amplitudes, losses=losses)
-    _save_plot(values, plot, quiet=args.json)
-    several = amplitudes.size > 1
-    if args.json:
-        out = {"amplitude_m": _json_value(amplitudes, several)}
-        out.update({key: _json_value(val, several) for key, val in values.items()})
-        print(json.dumps(out))
-        return 0
-    print(
-        f"joint: m = {joint.mass:g} kg, c = {joint.clearance * 1e3:g} mm, "
-        f"k_c = {joint.compression_stiffness:.4g} N/m, k_t = {joint.tension_stiffness:.4g} N/m"
-    )
-    friction, pin = losses.friction, losses.pin
-    print(
-        f"losses: mu_s P = {friction.force if friction else 0.0:g} N "
-        f"({friction.region if friction else 'none'}), e = {losses.restitution:g}, "
-        f"zeta = {losses.damping_ratio:g}, mu_c = {losses.contact_friction_coefficient:g}"
-        + (f", pin R = {pin.radius * 1e3:g} mm, L = {pin.length * 1e3:g} mm" if pin else "")
-    )
-    columns = [
-        ("A (um)", amplitudes * 1e6),
-        ("E_P (mJ)", values["sliding_friction_j"] * 1e3),
-        ("E_P paper", values["sliding_friction_paper_j"] * 1e3),
-        ("E_C (mJ)", values["contact_friction_j"] * 1e3),
-        ("E_I (mJ)", values["impact_j"] * 1e3),
-        ("E_v (mJ)", values["viscous_j"] * 1e3),
-        ("total (mJ)", values["total_j"] * 1e3),
-        ("eta", values["loss_factor"]),
-        ("b (um)", values["hertz_half_width_m"] * 1e6),
-    ]
-    print(" ".join(f"{name:>11}" for name, _ in columns))
-    for row in zip(*(np.atleast_1d(col) for _, col in columns), strict=True):
-        print(" ".join(f"{value:11.4g}" for value in row))
-    return 0
 
 
 def _run_rig(args: argparse.Namespace) -> int:
@@ -640,54 +620,6 @@ def _run_identify(args: argparse.Namespace) -> int:
         f"identified {len(results)} of {len(args.files)} records ({flagged} flagged, see the "
         f"flag and flag_reason columns); wrote {out}"
     )
-    return 0
-
-
-def _run_simulate(args: argparse.Namespace) -> int:
-    from clearjoint.simulate.study import load_study, run_study, summary, write_netcdf
-
-    study = load_study(args.study)
-    if args.out:
-        from clearjoint.checks import refuse_to_overwrite
-
-        if Path(args.out).suffix.lower() != ".nc":
-            raise ParameterError(
-                f"--out {args.out}: simulate writes netCDF; name the file .nc, e.g. result.nc"
-            )
-        refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    plot = _plot_target(args)
-    motion = run_study(study)
-    _save_plot(motion, plot, quiet=args.json)
-    result = summary(study, motion)
-    if args.out:
-        write_netcdf(study, motion, args.out, force=args.force)
-    if args.json:
-        print(json.dumps(result))
-        return 0
-    energy = result["energy_j"]
-    lines = [
-        f"study: {study.source} ({study.mode})",
-        f"excitation: {study.force_amplitude:g} N at {result['frequency_hz']:g} Hz",
-        f"amplitude X = {result['amplitude_m'] * 1e6:.4g} um "
-        f"(x_max {result['x_max_m'] * 1e6:.4g} um, x_min {result['x_min_m'] * 1e6:.4g} um)",
-    ]
-    if "period_multiple" in result:
-        lines.append(
-            f"period-{result['period_multiple']} orbit, reached after "
-            f"{result['periods_to_converge']} forcing periods"
-        )
-    lines.append(
-        f"events {result['events']}, impacts {result['impacts']}, "
-        f"stuck {result['stick_time_s'] * 1e3:.4g} ms"
-    )
-    lines.append(
-        "energy per orbit (J): " + ", ".join(f"{key} {val:.5g}" for key, val in energy.items())
-    )
-    lines.append(f"balance error {result['balance_error']:.2e}")
-    if args.out:
-        lines.append(f"wrote {args.out}")
-    print("\n".join(lines))
     return 0
 
 
@@ -920,7 +852,13 @@ def _amplitude_range(text: str, points: int) -> Any:
 
 
 def _run_frf(args: argparse.Namespace) -> int:
-    from clearjoint.studies import frequency_response_of, load_any_study, write_curve
+    from clearjoint.studies import (
+        curve_summary,
+        frequency_response_of,
+        load_any_study,
+        write_curve,
+    )
+    from clearjoint.studies.text import curve_lines, curve_warnings
     from clearjoint.units import parse_quantity
 
     # a force curve takes its forces from --from/--to, not from the study
@@ -968,50 +906,13 @@ def _run_frf(args: argparse.Namespace) -> int:
     )
     write_curve(curve, args.out, study.source)
     _save_plot(curve, plot_path, quiet=True)
-    return _print_frf(args, curve, study.source)
-
-
-def _print_frf(args: argparse.Namespace, curve: Any, source: str) -> int:
-    """Print the curve's warnings on stderr, then the curve (--json) or a summary."""
-    from clearjoint.studies import curve_summary
-
-    if curve.stop_reason != "reached":
-        print(
-            f"clearjoint frf: warning: the continuation stopped early ({curve.stop_reason}) at "
-            f"{curve.omega[-1] / (2 * math.pi):.6g} Hz, {curve.force_amplitude[-1]:.6g} N; "
-            "the curve covers only part of the range",
-            file=sys.stderr,
-        )
-    untrusted = [e for e in curve.events if e.kind == "untrusted"]
-    if untrusted:  # harmonic balance of a structure: orbits the exact motion does not follow
-        where = ", ".join(f"{e.omega / (2 * math.pi):.4g}" for e in untrusted)
-        print(
-            f"clearjoint frf: warning: at {where} Hz the harmonic-balance orbit misses one "
-            "period of the exact motion, so its stability is not to be trusted; raise "
-            "--harmonics or lower the force (docs/harmonic.md)",
-            file=sys.stderr,
-        )
+    for warning in curve_warnings(curve):
+        print(f"clearjoint frf: warning: {warning}", file=sys.stderr)
     if args.json:
         print(json.dumps(curve_summary(curve)))
         return 0
-    lines = [f"study: {source}", repr(curve)]
-    free = getattr(curve, "free_play", None)
-    if free is not None and free.any():
-        by_force = curve.parameter == "force"
-        span = curve.force_amplitude[free] if by_force else curve.omega[free] / (2 * math.pi)
-        unit = f"N at {curve.omega[0] / (2 * math.pi):.6g} Hz" if by_force else "Hz"
-        lines.append(
-            f"free play from {span.min():.6g} to {span.max():.6g} {unit}: the orbit stays inside "
-            "the gap (gap_stiffness 0), one of a continuum; its amplitude is set by the dynamics, "
-            "its position is not (the curve shows the orbit centred in the gap)"
-        )
-    for e in curve.events:
-        lines.append(
-            f"{e.kind}: {e.omega / (2 * math.pi):.6g} Hz, {e.force_amplitude:.6g} N, "
-            f"X = {e.amplitude * 1e6:.5g} um"
-        )
-    lines.append(f"wrote {args.out}" + (f" and {args.plot}" if args.plot else ""))
-    print("\n".join(lines))
+    wrote = f"wrote {args.out}" + (f" and {args.plot}" if args.plot else "")
+    print("\n".join([*curve_lines(curve, study.source), wrote]))
     return 0
 
 
