@@ -164,7 +164,7 @@ def _structure_curve(
         )
     refuse_harmonic_structure(study, "frf")
     h = DEFAULT_HARMONICS if harmonics is None else harmonics
-    common = {"harmonics": h, "samples": checked_samples(samples, h, names)}
+    samples = checked_samples(samples, h, names)
     if parameter == "force":
         hz = frequency if frequency is not None else study.omega / (2.0 * math.pi)
         pattern = study.force * (start / float(np.max(np.abs(study.force))))
@@ -174,7 +174,8 @@ def _structure_curve(
                 pattern,
                 2.0 * math.pi * hz,
                 None,
-                **common,
+                harmonics=h,
+                samples=samples,
                 parameter="force",
                 force_stop=stop,
                 max_points=max_points,
@@ -187,7 +188,8 @@ def _structure_curve(
             study.force,
             2.0 * math.pi * start,
             2.0 * math.pi * stop,
-            **common,
+            harmonics=h,
+            samples=samples,
             max_points=max_points,
         )
     except NoPeriodicResponse as exc:

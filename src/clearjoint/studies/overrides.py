@@ -258,8 +258,8 @@ def structure_at(study: StructureStudy, values: Values) -> StructureStudy:
         return study
     members = list(structure.members)
     for j, m in enumerate(structure.joint_members):
-        joint = members[m].joint
-        changes = {**common, **each.get(j, {})}
+        joint: Any = members[m].joint  # a joint member carries its joint
+        changes: dict[str, Any] = {**common, **each.get(j, {})}
         if (
             "compression_stiffness" in changes
             and "tension_stiffness" not in changes

@@ -7,6 +7,7 @@ mJ); the command line prints these lines as they are.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -56,7 +57,7 @@ def stiffness_lines(joint: Joint, table: dict[str, Any]) -> list[str]:
 
 
 def dissipation_lines(
-    joint: Joint, losses: Losses, amplitudes: Any, values: dict[str, Any]
+    joint: Joint, losses: Losses, amplitudes: Any, values: Mapping[str, Any]
 ) -> list[str]:
     """Return the joint, its losses and a table of energies per cycle (MODEL.md eq 10-18)."""
     friction, pin = losses.friction, losses.pin
