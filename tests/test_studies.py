@@ -41,21 +41,21 @@ length = "25mm"
 """
 
 CHAIN = """
-[structure]
-kind = "chain"
-masses = ["2kg", "1.5kg"]
-stiffnesses = ["inf", "6e7N/m"]
-joints = [true, false]
-
 [joint]
 clearance = "0.1mm"
 compression_stiffness = "8e7N/m"
 restitution = 0.5
 
+[structure]
+kind = "chain"
+joints = [true, false]
+masses = ["2kg", "1.5kg"]
+stiffnesses = ["inf", "6e7N/m"]
+
 [excitation]
-frequency = "600Hz"
 force_dof = "n2x"
 force_amplitude = "500N"
+frequency = "600Hz"
 """
 
 CLI_NAMES = {"joint.mass": "--mass", "losses.friction_coefficient": "--friction-coefficient",

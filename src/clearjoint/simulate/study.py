@@ -6,22 +6,5 @@ values over it and runs it; these names stay importable from ``clearjoint.simula
 
 from __future__ import annotations
 
-from clearjoint.studies.joint_study import (
-    DEFAULT_STUDY,
-    Study,
-    StudyError,
-    load_study,
-    run_study,
-    summary,
-    write_netcdf,
-)
-
-__all__ = [
-    "DEFAULT_STUDY",
-    "Study",
-    "StudyError",
-    "load_study",
-    "run_study",
-    "summary",
-    "write_netcdf",
-]
+from clearjoint.studies.joint_study import *  # noqa: F403  (every public name, as before)
+from clearjoint.studies.joint_study import __all__ as __all__

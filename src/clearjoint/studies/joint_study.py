@@ -27,6 +27,16 @@ from clearjoint.joint import Friction, Joint, Losses, Pin
 from clearjoint.simulate.core import Motion, SteadyState, steady_state, time_response
 from clearjoint.studies.rules import hole_radius
 
+__all__ = [
+    "DEFAULT_STUDY",
+    "Study",
+    "StudyError",
+    "load_study",
+    "run_study",
+    "summary",
+    "write_netcdf",
+]
+
 #: Every key a study may give, with its default (None: required) and the kind of quantity.
 DEFAULT_STUDY: dict[str, dict[str, tuple[Any, str]]] = {
     "joint": {
