@@ -562,11 +562,7 @@ def _run_rig(args: argparse.Namespace) -> int:
 def _run_identify(args: argparse.Namespace) -> int:
     from clearjoint.checks import refuse_to_overwrite
     from clearjoint.identify import identify_files
-    from clearjoint.studies.identify import (
-        figure_files,
-        write_identification_figures,
-        write_identifications,
-    )
+    from clearjoint.studies.identify import write_identification_results
 
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
@@ -602,18 +598,9 @@ def _run_identify(args: argparse.Namespace) -> int:
     if not results:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
-    rows = [ident.row() for _, ident in results]
-    if args.figures:  # every output checked before any is written
-        targets = [t for _, ident in results for t in figure_files(ident, Path(args.figures))]
-        refuse_to_overwrite(targets, force=args.force, option="--figures")
-    write_identifications(rows, out)
-    if args.figures:
-        write_identification_figures(results, Path(args.figures), force=args.force)
+    figures = Path(args.figures) if args.figures else None
+    write_identification_results(results, out, figures=figures, plot=plot, force=args.force)
     if plot is not None:
-        from clearjoint.identify import identifications_figure
-
-        plot.parent.mkdir(parents=True, exist_ok=True)
-        identifications_figure([ident for _, ident in results]).savefig(plot, dpi=100)
         print(f"wrote {plot}")
     flagged = sum(ident.flag != "ok" for _, ident in results)
     print(

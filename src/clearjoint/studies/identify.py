@@ -34,6 +34,33 @@ def write_identifications(rows: list[dict[str, Any]], out: Path) -> None:
     data.to_netcdf(out, engine="h5netcdf")
 
 
+def write_identification_results(
+    results: list[Any], out: Path, *, figures: Path | None, plot: Path | None, force: bool
+) -> None:
+    """Write the table ``out``, two figures per test into ``figures``, all loops to ``plot``.
+
+    Every figure file is checked before any output is written.
+
+    Raises
+    ------
+    OutputExistsError
+        A figure exists and ``force`` is False.
+    """
+    from clearjoint.checks import refuse_to_overwrite
+
+    if figures is not None:
+        targets = [t for _, ident in results for t in figure_files(ident, figures)]
+        refuse_to_overwrite(targets, force=force, option="--figures")
+    write_identifications([ident.row() for _, ident in results], out)
+    if figures is not None:
+        write_identification_figures(results, figures, force=force)
+    if plot is not None:
+        from clearjoint.identify import identifications_figure
+
+        plot.parent.mkdir(parents=True, exist_ok=True)
+        identifications_figure([ident for _, ident in results]).savefig(plot, dpi=100)
+
+
 def figure_files(ident: Any, folder: Path) -> list[Path]:
     """Return the two figure files of one identification: its stages and its loop."""
     stem = Path(ident.source).stem
