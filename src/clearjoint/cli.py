@@ -368,7 +368,7 @@ def _modes_parser(sub: Any) -> None:
         "--amplitude", required=True, help="modal amplitude range, e.g. 1um..1mm (or one value)"
     )
     p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
-    p.add_argument("--harmonics", type=int, default=7, help="H (default 7)")
+    p.add_argument("--harmonics", type=int, help="H (default 7)")
     _add_samples_option(p)
     p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
     _add_plot_option(p, force=False)
@@ -845,6 +845,7 @@ def _run_frf(args: argparse.Namespace) -> int:
         load_any_study,
         write_curve,
     )
+    from clearjoint.structure.study import StructureStudy
     from clearjoint.studies.text import curve_lines, curve_warnings
     from clearjoint.units import parse_quantity
 
@@ -868,7 +869,7 @@ def _run_frf(args: argparse.Namespace) -> int:
         )
     if args.max_points < 2:
         raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
-    structure = not hasattr(study, "joint")
+    structure = isinstance(study, StructureStudy)
     for option, given in (("--harmonics", args.harmonics), ("--samples", args.samples)):
         if args.method != "harmonic" and given is not None and not structure:
             raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")

@@ -29,6 +29,17 @@ from clearjoint.studies.harmonic import (
 from clearjoint.studies.joint_study import Study, StudyError, load_study
 from clearjoint.studies.rules import DEFAULT_HARMONICS
 
+__all__ = [
+    "curve_summary",
+    "frequency_response_of",
+    "load_any_study",
+    "mode_summary",
+    "name_dofs",
+    "nonlinear_modes_of",
+    "solver_losses",
+    "write_curve",
+]
+
 AnyStudy = Study | StructureStudy
 
 
@@ -201,17 +212,21 @@ def nonlinear_modes_of(
     mode: int,
     amplitudes: Any,
     *,
-    harmonics: int = DEFAULT_HARMONICS,
+    harmonics: int | None = None,
     samples: int | None = None,
     names: Mapping[str, str] | None = None,
 ) -> Any:
     """Return the study's nonlinear mode against amplitude by EPMC (MODEL.md 5.4).
+
+    ``harmonics`` defaults to :data:`DEFAULT_HARMONICS`.
 
     Raises
     ------
     ParameterError
         H below 1, too few samples, or what harmonic balance cannot carry.
     """
+    if harmonics is None:
+        harmonics = DEFAULT_HARMONICS
     if harmonics < 1:
         name = (names or {}).get("harmonics", "harmonics")
         raise ParameterError(f"{name} must be an integer >= 1, got {harmonics}")

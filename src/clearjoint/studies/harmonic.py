@@ -16,6 +16,13 @@ from clearjoint.errors import ParameterError
 from clearjoint.structure.study import StructureStudy
 from clearjoint.studies.joint_study import Study
 
+__all__ = [
+    "checked_samples",
+    "no_orbit",
+    "refuse_harmonic_losses",
+    "refuse_harmonic_structure",
+]
+
 #: What to do instead of harmonic balance, by the command that asked for it.
 _EXACT_ROUTE = {
     "frf": "drop --method harmonic (exact shooting carries it)",

@@ -11,6 +11,13 @@ from typing import Any
 
 import numpy as np
 
+__all__ = [
+    "figure_files",
+    "write_identification_figures",
+    "write_identification_results",
+    "write_identifications",
+]
+
 
 def write_identifications(rows: list[dict[str, Any]], out: Path) -> None:
     """Write one row per identified record to ``out`` (.csv, else netCDF over ``file``)."""

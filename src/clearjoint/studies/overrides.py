@@ -24,6 +24,16 @@ from clearjoint.structure.study import StructureStudy
 from clearjoint.studies.joint_study import DEFAULT_STUDY, Study
 from clearjoint.studies.rules import hole_radius, is_default_hole, tension_follows
 
+__all__ = [
+    "JOINT_FIELDS",
+    "PIN_FIELDS",
+    "joint_at",
+    "losses_at",
+    "pin_at",
+    "structure_at",
+    "study_at",
+]
+
 #: The fields of a Joint a value may set, in the order a missing one is reported.
 JOINT_FIELDS = (
     "mass",

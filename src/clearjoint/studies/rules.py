@@ -12,6 +12,13 @@ from __future__ import annotations
 import math
 from typing import Protocol
 
+__all__ = [
+    "DEFAULT_HARMONICS",
+    "hole_radius",
+    "is_default_hole",
+    "tension_follows",
+]
+
 #: Harmonics H that harmonic balance keeps when a study or command does not say.
 DEFAULT_HARMONICS = 7
 

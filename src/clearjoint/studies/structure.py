@@ -17,6 +17,12 @@ import numpy as np
 from clearjoint.errors import ParameterError
 from clearjoint.structure.study import StructureStudy
 
+__all__ = [
+    "STRUCTURE_TASKS",
+    "StructureTaskResult",
+    "run_structure_task",
+]
+
 #: The tasks :func:`run_structure_task` runs.
 STRUCTURE_TASKS = ("modes", "respond", "decay")
 

@@ -14,6 +14,16 @@ import numpy as np
 
 from clearjoint.joint import Joint, Losses
 
+__all__ = [
+    "curve_lines",
+    "curve_warnings",
+    "dissipation_lines",
+    "json_value",
+    "simulation_lines",
+    "stiffness_lines",
+    "stiffness_table",
+]
+
 
 def json_value(values: Any, several: bool) -> Any:
     """Return a JSON number for one amplitude, a list for several; inf becomes null."""
