@@ -839,13 +839,13 @@ def _amplitude_range(text: str, points: int) -> Any:
 
 
 def _run_frf(args: argparse.Namespace) -> int:
+    from clearjoint.structure.study import StructureStudy
     from clearjoint.studies import (
         curve_summary,
         frequency_response_of,
         load_any_study,
         write_curve,
     )
-    from clearjoint.structure.study import StructureStudy
     from clearjoint.studies.text import curve_lines, curve_warnings
     from clearjoint.units import parse_quantity
 
