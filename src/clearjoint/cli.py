@@ -258,20 +258,6 @@ def _add_samples_option(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _samples(args: argparse.Namespace, harmonics: int) -> int | None:
-    """--samples checked against --harmonics (aliasing) in CLI terms; None for the default."""
-    if args.samples is None:
-        return None
-    least = 2 * (2 * harmonics + 1)
-    if harmonics >= 1 and args.samples < least:
-        raise ParameterError(
-            f"--samples {args.samples} is too few for --harmonics {harmonics}: give at least "
-            f"2 (2H + 1) = {least} (fewer alias the joint law's higher harmonics onto the "
-            "kept ones), or leave --samples out for the default"
-        )
-    return int(args.samples)
-
-
 #: Figure formats ``--plot`` writes (matplotlib picks the format from the suffix).
 PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
@@ -382,7 +368,7 @@ def _modes_parser(sub: Any) -> None:
         "--amplitude", required=True, help="modal amplitude range, e.g. 1um..1mm (or one value)"
     )
     p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
-    p.add_argument("--harmonics", type=int, default=7, help="H (default 7)")
+    p.add_argument("--harmonics", type=int, help="H (default 7)")
     _add_samples_option(p)
     p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
     _add_plot_option(p, force=False)
@@ -427,94 +413,115 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _option(args: argparse.Namespace, option: str, kind: str) -> float | None:
-    """The value of ``--option`` in SI, None when not given; a bare number is refused."""
+#: Options that set a study value: (option, its key in the study file, kind of quantity).
+_STUDY_OPTIONS = (
+    ("mass", "joint.mass", "mass"),
+    ("clearance", "joint.clearance", "length"),
+    ("stiffness", "joint.compression_stiffness", "stiffness"),
+    ("tension-stiffness", "joint.tension_stiffness", "stiffness"),
+    ("gap-stiffness", "joint.gap_stiffness", "stiffness"),
+    ("gap-offset", "joint.gap_offset", "length"),
+    ("friction-coefficient", "losses.friction_coefficient", "dimensionless"),
+    ("lateral-load", "losses.lateral_load", "force"),
+    ("friction-region", "losses.friction_region", "text"),
+    ("restitution", "losses.restitution", "dimensionless"),
+    ("damping-ratio", "losses.damping_ratio", "dimensionless"),
+    ("pin-radius", "pin.radius", "length"),
+    ("pin-length", "pin.length", "length"),
+    ("hole-radius", "pin.hole_radius", "length"),
+    ("youngs-modulus", "pin.youngs_modulus", "pressure"),
+    ("poisson-ratio", "pin.poisson_ratio", "dimensionless"),
+    ("contact-friction-coefficient", "losses.contact_friction_coefficient", "dimensionless"),
+)
+#: How the study layer's errors name each value: as the option that gives it.
+_NAMES = {key: f"--{option}" for option, key, _ in _STUDY_OPTIONS} | {
+    "samples": "--samples",
+    "harmonics": "--harmonics",
+}
+
+
+def _overrides(args: argparse.Namespace) -> dict[str, Any]:
+    """The study values given as options, in SI by study key; a bare number is refused."""
     from clearjoint.units import parse_quantity
 
-    text = getattr(args, option.replace("-", "_"))
-    if text is None:
-        return None
-    return parse_quantity(text, kind, name=f"--{option}", bare="refuse")
-
-
-def _missing(option: str) -> ParameterError:
-    return ParameterError(f"--{option} is missing: give --{option} or put it in the study file")
-
-
-#: Joint options: (option, kind, Joint field).
-_JOINT_OPTIONS = (
-    ("mass", "mass", "mass"),
-    ("clearance", "length", "clearance"),
-    ("stiffness", "stiffness", "compression_stiffness"),
-    ("tension-stiffness", "stiffness", "tension_stiffness"),
-    ("gap-stiffness", "stiffness", "gap_stiffness"),
-    ("gap-offset", "length", "gap_offset"),
-)
-
-
-def _joint_from(args: argparse.Namespace, base: Any | None = None) -> Any:
-    """The joint from the options, each over the study joint ``base`` (if any).
-
-    A tension stiffness that the study left equal to the compression one follows
-    ``--stiffness``; one the study set on its own is kept unless overridden.
-    """
-    from clearjoint.joint import Joint
-
-    given = {field: _option(args, option, kind) for option, kind, field in _JOINT_OPTIONS}
-    values: dict[str, float] = {}
-    for option, _kind, field in _JOINT_OPTIONS:
-        value = given[field]
-        if value is None and base is not None:
-            value = getattr(base, field)
-        if value is None and field in ("mass", "clearance", "compression_stiffness"):
-            raise _missing(option)
-        if value is not None:
-            values[field] = value
-    follows = base is None or base.tension_stiffness == base.compression_stiffness
-    if given["tension_stiffness"] is None and follows:
-        values["tension_stiffness"] = values["compression_stiffness"]
-    return Joint(**values)
-
-
-def _json_value(values: np.ndarray, several: bool) -> Any:
-    """A JSON number for one amplitude, a list for several; inf becomes null."""
-    cleaned = [float(v) if np.isfinite(v) else None for v in np.atleast_1d(values)]
-    return cleaned if several else cleaned[0]
+    values: dict[str, Any] = {}
+    for option, key, kind in _STUDY_OPTIONS:
+        text = getattr(args, option.replace("-", "_"), None)
+        if text is not None:
+            values[key] = (
+                text
+                if kind == "text"
+                else parse_quantity(text, kind, name=f"--{option}", bare="refuse")
+            )
+    return values
 
 
 def _run_stiffness(args: argparse.Namespace) -> int:
     from clearjoint import stiffness
+    from clearjoint.studies import joint_at
+    from clearjoint.studies.text import json_value, stiffness_lines, stiffness_table
 
-    joint = _joint_from(args)
+    joint = joint_at(None, _overrides(args), _NAMES)
     amplitudes = _amplitudes(args)
     plot = _plot_target(args)
     _save_plot(stiffness.stiffness_curve(joint, amplitudes), plot, quiet=args.json)
-    period = stiffness.period(joint, amplitudes)
-    with np.errstate(divide="ignore"):
-        frequency_hz = 1.0 / period
-    k_d = stiffness.dynamic_stiffness(joint, amplitudes)
-    c_d = stiffness.stiffness_coefficient(joint, amplitudes)
+    table = stiffness_table(joint, amplitudes)
     several = amplitudes.size > 1
     if args.json:
-        out = {
-            "amplitude_m": _json_value(amplitudes, several),
-            "period_s": _json_value(period, several),
-            "natural_frequency_hz": _json_value(frequency_hz, several),
-            "dynamic_stiffness_n_per_m": _json_value(k_d, several),
-            "stiffness_coefficient": _json_value(c_d, several),
-        }
+        print(json.dumps({key: json_value(val, several) for key, val in table.items()}))
+    else:
+        print("\n".join(stiffness_lines(joint, table)))
+    return 0
+
+
+def _run_dissipation(args: argparse.Namespace) -> int:
+    from clearjoint import dissipation
+    from clearjoint.studies import joint_at, load_study, losses_at
+    from clearjoint.studies.text import dissipation_lines, json_value
+
+    base = load_study(args.study) if args.study else None
+    given = _overrides(args)
+    joint = joint_at(base.joint if base is not None else None, given, _NAMES)
+    losses = losses_at(base, joint, given, _NAMES)
+    amplitudes = _amplitudes(args)
+    plot = _plot_target(args)
+    values = dissipation.energies(joint, amplitudes, losses=losses)
+    _save_plot(values, plot, quiet=args.json)
+    several = amplitudes.size > 1
+    if args.json:
+        out = {"amplitude_m": json_value(amplitudes, several)}
+        out.update({key: json_value(val, several) for key, val in values.items()})
         print(json.dumps(out))
+    else:
+        print("\n".join(dissipation_lines(joint, losses, amplitudes, values)))
+    return 0
+
+
+def _run_simulate(args: argparse.Namespace) -> int:
+    from clearjoint.studies import load_study, run_study, summary, write_netcdf
+    from clearjoint.studies.text import simulation_lines
+
+    study = load_study(args.study)
+    if args.out:
+        from clearjoint.checks import refuse_to_overwrite
+
+        if Path(args.out).suffix.lower() != ".nc":
+            raise ParameterError(
+                f"--out {args.out}: simulate writes netCDF; name the file .nc, e.g. result.nc"
+            )
+        refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    plot = _plot_target(args)
+    motion = run_study(study)
+    _save_plot(motion, plot, quiet=args.json)
+    result = summary(study, motion)
+    if args.out:
+        write_netcdf(study, motion, args.out, force=args.force)
+    if args.json:
+        print(json.dumps(result))
         return 0
-    print(
-        f"joint: m = {joint.mass:g} kg, c = {joint.clearance * 1e3:g} mm, "
-        f"k_c = {joint.compression_stiffness:.4g} N/m, k_t = {joint.tension_stiffness:.4g} N/m, "
-        f"k0 = {joint.gap_stiffness:.4g} N/m, k_inf = {joint.large_amplitude_stiffness:.4g} N/m"
-    )
-    header = f"{'A (um)':>12} {'T (ms)':>12} {'f_n (Hz)':>12} {'k_d (N/m)':>12} {'c_d':>8}"
-    print(header)
-    print("-" * len(header))
-    for a, t, f, k, c in zip(amplitudes, period, frequency_hz, k_d, c_d, strict=True):
-        print(f"{a * 1e6:12.4g} {t * 1e3:12.5g} {f:12.5g} {k:12.5g} {c:8.4f}")
+    lines = simulation_lines(study.source, study.mode, result)
+    print("\n".join(lines + ([f"wrote {args.out}"] if args.out else [])))
     return 0
 
 
@@ -523,156 +530,6 @@ def _amplitudes(args: argparse.Namespace) -> Any:
 
     values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
     return np.array(values)
-
-
-_PIN_OPTIONS = ("pin-radius", "pin-length", "hole-radius", "youngs-modulus", "poisson-ratio")
-
-
-def _pin_from(args: argparse.Namespace, base: Any | None, clearance: float) -> Any:
-    """The pin from the options, each over the study's pin; None when neither gives one.
-
-    A hole radius the study left at its default (pin radius + clearance / 2)
-    follows an overridden pin radius or clearance.
-    """
-    from clearjoint.joint import Pin
-
-    base_pin = base.pin if base is not None else None
-    given = any(getattr(args, o.replace("-", "_")) is not None for o in _PIN_OPTIONS)
-    if not given and (base_pin is None or args.clearance is None):
-        return base_pin
-
-    def value(option: str, kind: str, field: str, default: float | None) -> float:
-        number = _option(args, option, kind)
-        if number is None:
-            number = getattr(base_pin, field) if base_pin is not None else default
-        if number is None:
-            raise ParameterError(
-                f"--{option} is missing: a pin needs --pin-radius and --pin-length "
-                "(or a [pin] table in the study file)"
-            )
-        return number
-
-    radius = value("pin-radius", "length", "radius", None)
-    length = value("pin-length", "length", "length", None)
-    hole = _option(args, "hole-radius", "length")
-    if hole is None:
-        default_hole = (
-            base is not None
-            and base_pin is not None
-            and math.isclose(
-                base_pin.hole_radius, base_pin.radius + 0.5 * base.joint.clearance, rel_tol=1e-12
-            )
-        )
-        hole = base_pin.hole_radius if base_pin and not default_hole else radius + 0.5 * clearance
-    return Pin(
-        radius=radius,
-        hole_radius=hole,
-        length=length,
-        youngs_modulus=value("youngs-modulus", "pressure", "youngs_modulus", 2.06e11),
-        poisson_ratio=value("poisson-ratio", "dimensionless", "poisson_ratio", 0.3),
-    )
-
-
-def _losses_from(args: argparse.Namespace, base: Any | None, joint: Any) -> dict[str, Any]:
-    """Friction, restitution, damping, pin and mu_c from options, over a study's values."""
-    from clearjoint.joint import Friction
-
-    def number(option: str, kind: str, default: float) -> float:
-        value = _option(args, option, kind)
-        return default if value is None else value
-
-    friction = base.friction if base is not None else None
-    mu_s = number("friction-coefficient", "dimensionless", friction.coefficient if friction else 0)
-    load = number("lateral-load", "force", friction.lateral_load if friction else 0.0)
-    region = args.friction_region or (friction.region if friction else "everywhere")
-    pin = _pin_from(args, base, joint.clearance)
-    sliding = None
-    if friction is None:  # neither the study nor the options gave both: one alone is no force
-        for given, option, other, example in (
-            (mu_s, "friction-coefficient", "lateral-load", "300N"),
-            (load, "lateral-load", "friction-coefficient", "0.2"),
-        ):
-            if given != 0.0 and getattr(args, other.replace("-", "_")) is None:
-                raise ParameterError(
-                    f"--{option} needs --{other} too (e.g. --{other} {example}): without it "
-                    "there is no sliding friction"
-                )
-    if mu_s != 0.0 or load != 0.0:
-        sliding = Friction(mu_s, load, region)  # validates the signs
-        sliding = sliding if sliding.force > 0.0 else None
-    if args.friction_region and sliding is None:
-        raise ParameterError(
-            "--friction-region needs sliding friction: give --friction-coefficient and "
-            "--lateral-load (or put them in the study file)"
-        )
-    mu_c = number(
-        "contact-friction-coefficient",
-        "dimensionless",
-        base.contact_friction_coefficient if base else 0.0,
-    )
-    if mu_c > 0.0 and pin is None:
-        raise ParameterError(
-            "--contact-friction-coefficient acts on the pin: give --pin-radius and --pin-length "
-            "(or a [pin] table in the study file)"
-        )
-    return {
-        "friction": sliding,
-        "restitution": number("restitution", "dimensionless", base.restitution if base else 1.0),
-        "damping_ratio": number(
-            "damping-ratio", "dimensionless", base.damping_ratio if base else 0.0
-        ),
-        "pin": pin,
-        "contact_friction_coefficient": mu_c,
-    }
-
-
-def _run_dissipation(args: argparse.Namespace) -> int:
-    from clearjoint import dissipation
-
-    base = None
-    if args.study:
-        from clearjoint.simulate.study import load_study
-
-        base = load_study(args.study)
-    joint = _joint_from(args, base.joint if base is not None else None)
-    losses = _losses_from(args, base, joint)
-    amplitudes = _amplitudes(args)
-    plot = _plot_target(args)
-    values = dissipation.energies(joint, amplitudes, **losses)
-    _save_plot(values, plot, quiet=args.json)
-    several = amplitudes.size > 1
-    if args.json:
-        out = {"amplitude_m": _json_value(amplitudes, several)}
-        out.update({key: _json_value(val, several) for key, val in values.items()})
-        print(json.dumps(out))
-        return 0
-    print(
-        f"joint: m = {joint.mass:g} kg, c = {joint.clearance * 1e3:g} mm, "
-        f"k_c = {joint.compression_stiffness:.4g} N/m, k_t = {joint.tension_stiffness:.4g} N/m"
-    )
-    friction = losses["friction"]
-    pin = losses["pin"]
-    print(
-        f"losses: mu_s P = {friction.force if friction else 0.0:g} N "
-        f"({friction.region if friction else 'none'}), e = {losses['restitution']:g}, "
-        f"zeta = {losses['damping_ratio']:g}, mu_c = {losses['contact_friction_coefficient']:g}"
-        + (f", pin R = {pin.radius * 1e3:g} mm, L = {pin.length * 1e3:g} mm" if pin else "")
-    )
-    columns = [
-        ("A (um)", amplitudes * 1e6),
-        ("E_P (mJ)", values["sliding_friction_j"] * 1e3),
-        ("E_P paper", values["sliding_friction_paper_j"] * 1e3),
-        ("E_C (mJ)", values["contact_friction_j"] * 1e3),
-        ("E_I (mJ)", values["impact_j"] * 1e3),
-        ("E_v (mJ)", values["viscous_j"] * 1e3),
-        ("total (mJ)", values["total_j"] * 1e3),
-        ("eta", values["loss_factor"]),
-        ("b (um)", values["hertz_half_width_m"] * 1e6),
-    ]
-    print(" ".join(f"{name:>11}" for name, _ in columns))
-    for row in zip(*(np.atleast_1d(col) for _, col in columns), strict=True):
-        print(" ".join(f"{value:11.4g}" for value in row))
-    return 0
 
 
 def _run_rig(args: argparse.Namespace) -> int:
@@ -705,6 +562,7 @@ def _run_rig(args: argparse.Namespace) -> int:
 def _run_identify(args: argparse.Namespace) -> int:
     from clearjoint.checks import refuse_to_overwrite
     from clearjoint.identify import identify_files
+    from clearjoint.studies.identify import write_identification_results
 
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
@@ -740,131 +598,15 @@ def _run_identify(args: argparse.Namespace) -> int:
     if not results:
         print("clearjoint identify: error: no record could be used", file=sys.stderr)
         return EXIT_BAD_INPUT
-    rows = [ident.row() for _, ident in results]
-    if args.figures:  # every output checked before any is written
-        targets = [t for _, ident in results for t in _figure_files(ident, Path(args.figures))]
-        refuse_to_overwrite(targets, force=args.force, option="--figures")
-    _write_rows(rows, out)
-    if args.figures:
-        _identify_figures(results, Path(args.figures), force=args.force)
+    figures = Path(args.figures) if args.figures else None
+    write_identification_results(results, out, figures=figures, plot=plot, force=args.force)
     if plot is not None:
-        from clearjoint.identify import identifications_figure
-
-        plot.parent.mkdir(parents=True, exist_ok=True)
-        identifications_figure([ident for _, ident in results]).savefig(plot, dpi=100)
         print(f"wrote {plot}")
     flagged = sum(ident.flag != "ok" for _, ident in results)
     print(
         f"identified {len(results)} of {len(args.files)} records ({flagged} flagged, see the "
         f"flag and flag_reason columns); wrote {out}"
     )
-    return 0
-
-
-def _write_rows(rows: list[dict[str, Any]], out: Path) -> None:
-    import csv
-
-    out.parent.mkdir(parents=True, exist_ok=True)
-    if out.suffix.lower() == ".csv":
-        with out.open("w", newline="", encoding="utf-8") as handle:
-            writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
-        return
-    import xarray as xr
-
-    columns = {key: [row[key] for row in rows] for key in rows[0]}
-    data = xr.Dataset(
-        {key: ("file", np.asarray(values)) for key, values in columns.items() if key != "file"},
-        coords={"file": ("file", np.asarray(columns["file"], dtype=str))},
-        attrs={"title": "clearjoint identification"},
-    )
-    data.to_netcdf(out, engine="h5netcdf")
-
-
-def _figure_files(ident: Any, folder: Path) -> list[Path]:
-    """The two figures ``clearjoint identify --figures`` writes for one identification."""
-    stem = Path(ident.source).stem
-    return [folder / f"{stem}_stages.png", folder / f"{stem}_loop.png"]
-
-
-def _identify_figures(results: list[Any], folder: Path, *, force: bool) -> None:
-    from clearjoint.checks import refuse_to_overwrite
-    from clearjoint.figures import displacement_stages_figure, identified_loop_figure
-
-    folder.mkdir(parents=True, exist_ok=True)
-    for record, ident in results:
-        stem = Path(ident.source).stem
-        targets = _figure_files(ident, folder)
-        refuse_to_overwrite(targets, force=force, option="--figures")
-        first = ident.cycles[0]
-        span = slice(first.start, ident.cycles[-1].stop)
-        runs = ident.stage_runs(record.time)
-        title = f"{stem} [{ident.flag}]"  # the credibility flag on every figure
-        fig = displacement_stages_figure(record.time, record.displacement, runs, title=title)
-        fig.savefig(targets[0], dpi=100)
-        fig = identified_loop_figure(
-            record.displacement[span],
-            ident.restoring_force[span],
-            ident.stage[span],
-            (first.upper_edge, first.lower_edge),
-            first.lines,
-            title=title,
-            model=ident.model,
-            slip_levels=(
-                ident.summary["friction_force_positive_n"],
-                ident.summary["friction_force_negative_n"],
-            ),
-            note=ident.flag_reason,
-        )
-        fig.savefig(targets[1], dpi=100)
-
-
-def _run_simulate(args: argparse.Namespace) -> int:
-    from clearjoint.simulate.study import load_study, run_study, summary, write_netcdf
-
-    study = load_study(args.study)
-    if args.out:
-        from clearjoint.checks import refuse_to_overwrite
-
-        if Path(args.out).suffix.lower() != ".nc":
-            raise ParameterError(
-                f"--out {args.out}: simulate writes netCDF; name the file .nc, e.g. result.nc"
-            )
-        refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    plot = _plot_target(args)
-    motion = run_study(study)
-    _save_plot(motion, plot, quiet=args.json)
-    result = summary(study, motion)
-    if args.out:
-        write_netcdf(study, motion, args.out, force=args.force)
-    if args.json:
-        print(json.dumps(result))
-        return 0
-    energy = result["energy_j"]
-    lines = [
-        f"study: {study.source} ({study.mode})",
-        f"excitation: {study.force_amplitude:g} N at {result['frequency_hz']:g} Hz",
-        f"amplitude X = {result['amplitude_m'] * 1e6:.4g} um "
-        f"(x_max {result['x_max_m'] * 1e6:.4g} um, x_min {result['x_min_m'] * 1e6:.4g} um)",
-    ]
-    if "period_multiple" in result:
-        lines.append(
-            f"period-{result['period_multiple']} orbit, reached after "
-            f"{result['periods_to_converge']} forcing periods"
-        )
-    lines.append(
-        f"events {result['events']}, impacts {result['impacts']}, "
-        f"stuck {result['stick_time_s'] * 1e3:.4g} ms"
-    )
-    lines.append(
-        "energy per orbit (J): " + ", ".join(f"{key} {val:.5g}" for key, val in energy.items())
-    )
-    lines.append(f"balance error {result['balance_error']:.2e}")
-    if args.out:
-        lines.append(f"wrote {args.out}")
-    print("\n".join(lines))
     return 0
 
 
@@ -940,275 +682,6 @@ def _run_report(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_frf(args: argparse.Namespace) -> int:
-    import math
-
-    from clearjoint.periodic import frequency_response
-    from clearjoint.simulate.study import load_study
-    from clearjoint.units import parse_quantity
-
-    structure_study = _structure_study(args.study)
-    if structure_study is None:
-        # a force curve takes its forces from --from/--to, not from the study
-        force_curve = args.parameter == "force"
-        study = load_study(
-            args.study, optional=("excitation.force_amplitude",) if force_curve else ()
-        )
-    _netcdf_target(args)  # before the run, not after
-    plot_path = _plot_target(args)
-    kind = "force" if args.parameter == "force" else "frequency"
-    start = parse_quantity(args.start, kind, name="--from")
-    stop = parse_quantity(args.stop, kind, name="--to")
-    for option, text, value in (("--from", args.start, start), ("--to", args.stop, stop)):
-        if not (math.isfinite(value) and value > 0.0):
-            raise ParameterError(f"{option} must be finite and > 0, got {text!r}")
-    if start == stop:
-        raise ParameterError(
-            f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
-            "give two different values"
-        )
-    if args.max_points < 2:
-        raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
-    if structure_study is not None:
-        curve = _frf_of_structure(args, structure_study, start, stop)
-        return _finish_frf(args, curve, structure_study.source, plot_path)
-    if args.method == "harmonic":
-        _harmonic_losses(study, args.study, "frf")
-    losses: dict[str, Any] = {
-        "damping_ratio": study.damping_ratio,
-        "friction": study.friction,
-        "restitution": study.restitution,
-    }
-    if args.method == "harmonic":
-        import functools
-
-        from clearjoint import harmonic
-
-        h = 7 if args.harmonics is None else args.harmonics
-        frequency_response = functools.partial(
-            harmonic.frequency_response, harmonics=h, samples=_samples(args, h)
-        )
-    elif args.harmonics is not None:
-        raise ParameterError("--harmonics goes with --method harmonic; drop it or add that")
-    elif args.samples is not None:
-        raise ParameterError("--samples goes with --method harmonic; drop it or add that")
-    if args.parameter == "force":
-        frequency = (
-            parse_quantity(args.frequency, "frequency", name="--frequency")
-            if args.frequency
-            else study.omega / (2.0 * math.pi)
-        )
-        if not (math.isfinite(frequency) and frequency > 0.0):
-            raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
-        curve = frequency_response(
-            study.joint,
-            start,
-            2.0 * math.pi * frequency,
-            None,
-            parameter="force",
-            force_stop=stop,
-            max_points=args.max_points,
-            **losses,
-        )
-    else:
-        if args.frequency:
-            raise ParameterError("--frequency goes with --parameter force; drop it or add that")
-        if not (math.isfinite(study.force_amplitude) and study.force_amplitude > 0.0):
-            raise ParameterError(
-                f"{study.source}: [excitation] force_amplitude must be finite and > 0, got "
-                f"{study.force_amplitude!r} N; give the force the curve is followed at, e.g. 100N"
-            )
-        curve = frequency_response(
-            study.joint,
-            study.force_amplitude,
-            2.0 * math.pi * start,
-            2.0 * math.pi * stop,
-            max_points=args.max_points,
-            **losses,
-        )
-    return _finish_frf(args, curve, study.source, plot_path)
-
-
-def _finish_frf(args: argparse.Namespace, curve: Any, source: str, plot_path: Path | None) -> int:
-    """Write the curve (--out, --plot) and print it (--json or a summary)."""
-    data = curve.to_xarray()
-    data.attrs["study"] = source
-    names = getattr(curve.settings.get("system"), "dof_names", None)
-    if names is not None and "dof" in data.dims:  # a structure: name its DOFs
-        data = data.assign_coords(dof=("dof", [str(name) for name in names]))
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    data.to_netcdf(args.out, engine="h5netcdf")
-    _save_plot(curve, plot_path, quiet=True)
-    if curve.stop_reason != "reached":
-        print(
-            f"clearjoint frf: warning: the continuation stopped early ({curve.stop_reason}) at "
-            f"{curve.omega[-1] / (2 * math.pi):.6g} Hz, {curve.force_amplitude[-1]:.6g} N; "
-            "the curve covers only part of the range",
-            file=sys.stderr,
-        )
-    free = getattr(curve, "free_play", None)
-    untrusted = [e for e in curve.events if e.kind == "untrusted"]
-    if untrusted:  # harmonic balance of a structure: orbits the exact motion does not follow
-        where = ", ".join(f"{e.omega / (2 * math.pi):.4g}" for e in untrusted)
-        print(
-            f"clearjoint frf: warning: at {where} Hz the harmonic-balance orbit misses one "
-            "period of the exact motion, so its stability is not to be trusted; raise "
-            "--harmonics or lower the force (docs/harmonic.md)",
-            file=sys.stderr,
-        )
-    source_system = curve.settings.get("system")
-    per_dof = curve.x_max.ndim == 2 and hasattr(source_system, "dof_names")
-    if args.json:
-        print(
-            json.dumps(
-                {
-                    "frequency_hz": (curve.omega / (2 * math.pi)).tolist(),
-                    "force_n": curve.force_amplitude.tolist(),
-                    "amplitude_m": curve.amplitude.tolist(),
-                    "x_max_m": curve.x_max.tolist(),
-                    "x_min_m": curve.x_min.tolist(),
-                    "stable": curve.stable.tolist(),
-                    **({"dofs": list(source_system.dof_names)} if per_dof else {}),
-                    "events": [
-                        {
-                            "kind": e.kind,
-                            "frequency_hz": e.omega / (2 * math.pi),
-                            "force_n": e.force_amplitude,
-                            "amplitude_m": e.amplitude,
-                        }
-                        for e in curve.events
-                    ],
-                    **({"free_play": free.tolist()} if free is not None else {}),
-                    "stop_reason": curve.stop_reason,
-                }
-            )
-        )
-        return 0
-    lines = [f"study: {source}", repr(curve)]
-    if free is not None and free.any():
-        by_force = curve.parameter == "force"
-        span = curve.force_amplitude[free] if by_force else curve.omega[free] / (2 * math.pi)
-        unit = f"N at {curve.omega[0] / (2 * math.pi):.6g} Hz" if by_force else "Hz"
-        lines.append(
-            f"free play from {span.min():.6g} to {span.max():.6g} {unit}: the orbit stays inside "
-            "the gap (gap_stiffness 0), one of a continuum; its amplitude is set by the dynamics, "
-            "its position is not (the curve shows the orbit centred in the gap)"
-        )
-    for e in curve.events:
-        lines.append(
-            f"{e.kind}: {e.omega / (2 * math.pi):.6g} Hz, {e.force_amplitude:.6g} N, "
-            f"X = {e.amplitude * 1e6:.5g} um"
-        )
-    lines.append(f"wrote {args.out}" + (f" and {args.plot}" if args.plot else ""))
-    print("\n".join(lines))
-    return 0
-
-
-def _structure_study(path: str) -> Any:
-    """The structure study in ``path`` (a file with a [structure] section), else None."""
-    from clearjoint.io_toml import read_toml
-    from clearjoint.simulate.study import StudyError
-
-    if "structure" not in read_toml(path, what="study", error=StudyError):
-        return None
-    from clearjoint.structure.study import load_structure_study
-
-    return load_structure_study(path)
-
-
-def _harmonic_losses(study: Any, path: str, command: str) -> None:
-    """Refuse, in CLI terms, the joint losses harmonic balance does not carry (``command``)."""
-    exact = {
-        "frf": "drop --method harmonic (exact shooting carries it)",
-        "modes": "follow the forced response instead with clearjoint frf STUDY (exact shooting)",
-    }[command]
-    if study.restitution != 1.0:
-        raise ParameterError(
-            f"{path}: [losses] restitution = {study.restitution:g} is an impact, which harmonic "
-            f"balance cannot carry; {exact}, or set restitution = 1"
-        )
-    friction = study.friction
-    if friction is None or friction.force <= 0.0:
-        return
-    if friction.region != "everywhere":
-        raise ParameterError(
-            f"{path}: [losses] friction_region = {friction.region!r} is not carried by harmonic "
-            f'balance; {exact}, or set friction_region = "everywhere"'
-        )
-
-
-def _structure_harmonic_check(study: Any, command: str) -> None:
-    """Refuse, in CLI terms, joints of a structure study that harmonic balance cannot carry."""
-    laws = study.structure.joint_laws
-    if any(law.restitution != 1.0 for law in laws):
-        value = next(law.restitution for law in laws if law.restitution != 1.0)
-        raise ParameterError(
-            f"{study.source}: [joint] restitution = {value:g} is an impact, which harmonic "
-            f"balance ({command}) cannot carry; set restitution = 1, or use clearjoint "
-            f"structure {study.source} respond for the exact motion with impacts"
-        )
-
-
-def _frf_of_structure(args: argparse.Namespace, study: Any, start: float, stop: float) -> Any:
-    """The frequency response of a structure study by harmonic balance (frf's work)."""
-    import math
-
-    from clearjoint import harmonic
-    from clearjoint.harmonic.response import NoPeriodicResponse
-    from clearjoint.units import parse_quantity
-
-    if args.method != "harmonic":
-        raise ParameterError(
-            f"{study.source} is a structure study: its frequency response is computed by "
-            "harmonic balance; add --method harmonic"
-        )
-    if study.force is None:
-        raise ParameterError(
-            f"{study.source}: frf needs the [excitation] section (force_dof, force_amplitude; "
-            "frequency for --parameter force); put it in the study file"
-        )
-    _structure_harmonic_check(study, "frf")
-    h = 7 if args.harmonics is None else args.harmonics
-    samples = _samples(args, h)
-    if args.parameter == "force":
-        frequency = (
-            parse_quantity(args.frequency, "frequency", name="--frequency")
-            if args.frequency
-            else study.omega / (2.0 * math.pi)
-        )
-        if not (math.isfinite(frequency) and frequency > 0.0):
-            raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
-        pattern = study.force * (start / float(np.max(np.abs(study.force))))
-        try:
-            return harmonic.frequency_response(
-                study.structure,
-                pattern,
-                2.0 * math.pi * frequency,
-                None,
-                harmonics=h,
-                samples=samples,
-                parameter="force",
-                force_stop=stop,
-                max_points=args.max_points,
-            )
-        except NoPeriodicResponse as exc:
-            raise _no_orbit(exc, study.source, start) from None
-    if args.frequency:
-        raise ParameterError("--frequency goes with --parameter force; drop it or add that")
-    try:
-        return harmonic.frequency_response(
-            study.structure,
-            study.force,
-            2.0 * math.pi * start,
-            2.0 * math.pi * stop,
-            harmonics=h,
-            samples=samples,
-            max_points=args.max_points,
-        )
-    except NoPeriodicResponse as exc:
-        raise _no_orbit(exc, study.source, float(np.max(np.abs(study.force)))) from None
-
-
 def _progress_bar(*columns: Any) -> Any:
     """A rich progress bar on stderr, drawn only on a terminal (stdout stays the output)."""
     from rich.console import Console
@@ -1233,22 +706,6 @@ def _harmonic_progress(command: str) -> Any:
     finally:
         logger.removeHandler(handler)
         logger.setLevel(level)
-
-
-def _no_orbit(exc: Any, source: str, force: float) -> ParameterError:
-    """The start found no harmonic-balance orbit: say so in CLI terms, with what to do."""
-    hz = exc.omega / (2.0 * math.pi)
-    reached = (
-        f"; following the force up from a small one reached only {exc.reached * force:.3g} N"
-        if exc.reached > 0.0
-        else ""
-    )
-    return ParameterError(
-        f"{source}: no harmonic-balance orbit at {hz:.6g} Hz and {force:.3g} N{reached}: at this "
-        "force the joints may rattle with no periodic orbit (docs/harmonic.md); lower "
-        "[excitation] force_amplitude, or start elsewhere (--from), or take the exact motion: "
-        f"clearjoint structure {source} respond"
-    )
 
 
 def _warning_printer(command: str) -> Callable[..., None]:
@@ -1381,60 +838,88 @@ def _amplitude_range(text: str, points: int) -> Any:
     return np.geomspace(values[0], values[1], points)
 
 
+def _run_frf(args: argparse.Namespace) -> int:
+    from clearjoint.structure.study import StructureStudy
+    from clearjoint.studies import (
+        curve_summary,
+        frequency_response_of,
+        load_any_study,
+        write_curve,
+    )
+    from clearjoint.studies.text import curve_lines, curve_warnings
+    from clearjoint.units import parse_quantity
+
+    # a force curve takes its forces from --from/--to, not from the study
+    force_curve = args.parameter == "force"
+    study = load_any_study(
+        args.study, optional=("excitation.force_amplitude",) if force_curve else ()
+    )
+    _netcdf_target(args)  # before the run, not after
+    plot_path = _plot_target(args)
+    kind = "force" if force_curve else "frequency"
+    start = parse_quantity(args.start, kind, name="--from")
+    stop = parse_quantity(args.stop, kind, name="--to")
+    for option, text, value in (("--from", args.start, start), ("--to", args.stop, stop)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ParameterError(f"{option} must be finite and > 0, got {text!r}")
+    if start == stop:
+        raise ParameterError(
+            f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
+            "give two different values"
+        )
+    if args.max_points < 2:
+        raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
+    structure = isinstance(study, StructureStudy)
+    for option, given in (("--harmonics", args.harmonics), ("--samples", args.samples)):
+        if args.method != "harmonic" and given is not None and not structure:
+            raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")
+    frequency = None
+    if args.frequency and not force_curve:
+        raise ParameterError("--frequency goes with --parameter force; drop it or add that")
+    if args.frequency:
+        frequency = parse_quantity(args.frequency, "frequency", name="--frequency")
+        if not (math.isfinite(frequency) and frequency > 0.0):
+            raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
+    curve = frequency_response_of(
+        study,
+        start,
+        stop,
+        parameter=args.parameter,
+        frequency=frequency,
+        method=args.method,
+        harmonics=args.harmonics,
+        samples=args.samples,
+        max_points=args.max_points,
+        names=_NAMES,
+    )
+    write_curve(curve, args.out, study.source)
+    _save_plot(curve, plot_path, quiet=True)
+    for warning in curve_warnings(curve):
+        print(f"clearjoint frf: warning: {warning}", file=sys.stderr)
+    if args.json:
+        print(json.dumps(curve_summary(curve)))
+        return 0
+    wrote = f"wrote {args.out}" + (f" and {args.plot}" if args.plot else "")
+    print("\n".join([*curve_lines(curve, study.source), wrote]))
+    return 0
+
+
 def _run_modes(args: argparse.Namespace) -> int:
-    import math
+    from clearjoint.studies import load_any_study, mode_summary, nonlinear_modes_of, write_curve
 
-    from clearjoint.harmonic import nonlinear_modes
-    from clearjoint.simulate.study import load_study
-
-    structure_study = _structure_study(args.study)
-    study: Any = structure_study if structure_study is not None else load_study(args.study)
+    study = load_any_study(args.study)
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     amplitudes = _amplitude_range(args.amplitude, args.points)
-    if args.harmonics < 1:
-        raise ParameterError(f"--harmonics must be an integer >= 1, got {args.harmonics}")
-    samples = _samples(args, args.harmonics)
-    if structure_study is not None:
-        _structure_harmonic_check(study, "modes")
-        mode = nonlinear_modes(
-            study.structure, args.mode, amplitudes, harmonics=args.harmonics, samples=samples
-        )
-    else:
-        _harmonic_losses(study, args.study, "modes")
-        mode = nonlinear_modes(
-            study.joint,
-            args.mode,
-            amplitudes,
-            harmonics=args.harmonics,
-            samples=samples,
-            damping_ratio=study.damping_ratio,
-            friction=study.friction,
-            restitution=study.restitution,
-        )
-    data = mode.to_xarray()
-    data.attrs["study"] = study.source
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    data.to_netcdf(args.out, engine="h5netcdf")
+    mode = nonlinear_modes_of(
+        study, args.mode, amplitudes, harmonics=args.harmonics, samples=args.samples, names=_NAMES
+    )
+    write_curve(mode, args.out, study.source)
     _save_plot(mode, plot_path, quiet=True)
     for line in filter(None, mode.note.split("; ")):
         print(f"clearjoint modes: warning: {line}", file=sys.stderr)
-
-    def finite(values: Any) -> list[float | None]:
-        return [float(v) if math.isfinite(v) else None for v in values]
-
     if args.json:
-        print(
-            json.dumps(
-                {
-                    "amplitude_m": mode.amplitude.tolist(),
-                    "frequency_hz": finite(mode.frequency / (2 * math.pi)),
-                    "damping_ratio": finite(mode.damping_ratio),
-                    "energy_per_cycle_j": finite(mode.energy_per_cycle),
-                    "epmc_damping_ratio": finite(mode.epmc_damping_ratio),
-                }
-            )
-        )
+        print(json.dumps(mode_summary(mode)))
         return 0
     wrote = f"wrote {args.out}" + (f" and {args.plot}" if args.plot else "")
     print("\n".join([f"study: {study.source}", repr(mode), wrote]))
@@ -1442,88 +927,28 @@ def _run_modes(args: argparse.Namespace) -> int:
 
 
 def _run_structure(args: argparse.Namespace) -> int:
-    import math
+    from matplotlib.figure import Figure
 
-    import xarray as xr
-
-    from clearjoint.structure import decay_backbone, free_decay, time_response
     from clearjoint.structure.study import load_structure_study
+    from clearjoint.studies import run_structure_task
 
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
-    s = study.structure
-    summary: dict[str, Any] = {"structure": repr(s)}
-    drawn: Any = None  # a result with .plot(ax), or a Figure already drawn
-    if args.task == "modes":
-        closed, opened = s.modes("closed"), s.modes("open")
-        data = xr.concat(
-            [closed.to_xarray(), opened.to_xarray()],
-            dim=xr.DataArray(["closed", "open"], dims="pattern"),
-        )
-        summary["closed_hz"] = closed.frequency_hz[:6].tolist()
-        summary["open_hz"] = opened.frequency_hz[:6].tolist()
-        if plot_path is not None:
-            from clearjoint.figures import structure_modes
-
-            drawn = structure_modes(closed, opened)
-    elif args.task == "respond":
-        if study.omega is None or study.force is None:
-            raise ParameterError(
-                f"{study.source}: respond needs an [excitation] section (frequency, force_dof, "
-                "force_amplitude); put it in the study file"
-            )
-        duration = study.periods * 2.0 * math.pi / study.omega
-        motion = time_response(
-            s, study.force, study.omega, duration, samples_per_period=study.samples_per_period
-        )
-        data = motion.to_xarray()
-        summary |= {
-            "events": motion.events,
-            "patterns": motion.patterns_visited,
-            "energy_j": motion.energy.as_dict(),
-            "balance_error": motion.balance_error,
-            "max_displacement_m": float(np.abs(motion.u).max()),
-        }
-        drawn = motion
-    else:
-        if study.decay_initial is None or study.decay_duration is None:
-            raise ParameterError(
-                f"{study.source}: decay needs a [decay] section (dof, initial_amplitude, "
-                "duration); put it in the study file"
-            )
-        motion = free_decay(
-            s,
-            (study.decay_initial, np.zeros(s.n_dof)),
-            study.decay_duration,
-            samples_per_period=max(study.samples_per_period, 64),
-        )
-        backbone = decay_backbone(motion, int(study.decay_dof or 0), mode=study.decay_mode)
-        data = xr.merge([motion.to_xarray(), backbone.to_xarray()], combine_attrs="drop_conflicts")
-        summary |= {
-            "events": motion.events,
-            "balance_error": motion.balance_error,
-            "amplitude_m": backbone.amplitude.tolist(),
-            "frequency_hz": (backbone.omega / (2.0 * math.pi)).tolist(),
-            "damping_ratio": [None if math.isnan(z) else float(z) for z in backbone.damping_ratio],
-        }
-        drawn = backbone
-    data.to_netcdf(out, engine="h5netcdf")
-    if plot_path is not None:
-        from matplotlib.figure import Figure
-
-        if isinstance(drawn, Figure):
-            _save_figure(drawn, plot_path, quiet=True)
-        else:
-            _save_plot(drawn, plot_path, quiet=True)
+    result = run_structure_task(study, args.task, figure=plot_path is not None)
+    result.data.to_netcdf(out, engine="h5netcdf")
+    if plot_path is not None and isinstance(result.drawn, Figure):
+        _save_figure(result.drawn, plot_path, quiet=True)
+    elif plot_path is not None:
+        _save_plot(result.drawn, plot_path, quiet=True)
     if args.json:
-        print(json.dumps(summary))
-    else:
-        for key, value in summary.items():
-            if isinstance(value, list):  # a cycle without a damping ratio (the last) says so
-                value = ["n/a" if item is None else item for item in value]
-            print(f"{key}: {value}")
-        print(f"wrote {out}" + (f" and {args.plot}" if args.plot else ""))
+        print(json.dumps(result.summary))
+        return 0
+    for key, value in result.summary.items():
+        if isinstance(value, list):  # a cycle without a damping ratio (the last) says so
+            value = ["n/a" if item is None else item for item in value]
+        print(f"{key}: {value}")
+    print(f"wrote {out}" + (f" and {args.plot}" if args.plot else ""))
     return 0
 
 

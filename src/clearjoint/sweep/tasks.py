@@ -38,12 +38,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from clearjoint.errors import ParameterError
+from clearjoint.studies.curves import solver_losses
+from clearjoint.studies.overrides import structure_at, study_at
 
 __all__ = [
     "FORCING_PARAMETERS",
@@ -119,50 +121,6 @@ FORCING_PARAMETERS: dict[str, Parameter] = {
     "excitation.force_amplitude": Parameter("force", "N", **_POSITIVE),
     "excitation.frequency": Parameter("frequency", "Hz", **_POSITIVE),
 }
-
-
-def study_at(study: Any, values: Mapping[str, float]) -> Any:
-    """Return the study with the point's ``values`` applied (keys as in the study file).
-
-    A symmetric joint (k_t = k_c) stays symmetric when only k_c is varied, and a
-    pin's hole follows a varied clearance (R_h = R_p + c/2), as in a study file
-    that leaves them to their defaults.
-    """
-    from clearjoint.joint import Friction, Pin
-
-    joint = study.joint
-    changes = {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith("joint.")}
-    if (
-        "compression_stiffness" in changes
-        and "tension_stiffness" not in changes
-        and joint.tension_stiffness == joint.compression_stiffness
-    ):
-        changes["tension_stiffness"] = changes["compression_stiffness"]
-    joint = replace(joint, **changes)
-    pin = study.pin
-    if pin is not None and "clearance" in changes:
-        pin = replace(pin, hole_radius=pin.radius + 0.5 * joint.clearance)
-    friction = study.friction
-    mu_s = values.get("losses.friction_coefficient", friction.coefficient if friction else 0.0)
-    load = values.get("losses.lateral_load", friction.lateral_load if friction else 0.0)
-    region = friction.region if friction else "everywhere"
-    friction = Friction(mu_s, load, region) if mu_s > 0.0 and load > 0.0 else None
-    omega = study.omega
-    if "excitation.frequency" in values:
-        omega = 2.0 * math.pi * values["excitation.frequency"]
-    return replace(
-        study,
-        joint=joint,
-        pin=pin if isinstance(pin, Pin) else None,
-        friction=friction,
-        omega=omega,
-        force_amplitude=values.get("excitation.force_amplitude", study.force_amplitude),
-        damping_ratio=values.get("losses.damping_ratio", study.damping_ratio),
-        restitution=values.get("losses.restitution", study.restitution),
-        contact_friction_coefficient=values.get(
-            "losses.contact_friction_coefficient", study.contact_friction_coefficient
-        ),
-    )
 
 
 def _steady_state(
@@ -326,9 +284,7 @@ def _stepped_sine(
         study.joint,
         study.force_amplitude,
         2.0 * math.pi * hz,
-        damping_ratio=study.damping_ratio,
-        friction=study.friction,
-        restitution=study.restitution,
+        **solver_losses(study.losses),
         max_periods=int(values["task.max_periods"]),
     )
     both = np.vstack([curve.amplitude_up, curve.amplitude_down])
@@ -393,9 +349,7 @@ def _periodic_orbit(
         study.joint,
         study.force_amplitude,
         study.omega,
-        damping_ratio=study.damping_ratio,
-        friction=study.friction,
-        restitution=study.restitution,
+        **solver_losses(study.losses),
         period_multiple=int(values["task.period_multiple"]),
     )
     per = 1.0 / int(values["task.period_multiple"])  # per forcing period
@@ -450,9 +404,7 @@ def _frequency_response(
         study.force_amplitude,
         2.0 * math.pi * low,
         2.0 * math.pi * high,
-        damping_ratio=study.damping_ratio,
-        friction=study.friction,
-        restitution=study.restitution,
+        **solver_losses(study.losses),
         max_points=int(values["task.max_points"]),
     )
     if curve.stop_reason != "reached":
@@ -515,9 +467,7 @@ def _nonlinear_mode(
         1,
         [values["task.amplitude"]],
         harmonics=int(values["task.harmonics"]),
-        damping_ratio=study.damping_ratio,
-        friction=study.friction,
-        restitution=study.restitution,
+        **solver_losses(study.losses),
     )
     if not bool(mode.converged[0]):
         raise SimulationError("the nonlinear mode did not converge at this amplitude")
@@ -568,70 +518,6 @@ STRUCTURE_JOINT_PARAMETERS: dict[str, Parameter] = {
         "joint.gap_offset",
     )
 }
-
-
-def _joint_key(key: str) -> tuple[str, int | None]:
-    """``joint.clearance[3]`` -> (clearance, 3); ``joint.clearance`` -> (clearance, None)."""
-    name = key.split(".", 1)[1]
-    if name.endswith("]") and "[" in name:
-        field_name, index = name[:-1].split("[", 1)
-        return field_name, int(index)
-    return name, None
-
-
-def structure_at(study: Any, values: Mapping[str, float]) -> Any:
-    """Return the structure study with the point's joint ``values`` applied.
-
-    ``joint.<key>`` sets that value on every joint of the structure; ``joint.<key>[j]``
-    on joint ``j`` only (0-based, in ``Structure.joint_members`` order: for a mast,
-    bay 1 left, bay 1 right, bay 2 left, ...). A symmetric joint (k_t = k_c) stays
-    symmetric when only k_c is varied, as in :func:`study_at`.
-
-    Raises
-    ------
-    ParameterError
-        A joint index the structure does not have.
-    """
-    from clearjoint.structure import Structure
-
-    structure = study.structure
-    n_joints = len(structure.joint_members)
-    common: dict[str, float] = {}
-    each: dict[int, dict[str, float]] = {}
-    for key, value in values.items():
-        if not key.startswith("joint."):
-            continue
-        name, index = _joint_key(key)
-        if index is None:
-            common[name] = value
-        elif not 0 <= index < n_joints:
-            raise ParameterError(
-                f"{key}: the structure has {n_joints} joints (0 to {n_joints - 1}); "
-                "check the per-joint draw"
-            )
-        else:
-            each.setdefault(index, {})[name] = value
-    if not common and not each:
-        return study
-    members = list(structure.members)
-    for j, m in enumerate(structure.joint_members):
-        joint = members[m].joint
-        changes = {**common, **each.get(j, {})}
-        if (
-            "compression_stiffness" in changes
-            and "tension_stiffness" not in changes
-            and joint.tension_stiffness == joint.compression_stiffness
-        ):
-            changes["tension_stiffness"] = changes["compression_stiffness"]
-        members[m] = replace(members[m], joint=replace(joint, **changes))
-    built = Structure(
-        structure.nodes,
-        structure.masses,
-        tuple(members),
-        supports=structure.supports,
-        rayleigh=structure.rayleigh,
-    )
-    return replace(study, structure=built)
 
 
 def _structure_mode(

@@ -1,0 +1,122 @@
+"""The tasks of a structure study: its modes, its exact forced response, its free decay.
+
+``modes``: the linear modes with every joint closed and open (MODEL.md 5.2);
+``respond``: the exact forced response over the study's periods; ``decay``: the exact
+free decay from a deflection along a closed mode, with its backbone (amplitude,
+frequency and damping ratio per cycle).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from clearjoint.errors import ParameterError
+from clearjoint.structure.study import StructureStudy
+
+__all__ = [
+    "STRUCTURE_TASKS",
+    "StructureTaskResult",
+    "run_structure_task",
+]
+
+#: The tasks :func:`run_structure_task` runs.
+STRUCTURE_TASKS = ("modes", "respond", "decay")
+
+
+@dataclass(frozen=True)
+class StructureTaskResult:
+    """What a structure task gives: its Dataset, a JSON-ready summary, what to draw.
+
+    ``drawn`` is a result with ``.plot(ax)``, a matplotlib Figure already drawn, or None.
+    """
+
+    data: Any
+    summary: dict[str, Any]
+    drawn: Any
+
+
+def run_structure_task(
+    study: StructureStudy, task: str, *, figure: bool = False
+) -> StructureTaskResult:
+    """Return the StructureTaskResult of ``task`` ("modes", "respond", "decay") on the study.
+
+    Parameters
+    ----------
+    study : StructureStudy
+    task : str
+        One of :data:`STRUCTURE_TASKS`.
+    figure : bool
+        Draw the modes figure (the other tasks' results draw themselves).
+
+    Raises
+    ------
+    ParameterError
+        The study lacks the section the task needs ([excitation] or [decay]).
+    """
+    import xarray as xr
+
+    from clearjoint.structure import decay_backbone, free_decay, time_response
+
+    s = study.structure
+    summary: dict[str, Any] = {"structure": repr(s)}
+    drawn: Any = None
+    if task == "modes":
+        closed, opened = s.modes("closed"), s.modes("open")
+        data = xr.concat(
+            [closed.to_xarray(), opened.to_xarray()],
+            dim=xr.DataArray(["closed", "open"], dims="pattern"),
+        )
+        summary["closed_hz"] = closed.frequency_hz[:6].tolist()
+        summary["open_hz"] = opened.frequency_hz[:6].tolist()
+        if figure:
+            from clearjoint.figures import structure_modes
+
+            drawn = structure_modes(closed, opened)
+    elif task == "respond":
+        if study.omega is None or study.force is None:
+            raise ParameterError(
+                f"{study.source}: respond needs an [excitation] section (frequency, force_dof, "
+                "force_amplitude); put it in the study file"
+            )
+        duration = study.periods * 2.0 * math.pi / study.omega
+        motion = time_response(
+            s, study.force, study.omega, duration, samples_per_period=study.samples_per_period
+        )
+        data = motion.to_xarray()
+        summary |= {
+            "events": motion.events,
+            "patterns": motion.patterns_visited,
+            "energy_j": motion.energy.as_dict(),
+            "balance_error": motion.balance_error,
+            "max_displacement_m": float(np.abs(motion.u).max()),
+        }
+        drawn = motion
+    elif task == "decay":
+        if study.decay_initial is None or study.decay_duration is None:
+            raise ParameterError(
+                f"{study.source}: decay needs a [decay] section (dof, initial_amplitude, "
+                "duration); put it in the study file"
+            )
+        motion = free_decay(
+            s,
+            (study.decay_initial, np.zeros(s.n_dof)),
+            study.decay_duration,
+            samples_per_period=max(study.samples_per_period, 64),
+        )
+        backbone = decay_backbone(motion, int(study.decay_dof or 0), mode=study.decay_mode)
+        data = xr.merge([motion.to_xarray(), backbone.to_xarray()], combine_attrs="drop_conflicts")
+        summary |= {
+            "events": motion.events,
+            "balance_error": motion.balance_error,
+            "amplitude_m": backbone.amplitude.tolist(),
+            "frequency_hz": (backbone.omega / (2.0 * math.pi)).tolist(),
+            "damping_ratio": [None if math.isnan(z) else float(z) for z in backbone.damping_ratio],
+        }
+        drawn = backbone
+    else:
+        raise ParameterError(f"task must be one of {', '.join(STRUCTURE_TASKS)}, got {task!r}")
+    return StructureTaskResult(data, summary, drawn)
