@@ -115,39 +115,51 @@ class ClearanceJoint:
     def force(self, delta: ArrayLike) -> NDArray[np.float64]:
         """Return the force f(delta) in N the joint carries at relative displacement delta in m.
 
-        MODEL.md sec. 0. ``delta`` of any shape (e.g. (N_t, n)); the result has its shape.
+        MODEL.md sec. 0 (:func:`clearjoint.laws.clearance.force`). ``delta`` of any shape
+        (e.g. (N_t, n)); the result has its shape.
         """
-        delta = np.asarray(delta, dtype=np.float64)
-        force = self.gap_stiffness * delta
-        force = force + self.compression_stiffness * np.maximum(delta - self.compression_gap, 0.0)
-        force = force + self.tension_stiffness * np.minimum(delta + self.tension_gap, 0.0)
-        return force
+        from clearjoint.laws import clearance  # here: numba loads on first use only
+
+        samples = np.asarray(delta, dtype=np.float64)
+        force, _ = clearance.forces_and_tangents(_column(samples), *clearance.parameters((self,)))
+        return force.reshape(samples.shape)
 
     def tangent_stiffness(self, delta: ArrayLike) -> NDArray[np.float64]:
         """Return df/d(delta) in N/m at relative displacement delta in m (same shape).
 
-        At a gap edge itself (a kink of f) the free-play stiffness k0 is returned.
+        MODEL.md sec. 0 (:func:`clearjoint.laws.clearance.tangent`). At a gap edge itself
+        (a kink of f) the free-play stiffness k0 is returned.
         """
-        delta = np.asarray(delta, dtype=np.float64)
-        stiffness = np.full(delta.shape, self.gap_stiffness)
-        stiffness = stiffness + np.where(
-            delta > self.compression_gap, self.compression_stiffness, 0.0
+        from clearjoint.laws import clearance  # here: numba loads on first use only
+
+        samples = np.asarray(delta, dtype=np.float64)
+        _, stiffness = clearance.forces_and_tangents(
+            _column(samples), *clearance.parameters((self,))
         )
-        stiffness = stiffness + np.where(delta < -self.tension_gap, self.tension_stiffness, 0.0)
-        return stiffness
+        return stiffness.reshape(samples.shape)
 
     def potential_energy(self, delta: ArrayLike) -> NDArray[np.float64]:
-        """Return the energy V(delta) in J stored in the joint, the integral of f from 0."""
-        delta = np.asarray(delta, dtype=np.float64)
-        energy = 0.5 * self.gap_stiffness * delta**2
-        energy = (
-            energy
-            + 0.5 * self.compression_stiffness * np.maximum(delta - self.compression_gap, 0.0) ** 2
-        )
-        energy = (
-            energy + 0.5 * self.tension_stiffness * np.minimum(delta + self.tension_gap, 0.0) ** 2
-        )
-        return energy
+        """Return the energy V(delta) in J stored in the joint, the integral of f from 0.
+
+        MODEL.md sec. 0 (:func:`clearjoint.laws.clearance.potential`); any shape.
+        """
+        from clearjoint.laws import clearance  # here: numba loads on first use only
+
+        samples = np.asarray(delta, dtype=np.float64)
+        energy = clearance.potentials(_column(samples), *clearance.parameters((self,)))
+        return energy.reshape(samples.shape)
+
+    def contact_force(self, delta: ArrayLike) -> NDArray[np.float64]:
+        """Return the normal force on the pin in N, >= 0, at relative displacement delta in m.
+
+        MODEL.md sec. 0 and eq 14 (:func:`clearjoint.laws.clearance.contact_force`): the
+        force less its free-play spring k0 delta, as a magnitude; any shape.
+        """
+        from clearjoint.laws import clearance  # here: numba loads on first use only
+
+        samples = np.asarray(delta, dtype=np.float64)
+        _, k_c, k_t, g_c, g_t = clearance.parameters((self,))
+        return clearance.contact_forces(_column(samples), k_c, k_t, g_c, g_t).reshape(samples.shape)
 
     def in_series(self, stiffness: float) -> ClearanceJoint:
         """Return the one massless law of this joint in series with a spring (MODEL.md 5.2).
@@ -378,6 +390,11 @@ class Pin:
         c = _checks.positive("clearance", clearance, unit="m")
         r_p = _checks.positive("pin radius", radius, unit="m")
         return cls(radius=r_p, hole_radius=r_p + 0.5 * c, length=length, **materials)
+
+
+def _column(samples: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Samples of any shape as one contiguous column (N, 1), for the laws' array forms."""
+    return np.ascontiguousarray(samples.reshape(-1, 1))
 
 
 def _poisson(name: str, value: float) -> float:

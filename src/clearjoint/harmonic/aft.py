@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
+from clearjoint.laws import clearance
 
 FloatArray = NDArray[np.float64]
 
@@ -376,17 +377,9 @@ def _evaluate_one_dof(
     kt = np.empty((n_t, n_j))
     for n in range(n_t):
         for j in range(n_j):
-            delta = b[j] * u[n]
-            fj = k0[j] * delta
-            kj = k0[j]
-            if delta > g_c[j]:
-                fj += k_c[j] * (delta - g_c[j])
-                kj += k_c[j]
-            if delta < -g_t[j]:
-                fj += k_t[j] * (delta + g_t[j])
-                kj += k_t[j]
-            f[n, j] = fj
-            kt[n, j] = kj
+            f[n, j], kt[n, j] = clearance.force_and_tangent(
+                b[j] * u[n], k0[j], k_c[j], k_t[j], g_c[j], g_t[j]
+            )
     jac = omega * c * d
     for i in range(n_c):
         jac[i, i] += k - m * w2 * order[i] * order[i]

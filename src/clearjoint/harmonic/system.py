@@ -22,8 +22,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
-from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.joint import ClearanceJoint, Friction, Joint
+from clearjoint.laws import clearance
 from clearjoint.stiffness import viscous_coefficient
 
 FloatArray = NDArray[np.float64]
@@ -94,8 +94,13 @@ class LinearSystem:
         return np.asarray(self.stiffness + (b.T * self.k0) @ b, dtype=np.float64)
 
     def joint_forces(self, delta: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Return f_j(delta) (N) and df_j/d delta (N/m) for samples ``delta`` (N_t, n_j)."""
-        return _law(np.ascontiguousarray(delta), self.k0, self.k_c, self.k_t, self.g_c, self.g_t)
+        """Return f_j(delta) (N) and df_j/d delta (N/m) for samples ``delta`` (N_t, n_j).
+
+        MODEL.md sec. 0: :func:`clearjoint.laws.clearance.forces_and_tangents`.
+        """
+        return clearance.forces_and_tangents(
+            np.ascontiguousarray(delta), self.k0, self.k_c, self.k_t, self.g_c, self.g_t
+        )
 
     def friction_forces(self, speed: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Return mu_s P tanh(v / v_eps) (N) and its derivative in v (N s/m), samples (N_t, n_j)."""
@@ -105,34 +110,6 @@ class LinearSystem:
             self.friction_force * ratio,
             (self.friction_force / self.friction_speed) * (1.0 - ratio * ratio),
         )
-
-
-@njit(cache=True)
-def _law(
-    delta: FloatArray,
-    k0: FloatArray,
-    k_c: FloatArray,
-    k_t: FloatArray,
-    g_c: FloatArray,
-    g_t: FloatArray,
-) -> tuple[FloatArray, FloatArray]:
-    """The piecewise-linear law of section 0 and its tangent, sample by sample (compiled)."""
-    force = np.empty_like(delta)
-    tangent = np.empty_like(delta)
-    for n in range(delta.shape[0]):
-        for j in range(delta.shape[1]):
-            d = delta[n, j]
-            f = k0[j] * d
-            k = k0[j]
-            if d > g_c[j]:
-                f += k_c[j] * (d - g_c[j])
-                k += k_c[j]
-            if d < -g_t[j]:
-                f += k_t[j] * (d + g_t[j])
-                k += k_t[j]
-            force[n, j] = f
-            tangent[n, j] = k
-    return force, tangent
 
 
 def _refuse_losses(
@@ -224,8 +201,6 @@ def from_structure(structure: Any, friction_speed: float = 0.0) -> LinearSystem:
     ``friction_speed`` (m/s, > 0 when some joint has friction); joints without
     friction get a friction force of 0.
     """
-    from clearjoint.structure.model import OPEN
-
     laws: tuple[ClearanceJoint, ...] = structure.joint_laws
     for index, law in zip(structure.joint_members, laws, strict=True):
         _refuse_structure_losses(law, index)
@@ -242,7 +217,7 @@ def from_structure(structure: Any, friction_speed: float = 0.0) -> LinearSystem:
             )
         forces = rub
         friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
-    k_lin, _ = structure.pattern_stiffness(np.full(n_j, OPEN, dtype=np.int64))
+    k_lin, _ = structure.pattern_stiffness(np.full(n_j, clearance.OPEN, dtype=np.int64))
     # pattern_stiffness("open") holds each joint's k0; the laws carry k0 themselves.
     b = structure.joint_directions
     k0 = np.array([law.gap_stiffness for law in laws])

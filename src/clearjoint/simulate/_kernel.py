@@ -31,6 +31,7 @@ import math
 import numpy as np
 
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
+from clearjoint.laws import clearance
 
 # ---- parameter vector layout -------------------------------------------------------------
 P_MASS, P_DAMP, P_K0, P_KC, P_KT, P_GC, P_GT, P_F0, P_W, P_FF, P_E, P_FMODE, P_TF = range(13)
@@ -39,8 +40,8 @@ N_PARAMS = 13
 # friction modes
 FRICTION_NONE, FRICTION_EVERYWHERE, FRICTION_FREE_PLAY = 0, 1, 2
 
-# regions
-FREE, COMPRESSION, TENSION = 0, 1, -1
+# regions: the law's contact states (FREE is the kernel's name of OPEN)
+FREE, COMPRESSION, TENSION = clearance.OPEN, clearance.COMPRESSION, clearance.TENSION
 
 # state vector layout: x, v, region, slip (-1, 0 = stick, +1)
 S_X, S_V, S_REGION, S_SLIP = range(4)
@@ -106,13 +107,11 @@ N_Q = 18
 
 @njit(cache=True)
 def region_force(p: np.ndarray, region: int) -> tuple[float, float]:
-    """(K, Fc): the restoring force in ``region`` is K x - Fc."""
-    k0 = p[P_K0]
-    if region == COMPRESSION:
-        return k0 + p[P_KC], p[P_KC] * p[P_GC]
-    if region == TENSION:
-        return k0 + p[P_KT], -p[P_KT] * p[P_GT]
-    return k0, 0.0
+    """(K, Fc): the restoring force in ``region`` is K x - Fc (MODEL.md sec. 0).
+
+    :func:`clearjoint.laws.clearance.state_law` on the parameter vector's law.
+    """
+    return clearance.state_law(region, p[P_K0], p[P_KC], p[P_KT], p[P_GC], p[P_GT])
 
 
 @njit(cache=True)
@@ -409,12 +408,11 @@ def decide_slip(p: np.ndarray, region: int, x: float, phi: float) -> int:
 
 @njit(cache=True)
 def region_of(p: np.ndarray, x: float, v: float) -> int:
-    """The region of a position (an edge counts as the side the velocity points to)."""
-    if x > p[P_GC] or (x == p[P_GC] and v > 0.0):
-        return COMPRESSION
-    if x < -p[P_GT] or (x == -p[P_GT] and v < 0.0):
-        return TENSION
-    return FREE
+    """The region of a position (an edge counts as the side the velocity points to).
+
+    :func:`clearjoint.laws.clearance.contact_state` on the parameter vector's gap edges.
+    """
+    return clearance.contact_state(x, v, p[P_GC], p[P_GT])
 
 
 @njit(cache=True)

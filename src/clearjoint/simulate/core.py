@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
-from clearjoint.contact import hertz_coefficient, hertz_contact
+from clearjoint.contact import contact_friction_power, hertz_contact
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
 from clearjoint.simulate import _kernel as kn
@@ -456,10 +456,13 @@ def _contact_friction(
     pin: Pin | None,
     friction_coefficient: float,
 ) -> float:
-    """MODEL.md eq 14-15 along the recorded motion: (4 mu_c beta_H / (3 pi R_p)) F_n^1.5 |v|."""
+    """MODEL.md eq 14-15 along the recorded motion: the integral of the arc friction power.
+
+    :func:`clearjoint.contact.contact_friction_power` at the pin's normal force
+    (:meth:`ClearanceJoint.contact_force`), by Gauss-Legendre over each contact segment.
+    """
     if pin is None or friction_coefficient == 0.0:
         return 0.0
-    factor = 4.0 * friction_coefficient * hertz_coefficient(pin) / (3.0 * math.pi * pin.radius)
     nodes, weights = np.polynomial.legendre.leggauss(64)
     tf = p[kn.P_TF]
     total = 0.0
@@ -472,14 +475,12 @@ def _contact_friction(
         times = start + 0.5 * row[kn.SEG_DT] * (nodes + 1.0)
         out = np.zeros((times.size, 3))
         kn.sample(p, row[None, :], 1, times, out)
-        if region == kn.COMPRESSION:
-            force = joint.compression_stiffness * np.maximum(out[:, 0] - joint.compression_gap, 0)
-        else:
-            force = joint.tension_stiffness * np.maximum(-joint.tension_gap - out[:, 0], 0)
-        total += 0.5 * row[kn.SEG_DT] * float(np.sum(weights * force**1.5 * np.abs(out[:, 1])))
+        force = joint.element.contact_force(out[:, 0])
+        power = contact_friction_power(pin, friction_coefficient, force, out[:, 1])
+        total += 0.5 * row[kn.SEG_DT] * float(np.sum(weights * power))
         peak = max(peak, float(force.max()))
     hertz_contact(pin, peak)  # warns when the arc is too wide for Hertz
-    return factor * total
+    return total
 
 
 def _stages(regions: NDArray[np.int64], starts: FloatArray, ends: FloatArray) -> tuple[Stage, ...]:

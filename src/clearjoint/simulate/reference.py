@@ -5,6 +5,9 @@ direction or stick) is integrated numerically (DOP853) until solve_ivp locates
 its first event. The event rules (restitution on entering contact, stick or
 slip at a velocity zero) are those of MODEL.md sec. 2. Used by the tests to
 cross-check the event-driven solver and by ``benchmarks/bench_simulate.py``.
+Its independence is the integration and the event location: each state's linear law
+K x - Fc is the kernel's ``region_force`` (:func:`clearjoint.laws.clearance.state_law`),
+which ``tests/test_laws_clearance.py`` checks against a law written out in the test.
 """
 
 from __future__ import annotations

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
+from clearjoint.laws import clearance
 from clearjoint.simulate._kernel import certified_step
 
 #: Most Taylor terms per step; a step that needs more is halved.
@@ -41,7 +42,8 @@ ROOT_TOL = 1e-15
 #: Deepest Bernstein subdivision.
 MAX_DEPTH = 64
 
-OPEN, COMPRESSION, TENSION = 0, 1, -1
+#: The law's contact states.
+OPEN, COMPRESSION, TENSION = clearance.OPEN, clearance.COMPRESSION, clearance.TENSION
 #: Status codes of ``march``.
 DONE, CHATTER, NO_CONVERGENCE = 0, 1, 2
 

@@ -28,11 +28,12 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
 from clearjoint.joint import ClearanceJoint, positive_or_inf
+from clearjoint.laws import clearance
 
 FloatArray = NDArray[np.float64]
 
-#: Joint states in a contact pattern.
-OPEN, COMPRESSION, TENSION = 0, 1, -1
+#: Joint states in a contact pattern: the law's contact states.
+OPEN, COMPRESSION, TENSION = clearance.OPEN, clearance.COMPRESSION, clearance.TENSION
 
 #: Above this many DOFs the matrices are returned sparse.
 SPARSE_ABOVE = 200
@@ -539,15 +540,21 @@ class Structure:
 
 
 def _law_state(law: ClearanceJoint, state: int) -> tuple[float, float]:
-    """(stiffness, offset) of a joint's law in one state: f = stiffness * delta - offset."""
-    k0 = law.gap_stiffness
-    if state == COMPRESSION:
-        return k0 + law.compression_stiffness, law.compression_stiffness * law.compression_gap
-    if state == TENSION:
-        return k0 + law.tension_stiffness, -law.tension_stiffness * law.tension_gap
-    if state == OPEN:
-        return k0, 0.0
-    raise StructureError(f"a joint state must be 0 (open), 1 or -1, got {state!r}")
+    """(stiffness, offset) of a joint's law in one state: f = stiffness * delta - offset.
+
+    MODEL.md sec. 0: :func:`clearjoint.laws.clearance.state_law`, for a valid state.
+    """
+    if state not in (OPEN, COMPRESSION, TENSION):
+        raise StructureError(f"a joint state must be 0 (open), 1 or -1, got {state!r}")
+    k_s, offset = clearance.state_law(
+        state,
+        law.gap_stiffness,
+        law.compression_stiffness,
+        law.tension_stiffness,
+        law.compression_gap,
+        law.tension_gap,
+    )
+    return float(k_s), float(offset)
 
 
 def edge_positions(laws: Sequence[ClearanceJoint]) -> tuple[FloatArray, FloatArray]:

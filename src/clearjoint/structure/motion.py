@@ -41,17 +41,10 @@ import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.laws import clearance
 from clearjoint.simulate.core import EnergyLedger, SimulationError
 from clearjoint.structure import _march
-from clearjoint.structure.model import (
-    COMPRESSION,
-    OPEN,
-    TENSION,
-    Structure,
-    StructureError,
-    _law_state,
-    edge_positions,
-)
+from clearjoint.structure.model import Structure, StructureError
 
 FloatArray = NDArray[np.float64]
 
@@ -74,7 +67,8 @@ class _Flow:
         self.omega = omega
         self.b = s.joint_directions
         self.laws = s.joint_laws
-        self.g_c, self.g_t = edge_positions(self.laws)
+        law_parameters = clearance.parameters(self.laws)
+        self.g_c, self.g_t = law_parameters[3:]
         self.restitution = np.array([law.restitution for law in self.laws], dtype=np.float64)
         inv_m = 1.0 / self.m
         self.impulse_dirs = self.b * inv_m  # rows M^-1 b_j
@@ -85,11 +79,7 @@ class _Flow:
         self.structure = s
         n_j = len(self.laws)
         # each joint's (stiffness, offset) in state -1, 0, 1 (column state + 1)
-        self.k_table = np.zeros((n_j, 3))
-        self.r_table = np.zeros((n_j, 3))
-        for j, law in enumerate(self.laws):
-            for state in (TENSION, OPEN, COMPRESSION):
-                self.k_table[j, state + 1], self.r_table[j, state + 1] = _law_state(law, state)
+        self.k_table, self.r_table = clearance.state_tables(*law_parameters)
         k_stiff = self.k_linear + (self.b.T * np.max(self.k_table, axis=1)) @ self.b
         w2 = scipy.linalg.eigh(k_stiff, np.diag(self.m), eigvals_only=True)
         self.omega_ref = math.sqrt(max(float(w2[-1]), 1e-300))
@@ -138,10 +128,13 @@ class _Flow:
         return 0.5 * float(v @ (self.m * v)) + 0.5 * float(u @ self.k_linear @ u) + stored
 
     def states_at(self, delta: FloatArray, rate: FloatArray) -> NDArray[np.int8]:
-        states = np.zeros(delta.size, dtype=np.int8)
-        states[(delta > self.g_c) | ((delta == self.g_c) & (rate > 0.0))] = COMPRESSION
-        states[(delta < -self.g_t) | ((delta == -self.g_t) & (rate < 0.0))] = TENSION
-        return states
+        """Each joint's contact state at shortenings ``delta`` moving at ``rate`` (n_j,)."""
+        return clearance.contact_states(
+            np.ascontiguousarray(delta, dtype=np.float64),
+            np.ascontiguousarray(rate, dtype=np.float64),
+            self.g_c,
+            self.g_t,
+        )
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,8 @@ equation of motion of MODEL.md 5.2 is integrated numerically (DOP853) with each
 joint's force f_j(b_j^T u) taken from its law directly; solve_ivp locates every gap
 edge as a terminal event, where restitution is applied and the integration restarts
 (so no step straddles a kink). Used by the tests and ``benchmarks/bench_structure.py``.
+The joints' law is written out here on purpose, not taken from
+:mod:`clearjoint.laws.clearance`: this is the independent route the tests check against.
 """
 
 from __future__ import annotations
