@@ -38,7 +38,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
-from clearjoint.continuation import Branch, ContinuationSettings, continue_branch
+from clearjoint.continuation import (
+    Branch,
+    ContinuationSettings,
+    continue_branch,
+    parameter_range,
+)
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint
 from clearjoint.simulate import _kernel as kn
@@ -783,38 +788,6 @@ def _free_play_orbit(p: FloatArray, omega: float, code: int = 0) -> FloatArray |
     return out
 
 
-def _parameter_range(
-    parameter: str,
-    force_amplitude: float,
-    omega_start: float,
-    omega_stop: float | None,
-    force_stop: float | None,
-) -> tuple[float, float]:
-    """The (start, stop) of the continuation parameter, checked: positive, nonzero width.
-
-    Shared by shooting (here) and harmonic balance (clearjoint.harmonic.response).
-    """
-    if parameter == "omega":
-        if omega_stop is None:
-            raise ParameterError("omega_stop is required with parameter='omega' (rad/s)")
-        w1 = _checks.positive("omega_stop", omega_stop, unit="rad/s")
-        if w1 == omega_start:
-            raise ParameterError(
-                f"the omega range has zero width ({omega_start!r} to {w1!r} rad/s); give two values"
-            )
-        return omega_start, w1
-    if force_stop is None:
-        raise ParameterError(
-            "force_stop is required with parameter='force': give the end of the force range (N)"
-        )
-    f1 = _checks.positive("force_stop", force_stop, unit="N")
-    if f1 == force_amplitude:
-        raise ParameterError(
-            f"the force range has zero width ({force_amplitude!r} to {f1!r} N); give two values"
-        )
-    return force_amplitude, f1
-
-
 def frequency_response(
     joint: Joint,
     force_amplitude: float,
@@ -877,7 +850,7 @@ def frequency_response(
         raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
     w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
     f0 = _checks.positive("force_amplitude", force_amplitude, unit="N")
-    start, stop = _parameter_range(parameter, f0, w0, omega_stop, force_stop)
+    start, stop = parameter_range(parameter, f0, w0, omega_stop, force_stop)
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
     first = periodic_orbit(

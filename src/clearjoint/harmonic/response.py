@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
-from clearjoint.continuation import ContinuationSettings, continue_branch
+from clearjoint.continuation import ContinuationSettings, continue_branch, parameter_range
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.harmonic import aft, check, hill, monodromy, solve
 from clearjoint.harmonic.solve import (
@@ -49,7 +49,7 @@ from clearjoint.harmonic.system import (
     scale_length,
 )
 from clearjoint.joint import Friction
-from clearjoint.periodic import FrequencyResponse, ResponseEvent, _parameter_range
+from clearjoint.periodic import FrequencyResponse, ResponseEvent
 
 FloatArray = NDArray[np.float64]
 
@@ -202,7 +202,7 @@ def frequency_response(
     )
     pattern = force_vector(model, force)
     peak = float(np.max(np.abs(pattern)))
-    start, stop = _parameter_range(parameter, peak, w0, omega_stop, force_stop)
+    start, stop = parameter_range(parameter, peak, w0, omega_stop, force_stop)
     unit_force = pattern / peak
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
