@@ -68,6 +68,72 @@ class EnergyLedger:
             "losses": self.losses,
         }
 
+    def __repr__(self) -> str:
+        return (
+            f"EnergyLedger(input {self.input * 1e3:.4g} mJ, losses {self.losses * 1e3:.4g} mJ "
+            f"(viscous {self.viscous * 1e3:.4g}, sliding friction "
+            f"{self.sliding_friction * 1e3:.4g}, impact {self.impact * 1e3:.4g}), "
+            f"contact friction {self.contact_friction * 1e3:.4g} mJ, "
+            f"balance error {self.balance_error:.1e})"
+        )
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the ledger as an ``xarray.Dataset`` of 0-d variables, each in J.
+
+        Returns
+        -------
+        xarray.Dataset
+            One 0-d variable per entry of :meth:`as_dict` (``attrs["units"] == "J"``)
+            and ``balance_error`` (1).
+        """
+        import xarray as xr
+
+        data = xr.Dataset(
+            {key: ((), value, {"units": "J"}) for key, value in self.as_dict().items()},
+            attrs={"title": "clearjoint energy ledger"},
+        )
+        data["balance_error"] = ((), self.balance_error, {"units": "1"})
+        return data
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the ledger as a ``pandas.DataFrame``: index ``entry``, one column ``energy_j``.
+
+        A ledger has no rows of its own: its table is one row per entry of :meth:`as_dict`.
+        """
+        import pandas as pd
+
+        entries = self.as_dict()
+        return pd.DataFrame(
+            {"energy_j": list(entries.values())}, index=pd.Index(list(entries), name="entry")
+        )
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw the input beside each loss as horizontal bars (mJ); return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            One bar container: input, viscous, sliding friction, impact, contact
+            friction and the change of mechanical energy.
+        """
+        from clearjoint.plotting import axes_or_new
+
+        axes: Axes = axes_or_new(ax)
+        entries = {k: v for k, v in self.as_dict().items() if k != "losses"}
+        axes.barh(
+            [k.replace("_", " ") for k in entries],
+            [v * 1e3 for v in entries.values()],
+            color=["0.3"] + ["0.7"] * (len(entries) - 1),
+        )
+        axes.invert_yaxis()
+        axes.set_xlabel("energy (mJ)")
+        return axes
+
 
 @dataclass(frozen=True)
 class Stage:
@@ -76,6 +142,51 @@ class Stage:
     name: str
     start: float
     end: float
+
+    def __repr__(self) -> str:
+        return f"Stage({self.name}, {self.start * 1e3:.6g}-{self.end * 1e3:.6g} ms)"
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the stage as an ``xarray.Dataset`` of 0-d ``name``, ``start``, ``end`` (s)."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "name": ((), self.name),
+                "start": ((), self.start, {"units": "s"}),
+                "end": ((), self.end, {"units": "s"}),
+            },
+            attrs={"title": "clearjoint stage of the motion"},
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the stage as a one-row ``pandas.DataFrame`` (a motion's stages: its to_xarray).
+
+        Columns ``name``, ``start_s``, ``end_s``.
+        """
+        import pandas as pd
+
+        return pd.DataFrame({"name": [self.name], "start_s": [self.start], "end_s": [self.end]})
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Shade the stage's time span (ms) on ``ax``; return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (usually a motion's plot); a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            Its last patch spans start to end in ms, labelled with the stage's name.
+        """
+        from clearjoint.plotting import axes_or_new
+
+        axes: Axes = axes_or_new(ax)
+        axes.axvspan(self.start * 1e3, self.end * 1e3, color="0.85", zorder=0, label=self.name)
+        axes.set_xlabel("time (ms)")
+        return axes
 
 
 @dataclass(frozen=True)
@@ -319,3 +430,80 @@ class FrequencySweep:
     multiple_down: NDArray[np.int64]
     steady_up: tuple[SteadyState | None, ...] = field(repr=False, default=())
     steady_down: tuple[SteadyState | None, ...] = field(repr=False, default=())
+
+    def __repr__(self) -> str:
+        f = self.omega / (2 * math.pi)
+
+        def largest(values: FloatArray) -> str:
+            return (
+                f"{float(np.nanmax(values)) * 1e6:.4g} um" if np.any(np.isfinite(values)) else "-"
+            )
+
+        return (
+            f"FrequencySweep({self.omega.size} frequencies, {f.min():.4g}-{f.max():.4g} Hz, "
+            f"max X up {largest(self.amplitude_up)}, down {largest(self.amplitude_down)}, "
+            f"{int(np.sum(self.multiple_up > 1) + np.sum(self.multiple_down > 1))} "
+            "orbits of more than one period)"
+        )
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the sweep as an ``xarray.Dataset`` on ``omega``, units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinates ``omega`` (n,) rad/s and ``frequency`` (Hz); ``amplitude_up``,
+            ``amplitude_down`` (m, NaN where none) and ``multiple_up``,
+            ``multiple_down`` (periods of each orbit, 0 where none).
+        """
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "amplitude_up": ("omega", self.amplitude_up, {"units": "m"}),
+                "amplitude_down": ("omega", self.amplitude_down, {"units": "m"}),
+                "multiple_up": ("omega", self.multiple_up, {"units": "forcing periods"}),
+                "multiple_down": ("omega", self.multiple_down, {"units": "forcing periods"}),
+            },
+            coords={
+                "omega": ("omega", self.omega, {"units": "rad/s"}),
+                "frequency": ("omega", self.omega / (2 * math.pi), {"units": "Hz"}),
+            },
+            attrs={"title": "clearjoint stepped-sine sweep"},
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the sweep as a ``pandas.DataFrame``, one row per frequency.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``to_xarray().to_dataframe()``: index ``omega`` (rad/s); columns
+            ``frequency`` (Hz), ``amplitude_up``, ``amplitude_down`` (m),
+            ``multiple_up``, ``multiple_down``.
+        """
+        return self.to_xarray().to_dataframe()
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw the steady amplitude X (mm) against frequency (Hz), up and down; return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            Two lines, "sweep up" then "sweep down" (gaps where no orbit was found).
+        """
+        from clearjoint.plotting import axes_or_new
+
+        axes: Axes = axes_or_new(ax)
+        f = self.omega / (2 * math.pi)
+        axes.plot(f, self.amplitude_up * 1e3, "-^", color="C0", ms=3, label="sweep up")
+        axes.plot(f, self.amplitude_down * 1e3, "--v", color="C3", ms=3, label="sweep down")
+        axes.set_xlabel("frequency (Hz)")
+        axes.set_ylabel("amplitude X (mm)")
+        axes.legend(frameon=False, fontsize="small")
+        return axes
