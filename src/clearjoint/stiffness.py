@@ -50,6 +50,29 @@ __all__ = [
 ]
 
 
+def _on_amplitude(
+    amplitude: FloatArray, columns: dict[str, tuple[FloatArray, str]], attrs: dict[str, object]
+) -> xr.Dataset:
+    """Return ``columns`` (name: (values, unit)) as a Dataset on the 1-D coordinate ``amplitude``.
+
+    The shared body of the ``to_xarray`` of :class:`FreeOrbit` and :class:`StiffnessCurve`:
+    each array broadcast like ``amplitude`` (m), its unit in its attrs.
+    """
+    import xarray as xr
+
+    from clearjoint.plotting import one_dimensional
+
+    a = one_dimensional("amplitude", amplitude)
+    return xr.Dataset(
+        {
+            name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
+            for name, (values, unit) in columns.items()
+        },
+        coords={"amplitude": ("amplitude", a, {"units": "m"})},
+        attrs=attrs,
+    )
+
+
 @dataclass(frozen=True)
 class FreeOrbit:
     """The free-vibration orbit of a joint at compression penetration A (MODEL.md eq 1-5).
@@ -146,18 +169,10 @@ class FreeOrbit:
         ParameterError
             The orbits were computed on a grid of more than one dimension.
         """
-        import xarray as xr
-
-        from clearjoint.plotting import one_dimensional
-
-        a = one_dimensional("amplitude", self.compression_penetration)
-        return xr.Dataset(
-            {
-                name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
-                for name, (values, unit) in self._columns().items()
-            },
-            coords={"amplitude": ("amplitude", a, {"units": "m"})},
-            attrs={"title": "clearjoint free-vibration orbits against penetration"},
+        return _on_amplitude(
+            self.compression_penetration,
+            self._columns(),
+            {"title": "clearjoint free-vibration orbits against penetration"},
         )
 
     def to_pandas(self) -> pd.DataFrame:
@@ -759,19 +774,11 @@ class StiffnessCurve:
             ``stiffness_coefficient`` (1), each (N,) with ``attrs["units"]``; the
             joint's parameters as attrs (SI, the unit in each name).
         """
-        import xarray as xr
-
-        from clearjoint.plotting import one_dimensional
-
-        a = one_dimensional("amplitude", self.amplitude)
         j = self.joint
-        return xr.Dataset(
+        return _on_amplitude(
+            self.amplitude,
+            self._columns(),
             {
-                name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
-                for name, (values, unit) in self._columns().items()
-            },
-            coords={"amplitude": ("amplitude", a, {"units": "m"})},
-            attrs={
                 "title": "clearjoint dynamic stiffness against amplitude",
                 "mass_kg": j.mass,
                 "clearance_m": j.clearance,
