@@ -46,8 +46,12 @@ from clearjoint.continuation import (
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint
 from clearjoint.results.motion import SteadyState
-from clearjoint.results.orbit import PeriodicOrbit
-from clearjoint.results.response import FrequencyResponse, ResponseEvent
+
+# the results moved to clearjoint.results; imported "as" themselves so that the old path
+# clearjoint.periodic re-exports them (and the API reference documents them once)
+from clearjoint.results.orbit import PeriodicOrbit as PeriodicOrbit
+from clearjoint.results.response import FrequencyResponse as FrequencyResponse
+from clearjoint.results.response import ResponseEvent as ResponseEvent
 from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate._shooting import (
     N_RES,
@@ -76,9 +80,6 @@ from clearjoint.simulate.core import (
 )
 
 __all__ = [
-    "FrequencyResponse",
-    "PeriodicOrbit",
-    "ResponseEvent",
     "frequency_response",
     "orbit_cycle",
     "orbit_monodromy",

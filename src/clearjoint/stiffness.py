@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, Protocol
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -51,7 +51,7 @@ __all__ = [
 
 
 def _on_amplitude(
-    amplitude: FloatArray, columns: dict[str, tuple[FloatArray, str]], attrs: dict[str, object]
+    amplitude: FloatArray, columns: dict[str, tuple[NDArray[Any], str]], attrs: dict[str, object]
 ) -> xr.Dataset:
     """Return ``columns`` (name: (values, unit)) as a Dataset on the 1-D coordinate ``amplitude``.
 
@@ -135,7 +135,7 @@ class FreeOrbit:
             f"X = {span(x)} um, T = {span(t)} ms)"
         )
 
-    def _columns(self) -> dict[str, tuple[FloatArray, str]]:
+    def _columns(self) -> dict[str, tuple[NDArray[Any], str]]:
         """Return each field but A_c with its unit: the variables of :meth:`to_xarray`."""
         return {
             "tension_penetration": (self.tension_penetration, "m"),

@@ -25,24 +25,18 @@ from clearjoint import checks as _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
-from clearjoint.results.motion import EnergyLedger, FrequencySweep, Motion, Stage, SteadyState
+
+# the results moved to clearjoint.results; imported "as" themselves so that the old path
+# clearjoint.simulate.core re-exports them (and the API reference documents them once)
+from clearjoint.results.motion import EnergyLedger as EnergyLedger
+from clearjoint.results.motion import FrequencySweep as FrequencySweep
+from clearjoint.results.motion import Motion as Motion
+from clearjoint.results.motion import Stage as Stage
+from clearjoint.results.motion import SteadyState as SteadyState
 from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate._shooting import newton_orbit, start_state
 from clearjoint.stiffness import viscous_coefficient
 from clearjoint.units import to_si
-
-__all__ = [
-    "STAGE_NAMES",
-    "EnergyLedger",
-    "FrequencySweep",
-    "Motion",
-    "SimulationError",
-    "Stage",
-    "SteadyState",
-    "frequency_sweep",
-    "steady_state",
-    "time_response",
-]
 
 FloatArray = NDArray[np.float64]
 
