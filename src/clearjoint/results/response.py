@@ -171,7 +171,7 @@ class FrequencyResponse:
         a_0, a_1, b_1, ..., a_H, b_H of each point, m, (n, 2H + 1) for a Joint and
         (n, 2H + 1, N) for a Structure (whose x_max, x_min, amplitude are then (n, N)).
     method : {"shooting", "harmonic"}
-        Exact shooting (this module) or harmonic balance (``clearjoint.harmonic``).
+        Exact shooting (``clearjoint.periodic``) or harmonic balance (``clearjoint.harmonic``).
     free_play : (n,) ndarray of bool, optional
         True where the orbit stays inside the gap with gap_stiffness 0: one of a
         continuum of orbits (any mean position that keeps it off the edges; Floquet
