@@ -294,3 +294,54 @@ def test_energies_accept_a_losses_value_for_the_five_keywords() -> None:
         ds.total(joint, amplitude, losses=Losses(**keywords)),  # type: ignore[arg-type]
         ds.total(joint, amplitude, **keywords),  # type: ignore[arg-type]
     )
+
+
+def test_comparison_tables_and_plot_carry_both_routes() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    result = ds.compare(joint(), 20000.0, 2 * math.pi * 100.0, restitution=0.9, damping_ratio=0.01)
+    data = result.to_xarray()
+    for key in result.exact:
+        assert float(data["exact"].sel(energy=key)) == result.exact[key]
+        assert float(data["closed"].sel(energy=key)) == result.closed[key]
+        assert float(data["gap"].sel(energy=key)) == result.gap[key]
+    assert data["exact"].attrs["units"] == "J"
+    assert data["penetration"].attrs["units"] == "m"
+    table = result.to_pandas()
+    assert table.loc["impact_j", "exact_j"] == result.exact["impact_j"]
+    text = repr(result)
+    assert text.startswith("Comparison(A = ")
+    assert "{" not in text
+    assert len(text) < 200
+    _, ax = plt.subplots()
+    assert result.plot(ax) is ax
+    assert len(ax.patches) == 2 * len(result.exact)
+    plt.close("all")
+
+
+def test_agreement_map_tables_and_plot() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    omega = 2 * math.pi * np.array([100.0, 200.0])
+    force = np.array([1.0, 2.0, 3.0])
+    gap = np.array([[0.1, -0.2, np.nan], [0.05, 0.0, 0.3]])
+    amap = ds.AgreementMap(omega, force, np.full((2, 3), 1e-6), {"total_j": gap})
+    data = amap.to_xarray()
+    np.testing.assert_array_equal(data["gap_total_j"].values, gap)
+    np.testing.assert_array_equal(data["force"].values, force)
+    assert data["penetration"].attrs["units"] == "m"
+    assert data["omega"].attrs["units"] == "rad/s"
+    table = amap.to_pandas()
+    assert table.loc[(omega[1], 3.0), "gap_total_j"] == 0.3
+    assert "2 x 3 grid" in repr(amap)
+    assert "array" not in repr(amap)
+    _, ax = plt.subplots()
+    assert amap.plot(ax) is ax
+    np.testing.assert_array_equal(np.ma.filled(ax.collections[0].get_array(), np.nan), gap.T)
+    plt.close("all")

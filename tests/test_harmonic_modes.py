@@ -586,3 +586,28 @@ def test_the_stick_check_on_a_joint_is_the_restoring_force_at_the_turning_points
     failed = _held(model, basis, amps, orbits, 6000.0)
     assert list(failed) == [0]
     assert failed[0].startswith("friction holds the joint")
+
+
+def test_nonlinear_mode_to_pandas_is_one_row_per_amplitude() -> None:
+    n, dofs = 3, 2
+    shape = np.outer(np.linspace(1.0, 2.0, n), [1e-4, 2e-4])
+    mode = NonlinearMode(
+        amplitude=np.array([1e-5, 2e-5, 4e-5]),
+        x_max=shape,
+        x_min=-shape,
+        frequency=np.array([600.0, 610.0, 630.0]),
+        damping_ratio=np.array([0.01, 0.02, 0.03]),
+        energy_per_cycle=np.array([1e-3, 2e-3, 3e-3]),
+        harmonic_shapes=np.zeros((n, 3, dofs)),
+        converged=np.array([True, True, False]),
+        epmc_damping_ratio=np.array([0.01, 0.015, 0.02]),
+        harmonics=1,
+        reference_dof="n2x",
+        dof_names=("n1x", "n2x"),
+    )
+    table = mode.to_pandas()
+    np.testing.assert_array_equal(table.index.to_numpy(), mode.amplitude)
+    np.testing.assert_allclose(table["frequency_hz"].to_numpy(), mode.frequency / (2 * math.pi))
+    np.testing.assert_array_equal(table["energy_per_cycle_j"].to_numpy(), mode.energy_per_cycle)
+    np.testing.assert_array_equal(table["x_max_m[n2x]"].to_numpy(), shape[:, 1])
+    np.testing.assert_array_equal(table["converged"].to_numpy(), mode.converged)

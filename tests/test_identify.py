@@ -944,3 +944,34 @@ def test_parallel_shares_give_the_serial_outcomes_in_file_order(tmp_path: Path) 
     for (ra, a), (rb, b) in zip(serial, parallel, strict=True):
         np.testing.assert_equal(a.row(), b.row())  # bit for bit; NaN equals NaN here
         np.testing.assert_array_equal(ra.displacement, rb.displacement)
+
+
+def test_cycle_result_tables_and_plot() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from clearjoint.identify import CycleResult
+
+    values = {"amplitude_m": 2e-4, "clearance_m": 1e-4, "energy_per_cycle_j": 3e-3}
+    lines = ((-50.0, 8e7), (0.0, 1e5), (40.0, 5e7))
+    cycle = CycleResult(0, 512, values, 5e-5, -5e-5, "joint", lines)
+    data = cycle.to_xarray()
+    for key, value in values.items():
+        assert float(data[key]) == value
+    assert data["clearance_m"].attrs["units"] == "m"
+    assert data["energy_per_cycle_j"].attrs["units"] == "J"
+    np.testing.assert_array_equal(data["line_slope"].values, [8e7, 1e5, 5e7])
+    assert data["line_slope"].attrs["units"] == "N/m"
+    assert list(data["stage"].values) == ["tension", "free play", "compression"]
+    row = cycle.to_pandas()
+    assert row.loc[0, "clearance_m"] == 1e-4
+    assert row.loc[0, "upper_edge_m"] == 5e-5
+    assert repr(cycle).startswith("CycleResult(samples 0-512, joint, X = 200 um")
+    _, ax = plt.subplots()
+    assert cycle.plot(ax) is ax
+    compression = ax.get_lines()[-1]
+    x = np.asarray(compression.get_xdata()) * 1e-6
+    np.testing.assert_allclose(compression.get_ydata(), 40.0 + 5e7 * x)
+    plt.close("all")

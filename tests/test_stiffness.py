@@ -341,3 +341,47 @@ def test_stiffness_curve_refuses_a_grid_as_a_table() -> None:
     curve = sk.stiffness_curve(j, np.full((2, 3), 1e-5))
     with pytest.raises(ParameterError, match="1-D amplitude"):
         curve.to_xarray()
+
+
+def test_free_orbit_tables_and_plot() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    a = np.array([1e-6, 2e-5, 1e-4])
+    orbit = sk.free_orbit(joint(), a)
+    data = orbit.to_xarray()
+    np.testing.assert_array_equal(data["amplitude"].values, a)
+    np.testing.assert_array_equal(data["period"].values, orbit.period)
+    np.testing.assert_array_equal(data["x_max"].values, orbit.x_max)
+    assert data["period"].attrs["units"] == "s"
+    assert data["contact_action"].attrs["units"] == "m^2/s"
+    table = orbit.to_pandas()
+    np.testing.assert_array_equal(table["free_play_time"].to_numpy(), orbit.free_play_time)
+    assert repr(orbit).startswith("FreeOrbit(3 amplitudes, A_c = 1-100 um")
+    _, ax = plt.subplots()
+    assert orbit.plot(ax) is ax
+    np.testing.assert_allclose(ax.get_lines()[0].get_ydata(), orbit.period * 1e3)
+    plt.close("all")
+
+
+def test_response_branch_tables_and_plot() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    branch = sk.equivalent_linear_response(joint(), 20000.0, 2 * math.pi * 100.0, 0.01)[0]
+    data = branch.to_xarray()
+    assert float(data["displacement_amplitude"]) == branch.displacement_amplitude
+    assert float(data["stiffness"]) == branch.stiffness
+    assert data["stiffness"].attrs["units"] == "N/m"
+    assert data["natural_frequency"].attrs["units"] == "rad/s"
+    row = branch.to_pandas()
+    assert row.loc[0, "penetration_m"] == branch.penetration
+    assert repr(branch).startswith("ResponseBranch(X = ")
+    _, ax = plt.subplots()
+    assert branch.plot(ax) is ax
+    assert ax.get_lines()[-1].get_ydata()[0] == pytest.approx(branch.displacement_amplitude * 1e6)
+    plt.close("all")

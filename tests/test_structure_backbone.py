@@ -70,3 +70,22 @@ def test_a_forced_motion_is_refused_not_read_as_a_decay() -> None:
     # the same call on the free decay of the same structure is read
     free = free_decay(one, ([1e-3], [0.0]), 0.1)
     assert decay_backbone(free, 0).amplitude.size > 5
+
+
+def test_backbone_to_pandas_is_one_row_per_cycle() -> None:
+    from clearjoint.structure import Backbone
+
+    bb = Backbone(
+        time=np.array([0.01, 0.02, 0.03]),
+        amplitude=np.array([3e-4, 2e-4, 1e-4]),
+        omega=np.array([600.0, 620.0, 640.0]),
+        damping_ratio=np.array([0.02, 0.03, np.nan]),
+        dof=2,
+        mode=1,
+    )
+    table = bb.to_pandas()
+    np.testing.assert_array_equal(table.index.to_numpy(), bb.time)
+    np.testing.assert_array_equal(table["amplitude_m"].to_numpy(), bb.amplitude)
+    np.testing.assert_allclose(table["frequency_hz"].to_numpy(), bb.omega / (2 * math.pi))
+    np.testing.assert_array_equal(table["damping_ratio"].to_numpy(), bb.damping_ratio)
+    assert bb.to_xarray()["omega"].attrs["units"] == "rad/s"

@@ -177,3 +177,14 @@ def test_structures_compare_by_value_and_are_not_hashable() -> None:
     assert a != "a structure"
     with pytest.raises(TypeError):
         hash(a)
+
+
+def test_modes_to_pandas_is_one_row_per_mode(three_links: Structure) -> None:
+    modes = three_links.modes()
+    table = modes.to_pandas()
+    np.testing.assert_array_equal(table.index.to_numpy(), np.arange(1, modes.omega.size + 1))
+    np.testing.assert_array_equal(table["omega_rad_per_s"].to_numpy(), modes.omega)
+    np.testing.assert_array_equal(table["frequency_hz"].to_numpy(), modes.frequency_hz)
+    for k, name in enumerate(three_links.dof_names):
+        np.testing.assert_array_equal(table[f"shape[{name}]"].to_numpy(), modes.shapes[k])
+    assert modes.to_xarray()["frequency"].attrs["units"] == "Hz"

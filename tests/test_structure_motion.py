@@ -9,7 +9,7 @@ import pytest
 
 from clearjoint import ClearanceJoint, Friction, Joint
 from clearjoint.simulate import time_response as joint_time_response
-from clearjoint.structure import StructureError, chain, free_decay, time_response
+from clearjoint.structure import Structure, StructureError, chain, free_decay, time_response
 from clearjoint.structure.reference import reference_response
 
 JOINT_ARGS = dict(
@@ -230,3 +230,14 @@ def test_too_many_events_is_an_error_not_a_truncated_motion(
         time_response(*args)
     assert isinstance(info.value, ClearjointError)
     assert "\n" not in str(info.value)
+
+
+def test_structure_motion_to_pandas_is_one_row_per_sample(three_links: Structure) -> None:
+    motion = time_response(three_links, [0.0, 0.0, 40.0], 400.0, 0.02, samples_per_period=32)
+    table = motion.to_pandas()
+    assert table.index.name == "time_s"
+    np.testing.assert_array_equal(table.index.to_numpy(), motion.t)
+    for k, name in enumerate(three_links.dof_names):
+        np.testing.assert_array_equal(table[f"u_m[{name}]"].to_numpy(), motion.u[:, k])
+        np.testing.assert_array_equal(table[f"v_m_per_s[{name}]"].to_numpy(), motion.v[:, k])
+    assert motion.to_xarray()["u"].attrs["units"] == "m"

@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
 
@@ -56,6 +57,9 @@ __all__ = [
     "ContinuationSettings",
     "Residual",
     "continue_branch",
+    "extrapolate",
+    "parameter_range",
+    "tangent_solve",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -234,8 +238,12 @@ def _gauss(m: FloatArray) -> bool:
 
 
 @njit(cache=True)
-def _tangent_solve(a: FloatArray, previous: FloatArray, t: FloatArray) -> bool:
-    """t <- the solution of [a; previous] t = e_last, normalised; False if singular."""
+def tangent_solve(a: FloatArray, previous: FloatArray, t: FloatArray) -> bool:
+    """Return whether the unit tangent t solving [a; previous] t = e_last was found (t filled).
+
+    Shared by this module and the shooting solver's compiled arclength step
+    (``clearjoint.simulate._shooting``); False when the system is singular.
+    """
     d = a.shape[0]
     m = np.zeros((d + 1, d + 2))
     m[:d, : d + 1] = a
@@ -264,7 +272,7 @@ def _tangent(a: Any, previous: FloatArray) -> FloatArray:
     if not isinstance(a, np.ndarray):
         return _sparse_tangent(a, previous)
     t = np.empty(a.shape[1])
-    if not _tangent_solve(np.ascontiguousarray(a, dtype=np.float64), previous, t):
+    if not tangent_solve(np.ascontiguousarray(a, dtype=np.float64), previous, t):
         _, _, vt = np.linalg.svd(a)
         t = vt[-1] / np.linalg.norm(vt[-1])
     unit: FloatArray = np.asarray(t, dtype=np.float64)
@@ -478,9 +486,7 @@ def continue_branch(
             attempt, fast_tangent = (None, None) if stepped is None else stepped
         else:
             if poly:
-                predicted = _extrapolate(
-                    trail[len(ys) - settings.predictor_degree - 1 : len(ys)], h
-                )
+                predicted = extrapolate(trail[len(ys) - settings.predictor_degree - 1 : len(ys)], h)
             else:
                 predicted = y + h * t + 0.5 * h * h * curvature
             attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
@@ -659,8 +665,8 @@ def _short_of_end(stop: float, last: float) -> str:
 
 
 @njit(cache=True)
-def _extrapolate(path: FloatArray, h: float) -> FloatArray:
-    """The polynomial through the rows of ``path`` (in chord length) at ``h`` past the last.
+def extrapolate(path: FloatArray, h: float) -> FloatArray:
+    """Return the polynomial through the rows of ``path`` (in chord length) at ``h`` past the last.
 
     Lagrange interpolation in the cumulative chord length s (s = 0 at the last
     row), evaluated at s = h: through the last n points, a predictor whose error
@@ -683,6 +689,44 @@ def _extrapolate(path: FloatArray, h: float) -> FloatArray:
         for k in range(m):
             out[k] += weight * path[i, k]
     return out
+
+
+#: The old private name, kept for the tests that call it.
+_extrapolate = extrapolate
+
+
+def parameter_range(
+    parameter: str,
+    force_amplitude: float,
+    omega_start: float,
+    omega_stop: float | None,
+    force_stop: float | None,
+) -> tuple[float, float]:
+    """Return the (start, stop) of the continuation parameter, checked: positive, nonzero width.
+
+    Shared by shooting (``clearjoint.periodic``) and harmonic balance
+    (``clearjoint.harmonic.response``): ``parameter`` "omega" runs omega_start to
+    omega_stop (rad/s), "force" runs force_amplitude to force_stop (N).
+    """
+    if parameter == "omega":
+        if omega_stop is None:
+            raise ParameterError("omega_stop is required with parameter='omega' (rad/s)")
+        w1 = _checks.positive("omega_stop", omega_stop, unit="rad/s")
+        if w1 == omega_start:
+            raise ParameterError(
+                f"the omega range has zero width ({omega_start!r} to {w1!r} rad/s); give two values"
+            )
+        return omega_start, w1
+    if force_stop is None:
+        raise ParameterError(
+            "force_stop is required with parameter='force': give the end of the force range (N)"
+        )
+    f1 = _checks.positive("force_stop", force_stop, unit="N")
+    if f1 == force_amplitude:
+        raise ParameterError(
+            f"the force range has zero width ({force_amplitude!r} to {f1!r} N); give two values"
+        )
+    return force_amplitude, f1
 
 
 def _behind(

@@ -457,6 +457,91 @@ class Comparison:
     gap: dict[str, float]
     cycle: SteadyState
 
+    def __repr__(self) -> str:
+        worst = max(self.gap, key=lambda key: abs(self.gap[key]), default="total_j")
+        return (
+            f"Comparison(A = {self.penetration * 1e6:.4g} um: total closed "
+            f"{self.closed.get('total_j', math.nan) * 1e3:.4g} mJ, exact "
+            f"{self.exact.get('total_j', math.nan) * 1e3:.4g} mJ, gap "
+            f"{self.gap.get('total_j', math.nan):+.3g}; largest gap {worst} "
+            f"{self.gap.get(worst, math.nan):+.3g})"
+        )
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return both routes' energies and their gap as an ``xarray.Dataset``, units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            On ``energy`` (the keys of :attr:`exact`): ``closed`` and ``exact`` (J) and
+            ``gap`` (closed / exact - 1); 0-d ``penetration`` (m). The cycle itself is
+            ``cycle.to_xarray()``.
+        """
+        import xarray as xr
+
+        keys = list(self.exact)
+        return xr.Dataset(
+            {
+                "closed": ("energy", [self.closed[k] for k in keys], {"units": "J"}),
+                "exact": ("energy", [self.exact[k] for k in keys], {"units": "J"}),
+                "gap": ("energy", [self.gap[k] for k in keys], {"units": "1"}),
+                "penetration": ((), self.penetration, {"units": "m"}),
+            },
+            coords={"energy": ("energy", keys)},
+            attrs={"title": "clearjoint energies per cycle: closed form against the exact cycle"},
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return both routes' energies as a ``pandas.DataFrame``, one row per energy.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index ``energy`` (the keys of :attr:`exact`); columns ``closed_j``,
+            ``exact_j`` and ``gap`` (closed / exact - 1).
+        """
+        import pandas as pd
+
+        keys = list(self.exact)
+        return pd.DataFrame(
+            {
+                "closed_j": [self.closed[k] for k in keys],
+                "exact_j": [self.exact[k] for k in keys],
+                "gap": [self.gap[k] for k in keys],
+            },
+            index=pd.Index(keys, name="energy"),
+        )
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw each energy by both routes side by side as bars (mJ); return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            Two bar containers, "closed form" then "exact cycle", one bar per energy.
+        """
+        from clearjoint.plotting import axes_or_new
+
+        axes: Axes = axes_or_new(ax)
+        keys = list(self.exact)
+        at = np.arange(len(keys), dtype=np.float64)
+        axes.bar(
+            at - 0.2, [self.closed[k] * 1e3 for k in keys], 0.4, color="0.4", label="closed form"
+        )
+        axes.bar(
+            at + 0.2, [self.exact[k] * 1e3 for k in keys], 0.4, color="0.8", label="exact cycle"
+        )
+        axes.set_xticks(at, [k.removesuffix("_j") for k in keys], rotation=30, ha="right")
+        axes.set_ylabel("energy per cycle (mJ)")
+        axes.set_title(f"A = {self.penetration * 1e6:.4g} µm", fontsize="small")
+        axes.legend(frameon=False, fontsize="small")
+        return axes
+
 
 def _exact_energies(
     cycle: SteadyState,
@@ -560,6 +645,89 @@ class AgreementMap:
     force: FloatArray
     penetration: FloatArray
     gap: dict[str, FloatArray]
+
+    def __repr__(self) -> str:
+        f = self.omega / (2 * math.pi)
+        found = int(np.sum(np.isfinite(self.penetration)))
+        total = self.gap.get("total_j")
+        worst = (
+            f", largest |gap| of the total {float(np.nanmax(np.abs(total))):.3g}"
+            if total is not None and np.any(np.isfinite(total))
+            else ""
+        )
+        return (
+            f"AgreementMap({self.omega.size} x {self.force.size} grid, "
+            f"{f.min():.4g}-{f.max():.4g} Hz, F0 {self.force.min():.4g}-{self.force.max():.4g} N, "
+            f"{found} points with an orbit{worst})"
+        )
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the map as an ``xarray.Dataset`` on (``omega``, ``force``), units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinates ``omega`` (F,) rad/s (with ``frequency`` in Hz) and ``force`` (N,) N;
+            ``penetration`` (F, N) in m and ``gap_<key>`` (F, N) for each energy key
+            (closed / exact - 1, unit 1); NaN where no orbit was found.
+        """
+        import xarray as xr
+
+        dims = ("omega", "force")
+        return xr.Dataset(
+            {
+                "penetration": (dims, self.penetration, {"units": "m"}),
+                **{f"gap_{key}": (dims, value, {"units": "1"}) for key, value in self.gap.items()},
+            },
+            coords={
+                "omega": ("omega", self.omega, {"units": "rad/s"}),
+                "frequency": ("omega", self.omega / (2 * math.pi), {"units": "Hz"}),
+                "force": ("force", self.force, {"units": "N"}),
+            },
+            attrs={"title": "clearjoint agreement of the closed forms with the exact cycle"},
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the map as a ``pandas.DataFrame``, one row per (omega, force) point.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``to_xarray().to_dataframe()``: index (``omega`` rad/s, ``force`` N); columns
+            ``frequency`` (Hz), ``penetration`` (m) and ``gap_<key>`` of each energy.
+        """
+        return self.to_xarray().to_dataframe()
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw the total energy's gap over frequency (Hz) and force (N); return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            One QuadMesh: closed / exact - 1 of ``total_j`` (the penetration in um when
+            no gap was computed), blank where no orbit was found, with a colour bar.
+        """
+        from clearjoint.plotting import axes_or_new
+
+        axes: Axes = axes_or_new(ax)
+        total = self.gap.get("total_j")
+        values, label = (
+            (total, "gap of the total, closed / exact - 1")
+            if total is not None
+            else (self.penetration * 1e6, "penetration A (µm)")
+        )
+        mesh = axes.pcolormesh(
+            self.omega / (2 * math.pi), self.force, values.T, shading="nearest", cmap="RdBu_r"
+        )
+        axes.figure.colorbar(mesh, ax=axes, label=label)
+        axes.set_xlabel("frequency (Hz)")
+        axes.set_ylabel("force amplitude F0 (N)")
+        return axes
 
 
 def _agreement_row(

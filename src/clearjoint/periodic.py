@@ -31,16 +31,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
-from clearjoint.continuation import Branch, ContinuationSettings, continue_branch
+from clearjoint.continuation import (
+    Branch,
+    ContinuationSettings,
+    continue_branch,
+    parameter_range,
+)
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint
+from clearjoint.results.motion import SteadyState
+
+# the results moved to clearjoint.results; imported "as" themselves so that the old path
+# clearjoint.periodic re-exports them (and the API reference documents them once)
+from clearjoint.results.orbit import PeriodicOrbit as PeriodicOrbit
+from clearjoint.results.response import FrequencyResponse as FrequencyResponse
+from clearjoint.results.response import ResponseEvent as ResponseEvent
 from clearjoint.simulate import _kernel as kn
 from clearjoint.simulate._shooting import (
     N_RES,
@@ -62,22 +73,16 @@ from clearjoint.simulate._shooting import (
 )
 from clearjoint.simulate.core import (
     SimulationError,
-    SteadyState,
     _initial_state,
     _orbit_from,
     _parameters,
     _run,
 )
 
-if TYPE_CHECKING:
-    import xarray as xr
-    from matplotlib.axes import Axes
-
 __all__ = [
-    "FrequencyResponse",
-    "PeriodicOrbit",
-    "ResponseEvent",
     "frequency_response",
+    "orbit_cycle",
+    "orbit_monodromy",
     "periodic_orbit",
 ]
 
@@ -98,62 +103,6 @@ _BACK_POINTS = 500
 _MIN_STEP = 1e-6
 #: Points in a row at tiny steps after which a jump across the kink ahead is tried.
 _CRAWL_POINTS = 20
-
-
-@dataclass(frozen=True)
-class PeriodicOrbit:
-    """An exact periodic orbit of ``period_multiple`` forcing periods, with its stability.
-
-    Attributes
-    ----------
-    initial_state : tuple of float
-        (x0, x0') at forcing phase 0, m and m/s.
-    cycle : SteadyState
-        The orbit sampled, with its stages and energy ledger.
-    monodromy : (2, 2) ndarray
-        dP_p/dz0, exact (closed-form flows and saltation matrices).
-    multipliers : (2,) complex ndarray
-        Floquet multipliers, eig(monodromy).
-    stable : bool
-        Every multiplier has modulus < 1.
-    omega, force_amplitude : float
-        rad/s and N.
-    period_multiple : int
-    newton_iterations : int
-    """
-
-    initial_state: tuple[float, float]
-    cycle: SteadyState = field(repr=False)
-    monodromy: FloatArray = field(repr=False)
-    multipliers: NDArray[np.complex128] = field(repr=False)
-    stable: bool
-    omega: float
-    force_amplitude: float
-    period_multiple: int = 1
-    newton_iterations: int = 0
-
-    @property
-    def x_max(self) -> float:
-        """Largest x along the orbit, m."""
-        return self.cycle.x_max
-
-    @property
-    def x_min(self) -> float:
-        """Smallest x along the orbit, m."""
-        return self.cycle.x_min
-
-    @property
-    def amplitude(self) -> float:
-        """X = (x_max - x_min) / 2, m."""
-        return self.cycle.amplitude
-
-    def __repr__(self) -> str:
-        mu = float(np.max(np.abs(self.multipliers)))
-        return (
-            f"PeriodicOrbit(period-{self.period_multiple}, {self.omega / (2 * math.pi):.6g} Hz, "
-            f"F0={self.force_amplitude:.4g} N, X={self.amplitude:.4g} m, "
-            f"{'stable' if self.stable else 'unstable'}, max|mu|={mu:.4g})"
-        )
 
 
 def _scales(joint: Joint, p: FloatArray, z: FloatArray) -> FloatArray:
@@ -240,361 +189,63 @@ def _orbit(
     )
 
 
+def orbit_cycle(
+    joint: Joint,
+    force_amplitude: float,
+    omega: float,
+    initial_state: ArrayLike,
+    *,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+) -> SteadyState:
+    """Return the period-1 orbit from ``initial_state`` re-run exactly, as a SteadyState.
+
+    MODEL.md sec. 5.1: one forcing period of the exact flow from (x0, x0') at forcing
+    phase 0, sampled (64 samples) with its stages and energy ledger; what
+    :meth:`FrequencyResponse.cycle` gives for a point of a shooting curve.
+
+    Parameters
+    ----------
+    joint : Joint
+    force_amplitude, omega : float
+        F0 (N) and the forcing circular frequency (rad/s).
+    initial_state : (2,) array_like
+        (x0, x0') at forcing phase 0, m and m/s: a point of the orbit.
+    damping_ratio, friction, restitution
+        As for :func:`clearjoint.simulate.steady_state`.
+
+    Returns
+    -------
+    SteadyState
+    """
+    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    z = np.asarray(initial_state, dtype=np.float64)
+    state = np.zeros(4)
+    start_state(p, float(z[0]), float(z[1]), state)
+    return _orbit_from(p, joint, state, 1, 0, None, 0.0, 64)
+
+
+def orbit_monodromy(
+    joint: Joint,
+    force_amplitude: float,
+    omega: float,
+    initial_state: ArrayLike,
+    *,
+    damping_ratio: float = 0.0,
+    friction: Friction | None = None,
+    restitution: float = 1.0,
+) -> FloatArray:
+    """Return the exact monodromy matrix dP/dz0 (2, 2) of one forcing period from ``initial_state``.
+
+    MODEL.md sec. 5.1: the closed-form flows and saltation matrices of the period-1
+    map from (x0, x0') at forcing phase 0; arguments as for :func:`orbit_cycle`.
+    """
+    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    return shoot(p, np.asarray(initial_state, dtype=np.float64), 1).monodromy
+
+
 # ---- frequency response ---------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class ResponseEvent:
-    """A fold, period doubling, grazing or other event found along a frequency-response curve.
-
-    Attributes
-    ----------
-    kind : {"fold", "period_doubling", "grazing", "neimark_sacker", "untrusted", ...}
-        The last two come from harmonic balance only (clearjoint.harmonic).
-    omega : float
-        rad/s.
-    force_amplitude : float
-        N.
-    amplitude : float
-        X of the period-1 orbit there, m.
-    note : str
-        What it means (e.g. that a period-2 branch is born there).
-    """
-
-    kind: str
-    omega: float
-    force_amplitude: float
-    amplitude: float
-    note: str = ""
-
-    def __repr__(self) -> str:
-        return (
-            f"ResponseEvent({self.kind}, {self.omega / (2 * math.pi):.6g} Hz, "
-            f"F0={self.force_amplitude:.4g} N, X={self.amplitude:.4g} m)"
-        )
-
-
-#: A Structure's curve labels the DOFs with the largest amplitude, this many (C0 to C7).
-_LABELLED = 8
-
-
-@dataclass(frozen=True)
-class FrequencyResponse:
-    """A whole frequency-response curve of exact period-1 orbits, stable and unstable.
-
-    Attributes
-    ----------
-    omega, force_amplitude : (n,) ndarray
-        rad/s and N at each point (one of them is constant).
-    x_max, x_min, amplitude : (n,) ndarray
-        Extremes and X = (x_max - x_min)/2 of each orbit, m.
-    stable : (n,) ndarray of bool
-    multipliers : (n, 2) complex ndarray
-        Floquet multipliers of each orbit.
-    initial_state : (n, 2) ndarray
-        (x, x') at forcing phase 0, m and m/s.
-    events : list of ResponseEvent
-    parameter : {"omega", "force"}
-    stop_reason : str
-        Why the continuation stopped ("reached" when it got to the end).
-    coefficients : ndarray, optional
-        Harmonic balance only (``method == "harmonic"``): the harmonic coefficients
-        a_0, a_1, b_1, ..., a_H, b_H of each point, m, (n, 2H + 1) for a Joint and
-        (n, 2H + 1, N) for a Structure (whose x_max, x_min, amplitude are then (n, N)).
-    method : {"shooting", "harmonic"}
-        Exact shooting (this module) or harmonic balance (``clearjoint.harmonic``).
-    free_play : (n,) ndarray of bool, optional
-        True where the orbit stays inside the gap with gap_stiffness 0: one of a
-        continuum of orbits (any mean position that keeps it off the edges; Floquet
-        multiplier exactly 1, so ``stable`` is False), of which the curve shows the one
-        centred in the gap. Its amplitude is set by the dynamics, its position is not.
-        None for harmonic balance.
-    """
-
-    omega: FloatArray
-    force_amplitude: FloatArray
-    x_max: FloatArray
-    x_min: FloatArray
-    amplitude: FloatArray
-    stable: NDArray[np.bool_]
-    multipliers: NDArray[np.complex128]
-    initial_state: FloatArray
-    events: list[ResponseEvent]
-    parameter: str
-    stop_reason: str
-    settings: dict[str, Any] = field(repr=False, default_factory=dict)
-    coefficients: FloatArray | None = field(repr=False, default=None)
-    method: str = "shooting"
-    free_play: NDArray[np.bool_] | None = field(repr=False, default=None)
-
-    def __repr__(self) -> str:
-        kinds = ", ".join(
-            f"{sum(e.kind == k for e in self.events)} {k}"
-            for k in ("fold", "period_doubling", "grazing")
-        )
-        others = sorted({e.kind for e in self.events} - {"fold", "period_doubling", "grazing"})
-        kinds += "".join(f", {sum(e.kind == k for e in self.events)} {k}" for k in others)
-        f = self.omega / (2 * math.pi)
-        if self.free_play is not None and self.free_play.any():
-            kinds += f", {int(np.sum(self.free_play))} free play"
-        return (
-            f"FrequencyResponse({self.omega.size} points, {f.min():.4g}-{f.max():.4g} Hz, "
-            f"F0 {self.force_amplitude.min():.4g}-{self.force_amplitude.max():.4g} N, "
-            f"max X={self.amplitude.max():.4g} m, {int(np.sum(~self.stable))} unstable, "
-            f"{kinds}, {self.stop_reason})"
-        )
-
-    def cycle(self, index: int) -> SteadyState:
-        """The orbit at point ``index`` as a SteadyState (stages, energy ledger), re-run exactly."""
-        if self.method != "shooting":
-            raise ParameterError(
-                "cycle() re-runs exact orbits of a shooting curve; for a harmonic-balance point "
-                "use clearjoint.periodic.periodic_orbit(..., initial=initial_state[index])"
-            )
-        p = self._point_parameters(index)
-        state = np.zeros(4)
-        start_state(
-            p, float(self.initial_state[index, 0]), float(self.initial_state[index, 1]), state
-        )
-        return _orbit_from(p, self.settings["joint"], state, 1, 0, None, 0.0, 64)
-
-    def period_2_orbit(self, event: ResponseEvent) -> PeriodicOrbit:
-        """Switch branches at a period doubling: the period-2 orbit born there (MODEL.md sec. 5.1).
-
-        At a period doubling a Floquet multiplier of the period-1 orbit passes -1 and a
-        period-2 orbit branches off along its eigenvector w. From the curve's points
-        around the event (a multiplier below -0.5), nearest first, on either side, Newton
-        on the two-period map P_2 starts at z* +- eps w (eps from 1e-3 to 0.3 of the
-        orbit's size); the first fixed point of P_2 that is not the period-1 orbit z*
-        (further than 1e-6 of its size) is returned.
-
-        Parameters
-        ----------
-        event : ResponseEvent
-            One of ``events`` with ``kind == "period_doubling"``.
-
-        Returns
-        -------
-        PeriodicOrbit
-            ``period_multiple == 2``, at the frequency (or force) of the curve point it
-            branched from.
-
-        Raises
-        ------
-        ParameterError
-            The event is not a period doubling, or the curve is not from shooting.
-        SimulationError
-            No period-2 orbit was found near the event.
-        """
-        if self.method != "shooting" or event.kind != "period_doubling":
-            raise ParameterError(
-                "period_2_orbit takes a 'period_doubling' event of a shooting curve, got "
-                f"{event.kind!r} of a {self.method!r} curve"
-            )
-        s = self.settings
-        lam = self.omega if self.parameter == "omega" else self.force_amplitude
-        at = event.omega if self.parameter == "omega" else event.force_amplitude
-        # both sides: past a supercritical doubling the period-2 orbit lies where the
-        # period-1 orbit is unstable, past a subcritical one where it is stable
-        beyond = np.nonzero(self.multipliers.real.min(axis=1) < -0.5)[0]
-        beyond = beyond[np.argsort(np.abs(lam[beyond] - at))][:16]
-        for i in beyond:
-            kw = {
-                "damping_ratio": s["damping_ratio"],
-                "friction": s["friction"],
-                "restitution": s["restitution"],
-            }
-            w, f = float(self.omega[i]), float(self.force_amplitude[i])
-            z = self.initial_state[i]
-            mono = self._monodromy(int(i))
-            mu, vectors = np.linalg.eig(mono)
-            direction = np.real(vectors[:, int(np.argmin(mu.real))])
-            size = np.array([max(self.amplitude[i], 1e-300), max(self.amplitude[i], 1e-300) * w])
-            direction = direction / np.max(np.abs(direction) / size)
-            for eps in (1e-3, 1e-2, 3e-2, 1e-1, 3e-1):
-                for sign in (1.0, -1.0):
-                    try:
-                        orbit = periodic_orbit(
-                            s["joint"],
-                            f,
-                            w,
-                            period_multiple=2,
-                            initial=z + sign * eps * direction,
-                            **kw,
-                        )
-                    except SimulationError:
-                        continue
-                    if np.max(np.abs(np.array(orbit.initial_state) - z) / size) > 1e-6:
-                        return orbit
-        raise SimulationError(
-            f"no period-2 orbit found near the period doubling at {event!r}; try "
-            "periodic_orbit(..., period_multiple=2, initial=...) from a steady_state"
-        )
-
-    def _point_parameters(self, index: int) -> Any:
-        """The kernel's parameters of point ``index`` (its force and frequency)."""
-        s = self.settings
-        return _parameters(
-            s["joint"],
-            float(self.force_amplitude[index]),
-            float(self.omega[index]),
-            s["damping_ratio"],
-            s["friction"],
-            s["restitution"],
-        )
-
-    def _monodromy(self, index: int) -> FloatArray:
-        """The monodromy matrix of the period-1 orbit at point ``index`` (re-run exactly)."""
-        p = self._point_parameters(index)
-        return shoot(p, self.initial_state[index], 1).monodromy
-
-    def plot(self, ax: Axes | None = None) -> Axes:
-        """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.
-
-        Free-play orbits (``free_play``: a continuum inside the gap) are dotted grey. A
-        Structure's curve (X of shape (n, N)) draws one curve per DOF: the 8 that move
-        most in their own colours, labelled (``settings["dof_names"]`` or "DOF k"),
-        the others light grey.
-
-        Returns
-        -------
-        matplotlib.axes.Axes
-        """
-        import matplotlib.pyplot as plt
-
-        if ax is None:
-            _, ax = plt.subplots(figsize=(6.4, 4.0))
-        if self.parameter == "force":
-            xs, label = self.force_amplitude, "force amplitude F0 (N)"
-        else:
-            xs, label = self.omega / (2 * math.pi), "frequency (Hz)"
-        ys = self.amplitude * 1e3
-        free = np.zeros(self.stable.size, dtype=bool) if self.free_play is None else self.free_play
-        style = np.where(free, 2, self.stable.astype(int))  # 0 unstable, 1 stable, 2 free play
-        looks = {0: ("--", "C3"), 1: ("-", "C0"), 2: (":", "0.4")}
-        columns = ys.reshape(ys.shape[0], -1)
-        per_dof = ys.ndim == 2  # a Structure by harmonic balance: one curve per DOF
-        names = list(self.settings.get("dof_names", [])) if per_dof else []
-        if len(names) != columns.shape[1]:
-            names = [f"DOF {k}" for k in range(columns.shape[1])]
-        # the _LABELLED DOFs that move most get their own colour and legend entry
-        peak = np.nan_to_num(np.nanmax(np.abs(columns), axis=0, initial=0.0))
-        labelled = np.argsort(-peak, kind="stable")[:_LABELLED].tolist()
-        for k in range(columns.shape[1]):
-            own = f"C{labelled.index(k)}" if k in labelled else "0.75"
-            start = 0
-            for i in range(1, style.size + 1):
-                if i == style.size or style[i] != style[start]:
-                    end = min(i + 1, style.size)
-                    line, color = looks[int(style[start])]
-                    if per_dof and style[start] != 2:
-                        color = own
-                    ax.plot(xs[start:end], columns[start:end, k], line, color=color, lw=1.5)
-                    start = i
-        if per_dof:
-            for k in labelled:
-                ax.plot([], [], "-", color=f"C{labelled.index(k)}", label=names[k])
-            if columns.shape[1] > len(labelled):
-                ax.plot([], [], "-", color="0.75", label="other DOFs")
-            ax.plot([], [], "-", color="k", label="stable (solid)")
-            ax.plot([], [], "--", color="k", label="unstable (dashed)")
-        else:
-            ax.plot([], [], "-", color="C0", label="stable")
-            ax.plot([], [], "--", color="C3", label="unstable")
-        if free.any():
-            ax.plot([], [], ":", color="0.4", label="free play (centred; position not set)")
-        markers = {
-            "fold": ("o", "k"),
-            "period_doubling": ("s", "C2"),
-            "grazing": ("^", "C1"),
-            "neimark_sacker": ("D", "C4"),
-        }
-        for kind, (marker, color) in markers.items():
-            chosen = [e for e in self.events if e.kind == kind]
-            if chosen:
-                ex = [
-                    e.force_amplitude if self.parameter == "force" else e.omega / (2 * math.pi)
-                    for e in chosen
-                ]
-                ey = [e.amplitude * 1e3 for e in chosen]
-                ax.plot(ex, ey, marker, color=color, ls="none", mfc="none", label=kind)
-        ax.set_xlabel(label)
-        ax.set_ylabel("amplitude X (mm)")
-        ax.legend(frameon=False, fontsize="small")
-        return ax
-
-    def to_xarray(self) -> xr.Dataset:
-        """The curve as an xarray Dataset over ``point`` (and ``event``), units in attrs."""
-        import xarray as xr
-
-        # harmonic balance of a Structure: per-DOF extremes (n, N), u(0) then u'(0) (n, 2N)
-        per = ("point",) if self.x_max.ndim == 1 else ("point", "dof")
-        n_dof = 1 if self.x_max.ndim == 1 else self.x_max.shape[1]
-        x0 = self.initial_state[:, :n_dof].reshape(self.x_max.shape)
-        v0 = self.initial_state[:, n_dof:].reshape(self.x_max.shape)
-        ds = xr.Dataset(
-            {
-                "x_max": (per, self.x_max, {"units": "m"}),
-                "x_min": (per, self.x_min, {"units": "m"}),
-                "amplitude": (per, self.amplitude, {"units": "m"}),
-                "stable": ("point", self.stable.astype(np.int8), {"units": "1 stable, 0 not"}),
-                "multiplier_real": (("point", "multiplier"), self.multipliers.real.copy()),
-                "multiplier_imag": (("point", "multiplier"), self.multipliers.imag.copy()),
-                "initial_displacement": (per, x0, {"units": "m"}),
-                "initial_velocity": (per, v0, {"units": "m/s"}),
-                **(
-                    {}
-                    if self.free_play is None
-                    else {
-                        "free_play": (
-                            "point",
-                            self.free_play.astype(np.int8),
-                            {
-                                "units": "1 in the gap (k0 = 0), 0 not",
-                                "note": "1: one of a continuum of orbits; the position is not "
-                                "set by the dynamics, the one centred in the gap is given",
-                            },
-                        )
-                    }
-                ),
-                "event_kind": ("event", np.array([e.kind for e in self.events], dtype=str)),
-                "event_frequency": (
-                    "event",
-                    np.array([e.omega / (2 * math.pi) for e in self.events]),
-                    {"units": "Hz"},
-                ),
-                "event_force": (
-                    "event",
-                    np.array([e.force_amplitude for e in self.events]),
-                    {"units": "N"},
-                ),
-                "event_amplitude": (
-                    "event",
-                    np.array([e.amplitude for e in self.events]),
-                    {"units": "m"},
-                ),
-            },
-            coords={
-                "omega": ("point", self.omega, {"units": "rad/s"}),
-                "frequency": ("point", self.omega / (2 * math.pi), {"units": "Hz"}),
-                "force_amplitude": ("point", self.force_amplitude, {"units": "N"}),
-            },
-            attrs={
-                "title": "clearjoint frequency response (exact periodic orbits, continuation)",
-                "parameter": self.parameter,
-                "stop_reason": self.stop_reason,
-                "method": self.method,
-            },
-        )
-        if self.coefficients is not None:
-            dims = ("point", "coefficient", "dof")[: self.coefficients.ndim]
-            ds["coefficients"] = (
-                dims,
-                self.coefficients,
-                {"units": "m", "order": "a_0, a_1, b_1, ..., a_H, b_H of cos/sin(h w t)"},
-            )
-            ds.attrs["title"] = "clearjoint frequency response (harmonic balance, continuation)"
-        return ds
 
 
 class _MapResidual:
@@ -783,38 +434,6 @@ def _free_play_orbit(p: FloatArray, omega: float, code: int = 0) -> FloatArray |
     return out
 
 
-def _parameter_range(
-    parameter: str,
-    force_amplitude: float,
-    omega_start: float,
-    omega_stop: float | None,
-    force_stop: float | None,
-) -> tuple[float, float]:
-    """The (start, stop) of the continuation parameter, checked: positive, nonzero width.
-
-    Shared by shooting (here) and harmonic balance (clearjoint.harmonic.response).
-    """
-    if parameter == "omega":
-        if omega_stop is None:
-            raise ParameterError("omega_stop is required with parameter='omega' (rad/s)")
-        w1 = _checks.positive("omega_stop", omega_stop, unit="rad/s")
-        if w1 == omega_start:
-            raise ParameterError(
-                f"the omega range has zero width ({omega_start!r} to {w1!r} rad/s); give two values"
-            )
-        return omega_start, w1
-    if force_stop is None:
-        raise ParameterError(
-            "force_stop is required with parameter='force': give the end of the force range (N)"
-        )
-    f1 = _checks.positive("force_stop", force_stop, unit="N")
-    if f1 == force_amplitude:
-        raise ParameterError(
-            f"the force range has zero width ({force_amplitude!r} to {f1!r} N); give two values"
-        )
-    return force_amplitude, f1
-
-
 def frequency_response(
     joint: Joint,
     force_amplitude: float,
@@ -877,7 +496,7 @@ def frequency_response(
         raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
     w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
     f0 = _checks.positive("force_amplitude", force_amplitude, unit="N")
-    start, stop = _parameter_range(parameter, f0, w0, omega_stop, force_stop)
+    start, stop = parameter_range(parameter, f0, w0, omega_stop, force_stop)
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
     first = periodic_orbit(

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, Protocol
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -48,6 +48,29 @@ __all__ = [
     "stiffness_curve",
     "viscous_coefficient",
 ]
+
+
+def _on_amplitude(
+    amplitude: FloatArray, columns: dict[str, tuple[NDArray[Any], str]], attrs: dict[str, object]
+) -> xr.Dataset:
+    """Return ``columns`` (name: (values, unit)) as a Dataset on the 1-D coordinate ``amplitude``.
+
+    The shared body of the ``to_xarray`` of :class:`FreeOrbit` and :class:`StiffnessCurve`:
+    each array broadcast like ``amplitude`` (m), its unit in its attrs.
+    """
+    import xarray as xr
+
+    from clearjoint.plotting import one_dimensional
+
+    a = one_dimensional("amplitude", amplitude)
+    return xr.Dataset(
+        {
+            name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
+            for name, (values, unit) in columns.items()
+        },
+        coords={"amplitude": ("amplitude", a, {"units": "m"})},
+        attrs=attrs,
+    )
 
 
 @dataclass(frozen=True)
@@ -97,6 +120,108 @@ class FreeOrbit:
     def displacement_amplitude(self) -> FloatArray:
         """X = (x_max - x_min) / 2, m."""
         return 0.5 * (self.x_max - self.x_min)
+
+    def __repr__(self) -> str:
+        a = np.atleast_1d(self.compression_penetration) * 1e6
+        x = np.atleast_1d(self.displacement_amplitude) * 1e6
+        t = np.atleast_1d(self.period) * 1e3
+
+        def span(values: FloatArray) -> str:
+            low, high = float(np.min(values)), float(np.max(values))
+            return f"{low:.4g}" if low == high else f"{low:.4g}-{high:.4g}"
+
+        return (
+            f"FreeOrbit({a.size} amplitude{'s' if a.size != 1 else ''}, A_c = {span(a)} um: "
+            f"X = {span(x)} um, T = {span(t)} ms)"
+        )
+
+    def _columns(self) -> dict[str, tuple[NDArray[Any], str]]:
+        """Return each field but A_c with its unit: the variables of :meth:`to_xarray`."""
+        return {
+            "tension_penetration": (self.tension_penetration, "m"),
+            "compression_speed": (self.compression_speed, "m/s"),
+            "tension_speed": (self.tension_speed, "m/s"),
+            "compression_touched": (self.compression_touched, "1 touched, 0 not"),
+            "tension_touched": (self.tension_touched, "1 touched, 0 not"),
+            "x_max": (self.x_max, "m"),
+            "x_min": (self.x_min, "m"),
+            "displacement_amplitude": (self.displacement_amplitude, "m"),
+            "compression_time": (self.compression_time, "s"),
+            "tension_time": (self.tension_time, "s"),
+            "free_play_time": (self.free_play_time, "s"),
+            "period": (self.period, "s"),
+            "contact_action": (self.contact_action, "m^2/s"),
+            "free_play_action": (self.free_play_action, "m^2/s"),
+        }
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the orbits as an ``xarray.Dataset`` on ``amplitude`` (A_c), units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinate ``amplitude`` (N,): the compression penetration A_c in m; one
+            variable (N,) per other field (and ``displacement_amplitude``), each with
+            ``attrs["units"]``.
+
+        Raises
+        ------
+        ParameterError
+            The orbits were computed on a grid of more than one dimension.
+        """
+        return _on_amplitude(
+            self.compression_penetration,
+            self._columns(),
+            {"title": "clearjoint free-vibration orbits against penetration"},
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the orbits as a ``pandas.DataFrame``, one row per penetration A_c.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``to_xarray().to_dataframe()``: index ``amplitude`` (A_c, m), one column per
+            field (units in :meth:`to_xarray`'s attrs).
+        """
+        return self.to_xarray().to_dataframe()
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw the period and the time in contact and in the gap (ms) against A_c; return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            Four lines: period T, compression, tension and free-play time per cycle.
+        """
+        from clearjoint.plotting import axes_or_new, one_dimensional
+
+        axes: Axes = axes_or_new(ax)
+        a = one_dimensional("amplitude", self.compression_penetration)
+        marker = "o" if a.size < 20 else None
+        for values, style, label in (
+            (self.period, "-", "period T"),
+            (self.compression_time, "--", "in compression"),
+            (self.tension_time, "-.", "in tension"),
+            (self.free_play_time, ":", "in free play"),
+        ):
+            axes.plot(
+                a * 1e6,
+                np.broadcast_to(values, a.shape) * 1e3,
+                style,
+                color="black",
+                marker=marker,
+                label=label,
+            )
+        axes.set_xlabel("compression penetration A_c (µm)")
+        axes.set_ylabel("time per cycle (ms)")
+        axes.legend(frameon=False, fontsize="small")
+        return axes
 
 
 def _contact_time(speed: FloatArray, y0: float, omega_s: float) -> FloatArray:
@@ -385,6 +510,86 @@ class ResponseBranch:
     stable: bool
     in_contact: bool
 
+    def __repr__(self) -> str:
+        return (
+            f"ResponseBranch(X = {self.displacement_amplitude * 1e6:.4g} um, "
+            f"A = {self.penetration * 1e6:.4g} um, k = {self.stiffness:.4g} N/m, "
+            f"w_n = {self.natural_frequency / (2 * math.pi):.4g} Hz, "
+            f"{'stable' if self.stable else 'unstable'}"
+            f"{'' if self.in_contact else ', inside the gap'})"
+        )
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the branch as an ``xarray.Dataset`` of 0-d variables, units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            ``penetration`` (m), ``displacement_amplitude`` (m), ``stiffness`` (N/m),
+            ``natural_frequency`` (rad/s), ``stable`` and ``in_contact`` (1 or 0).
+        """
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "penetration": ((), self.penetration, {"units": "m"}),
+                "displacement_amplitude": ((), self.displacement_amplitude, {"units": "m"}),
+                "stiffness": ((), self.stiffness, {"units": "N/m"}),
+                "natural_frequency": ((), self.natural_frequency, {"units": "rad/s"}),
+                "stable": ((), int(self.stable), {"units": "1 stable, 0 not"}),
+                "in_contact": ((), int(self.in_contact), {"units": "1 in contact, 0 not"}),
+            },
+            attrs={"title": "clearjoint equivalent linear response branch (MODEL.md eq 7)"},
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the branch as a one-row ``pandas.DataFrame`` (one solution: no longer table).
+
+        Columns ``penetration_m``, ``displacement_amplitude_m``, ``stiffness_n_per_m``,
+        ``natural_frequency_rad_per_s``, ``stable``, ``in_contact``; the branches of
+        :func:`equivalent_linear_response` together are ``pd.concat`` of theirs.
+        """
+        import pandas as pd
+
+        return pd.DataFrame(
+            {
+                "penetration_m": [self.penetration],
+                "displacement_amplitude_m": [self.displacement_amplitude],
+                "stiffness_n_per_m": [self.stiffness],
+                "natural_frequency_rad_per_s": [self.natural_frequency],
+                "stable": [self.stable],
+                "in_contact": [self.in_contact],
+            }
+        )
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Mark the branch at (w_n in Hz, X in um): filled if stable, open if not; return the Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (e.g. over a frequency response); a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            Its last line is the one marker.
+        """
+        from clearjoint.plotting import axes_or_new
+
+        axes: Axes = axes_or_new(ax)
+        axes.plot(
+            [self.natural_frequency / (2 * math.pi)],
+            [self.displacement_amplitude * 1e6],
+            "o",
+            color="black",
+            mfc="black" if self.stable else "none",
+            label="stable" if self.stable else "unstable",
+        )
+        axes.set_xlabel("natural frequency of the equivalent system (Hz)")
+        axes.set_ylabel("displacement amplitude X (µm)")
+        return axes
+
 
 def equivalent_linear_response(
     joint: Joint,
@@ -569,19 +774,11 @@ class StiffnessCurve:
             ``stiffness_coefficient`` (1), each (N,) with ``attrs["units"]``; the
             joint's parameters as attrs (SI, the unit in each name).
         """
-        import xarray as xr
-
-        from clearjoint.plotting import one_dimensional
-
-        a = one_dimensional("amplitude", self.amplitude)
         j = self.joint
-        return xr.Dataset(
+        return _on_amplitude(
+            self.amplitude,
+            self._columns(),
             {
-                name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
-                for name, (values, unit) in self._columns().items()
-            },
-            coords={"amplitude": ("amplitude", a, {"units": "m"})},
-            attrs={
                 "title": "clearjoint dynamic stiffness against amplitude",
                 "mass_kg": j.mass,
                 "clearance_m": j.clearance,

@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.axes import Axes
 
-    from clearjoint.periodic import FrequencyResponse
+    from clearjoint.results import FrequencyResponse
 
 __all__ = ["RESIDUAL_TOLERANCE", "OrbitCheck", "check_orbits", "spread", "untrusted_events"]
 
@@ -235,7 +235,7 @@ def check_orbits(
 def untrusted(omega: ArrayLike, force: ArrayLike, amplitude: ArrayLike, i: int, note: str) -> Any:
     """Return an ``"untrusted"`` ResponseEvent at point ``i`` of a curve (w in rad/s, the
     force in N, per-point amplitudes in m, per DOF or not: their largest), saying why."""
-    from clearjoint.periodic import ResponseEvent
+    from clearjoint.results import ResponseEvent
 
     return ResponseEvent(
         "untrusted",

@@ -47,6 +47,7 @@ from clearjoint.harmonic.system import (
 from clearjoint.joint import Friction
 
 if TYPE_CHECKING:
+    import pandas as pd
     import xarray as xr
     from matplotlib.axes import Axes
 
@@ -223,6 +224,38 @@ class NonlinearMode:
                 "note": self.note,
             },
         )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the mode as a ``pandas.DataFrame``, one row per modal amplitude.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index ``amplitude_m``; columns ``frequency_hz``, ``omega_rad_per_s``,
+            ``damping_ratio``, ``energy_per_cycle_j``, ``epmc_damping_ratio``,
+            ``converged``, and the extremes ``x_max_m``, ``x_min_m`` (a Structure's:
+            one column per DOF, ``x_max_m[<dof name>]``). The harmonic shapes are in
+            :meth:`to_xarray`.
+        """
+        import pandas as pd
+
+        columns: dict[str, Any] = {
+            "frequency_hz": self.frequency / (2.0 * math.pi),
+            "omega_rad_per_s": self.frequency,
+            "damping_ratio": self.damping_ratio,
+            "energy_per_cycle_j": self.energy_per_cycle,
+            "epmc_damping_ratio": self.epmc_damping_ratio,
+            "converged": self.converged,
+        }
+        for key, values in (("x_max", self.x_max), ("x_min", self.x_min)):
+            if values.ndim == 1:
+                columns[f"{key}_m"] = values
+                continue
+            names = list(self.dof_names)
+            if len(names) != values.shape[1]:
+                names = [f"DOF {k}" for k in range(values.shape[1])]
+            columns.update({f"{key}_m[{name}]": values[:, k] for k, name in enumerate(names)})
+        return pd.DataFrame(columns, index=pd.Index(self.amplitude, name="amplitude_m"))
 
 
 def _amplitudes(amplitudes: ArrayLike) -> FloatArray:

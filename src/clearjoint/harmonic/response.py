@@ -3,7 +3,7 @@
 The HB residual (:mod:`clearjoint.harmonic.aft`) is followed in w (or in the force
 amplitude) by the same continuation as the exact shooting of
 :mod:`clearjoint.periodic`, and returned as the same
-:class:`~clearjoint.periodic.FrequencyResponse`, with the harmonic coefficients
+:class:`~clearjoint.results.FrequencyResponse`, with the harmonic coefficients
 kept. Stability (``stability``): for one DOF with constant damping from Hill's infinite
 determinant (one determinant per point); for a Joint with friction from Hill's quadratic
 eigenproblem with the centroid sorting (:mod:`clearjoint.harmonic.hill`); for a Structure
@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
-from clearjoint.continuation import ContinuationSettings, continue_branch
+from clearjoint.continuation import ContinuationSettings, continue_branch, parameter_range
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.harmonic import aft, check, hill, monodromy, solve
 from clearjoint.harmonic.solve import (
@@ -49,7 +49,7 @@ from clearjoint.harmonic.system import (
     scale_length,
 )
 from clearjoint.joint import Friction
-from clearjoint.periodic import FrequencyResponse, ResponseEvent, _parameter_range
+from clearjoint.results import FrequencyResponse, ResponseEvent
 
 FloatArray = NDArray[np.float64]
 
@@ -202,7 +202,7 @@ def frequency_response(
     )
     pattern = force_vector(model, force)
     peak = float(np.max(np.abs(pattern)))
-    start, stop = _parameter_range(parameter, peak, w0, omega_stop, force_stop)
+    start, stop = parameter_range(parameter, peak, w0, omega_stop, force_stop)
     unit_force = pattern / peak
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
@@ -286,7 +286,9 @@ def frequency_response(
     }
     names = getattr(system, "dof_names", None)
     if names is not None and not model.is_joint:
-        settings["dof_names"] = list(names)  # the plot's legend
+        # the curve carries them (FrequencyResponse.dof_names); kept in settings for
+        # the readers of the older place
+        settings["dof_names"] = list(names)
     response = _response(
         model,
         basis,
@@ -569,7 +571,14 @@ def _response(
         settings=settings,
         coefficients=coef_out.copy(),
         method="harmonic",
+        dof_names=None if model.is_joint else _dof_names(settings, n),
     )
+
+
+def _dof_names(settings: dict[str, Any], n_dof: int) -> tuple[str, ...] | None:
+    """Return the solved structure's DOF names (``settings["dof_names"]``), None if it has none."""
+    names = settings.get("dof_names")
+    return tuple(str(name) for name in names) if names is not None and len(names) == n_dof else None
 
 
 def _sticking_events(

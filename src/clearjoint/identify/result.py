@@ -95,6 +95,104 @@ class CycleResult:
     model: str
     lines: tuple[tuple[float, float], ...] = ()
 
+    def __repr__(self) -> str:
+        amplitude = self.values.get("amplitude_m", math.nan)
+        clearance = self.values.get("clearance_m", math.nan)
+        return (
+            f"CycleResult(samples {self.start}-{self.stop}, {self.model}, "
+            f"X = {amplitude * 1e6:.4g} um, clearance {clearance * 1e6:.4g} um, "
+            f"edges {self.lower_edge * 1e6:.4g} / {self.upper_edge * 1e6:.4g} um)"
+        )
+
+    def to_xarray(self) -> xr.Dataset:
+        """Return the cycle's values as an ``xarray.Dataset`` of 0-d variables, units in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+            One 0-d variable per entry of ``values`` (its unit from :data:`UNITS`),
+            ``upper_edge`` and ``lower_edge`` (m), and the elastic lines
+            ``line_intercept`` (N) and ``line_slope`` (N/m) on ``stage`` (tension,
+            free play, compression; empty but for a joint). ``attrs`` give the
+            sample span and the model.
+        """
+        import xarray as xr
+
+        names = ("tension", "free play", "compression")[: len(self.lines)]
+        data = xr.Dataset(
+            {
+                key: ((), value, {"units": UNITS.get(key, "1")})
+                for key, value in self.values.items()
+            },
+            attrs={
+                "title": "clearjoint one identified cycle",
+                "start_sample": self.start,
+                "stop_sample": self.stop,
+                "model": self.model,
+            },
+        )
+        data["upper_edge"] = ((), self.upper_edge, {"units": "m"})
+        data["lower_edge"] = ((), self.lower_edge, {"units": "m"})
+        data["line_intercept"] = ("stage", [c for c, _ in self.lines], {"units": "N"})
+        data["line_slope"] = ("stage", [k for _, k in self.lines], {"units": "N/m"})
+        return data.assign_coords(stage=("stage", list(names)))
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Return the cycle as a one-row ``pandas.DataFrame`` (a record's cycles together:
+        :meth:`Identification.to_pandas`).
+
+        Columns ``start``, ``stop``, ``model``, ``upper_edge_m``, ``lower_edge_m``, then
+        each entry of ``values`` (its name carries the unit).
+        """
+        import pandas as pd
+
+        row: dict[str, Any] = {
+            "start": self.start,
+            "stop": self.stop,
+            "model": self.model,
+            "upper_edge_m": self.upper_edge,
+            "lower_edge_m": self.lower_edge,
+            **self.values,
+        }
+        return pd.DataFrame({key: [value] for key, value in row.items()})
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw the cycle's fitted elastic lines, force (N) against x (um), and its gap edges.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's Axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            Two dotted vertical lines at the gap edges, then one line per fitted stage
+            (tension, free play, compression), each over its own span (half the gap
+            beyond each edge).
+        """
+        from clearjoint.plotting import axes_or_new
+
+        axes: Axes = axes_or_new(ax)
+        width = max(self.upper_edge - self.lower_edge, 1e-12)
+        for edge in (self.lower_edge, self.upper_edge):
+            axes.axvline(edge * 1e6, color="0.5", ls=":", lw=0.8)
+        spans = (
+            (self.lower_edge - 0.5 * width, self.lower_edge),
+            (self.lower_edge, self.upper_edge),
+            (self.upper_edge, self.upper_edge + 0.5 * width),
+        )
+        for (intercept, slope), span, name in zip(
+            self.lines, spans, ("tension", "free play", "compression"), strict=False
+        ):
+            x = np.array(span)
+            axes.plot(x * 1e6, intercept + slope * x, color="black", lw=1.5, label=name)
+        axes.set_xlabel("displacement x (µm)")
+        axes.set_ylabel("restoring force (N)")
+        if self.lines:
+            axes.legend(frameon=False, fontsize="small")
+        return axes
+
 
 @dataclass(frozen=True)
 class Identification:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from clearjoint.continuation import _extrapolate, _tangent_solve
+from clearjoint.continuation import extrapolate, tangent_solve
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.simulate import _kernel as kn
 
@@ -612,7 +612,7 @@ def arclength_step(
     to fall back on its SVD). Returns the corrector's iterations, -1 on failure.
     """
     if points.shape[0] > 1:
-        predicted = _extrapolate(points, h)
+        predicted = extrapolate(points, h)
     else:
         predicted = np.empty(3)
         for i in range(3):
@@ -626,7 +626,7 @@ def arclength_step(
     for i in range(2):
         for j in range(3):
             a[i, j] = system[i, j]
-    if not _tangent_solve(a, tangent, t_new):
+    if not tangent_solve(a, tangent, t_new):
         t_new[:] = np.nan
         return its
     if t_new[0] * tangent[0] + t_new[1] * tangent[1] + t_new[2] * tangent[2] < 0.0:

@@ -100,6 +100,27 @@ class Backbone:
             },
         )
 
+    def to_pandas(self) -> Any:
+        """Return the backbone as a ``pandas.DataFrame``, one row per cycle.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index ``cycle_time_s`` (the middle of each cycle); columns ``amplitude_m``,
+            ``omega_rad_per_s``, ``frequency_hz`` and ``damping_ratio``.
+        """
+        import pandas as pd
+
+        return pd.DataFrame(
+            {
+                "amplitude_m": self.amplitude,
+                "omega_rad_per_s": self.omega,
+                "frequency_hz": self.omega / (2.0 * math.pi),
+                "damping_ratio": self.damping_ratio,
+            },
+            index=pd.Index(self.time, name="cycle_time_s"),
+        )
+
 
 def _maxima(t: FloatArray, u: FloatArray, v: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Times and values of the maxima: v crossing zero downward, refined between samples."""

@@ -172,6 +172,23 @@ class Modes:
             attrs={"pattern": self.pattern},
         )
 
+    def to_pandas(self) -> Any:
+        """Return the modes as a ``pandas.DataFrame``, one row per mode.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index ``mode`` (1, 2, ...); columns ``omega_rad_per_s``, ``frequency_hz``,
+            then the mass-normalised shape on each DOF, ``shape[<dof name>]`` in
+            1/sqrt(kg).
+        """
+        import pandas as pd
+
+        columns: dict[str, Any] = {"omega_rad_per_s": self.omega, "frequency_hz": self.frequency_hz}
+        names = self.structure.dof_names
+        columns.update({f"shape[{name}]": self.shapes[k] for k, name in enumerate(names)})
+        return pd.DataFrame(columns, index=pd.Index(np.arange(1, self.omega.size + 1), name="mode"))
+
 
 @dataclass(frozen=True, eq=False)
 class Structure:

@@ -42,7 +42,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
 from clearjoint.laws import clearance
-from clearjoint.simulate.core import EnergyLedger, SimulationError
+from clearjoint.results import EnergyLedger
+from clearjoint.simulate.core import SimulationError
 from clearjoint.structure import _march
 from clearjoint.structure.model import Structure, StructureError
 
@@ -229,6 +230,23 @@ class StructureMotion:
             },
             attrs={"events": self.events, "omega_rad_per_s": self.omega, **ledger},
         )
+
+    def to_pandas(self) -> Any:
+        """Return the sampled motion as a ``pandas.DataFrame``, one row per sample.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index ``time_s``; columns ``u_m[<dof name>]`` then ``v_m_per_s[<dof name>]``
+            for each DOF (``structure.dof_names``). The contact patterns, events and
+            energy ledger are in :meth:`to_xarray`.
+        """
+        import pandas as pd
+
+        names = self.structure.dof_names
+        columns = {f"u_m[{name}]": self.u[:, k] for k, name in enumerate(names)}
+        columns.update({f"v_m_per_s[{name}]": self.v[:, k] for k, name in enumerate(names)})
+        return pd.DataFrame(columns, index=pd.Index(self.t, name="time_s"))
 
 
 def _vector(name: str, value: ArrayLike, structure: Structure) -> FloatArray:
