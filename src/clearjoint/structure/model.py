@@ -29,6 +29,7 @@ from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
 from clearjoint.joint import ClearanceJoint, positive_or_inf
 from clearjoint.laws import clearance
+from clearjoint.system import VibrationSystem
 
 FloatArray = NDArray[np.float64]
 
@@ -494,6 +495,32 @@ class Structure:
             k, _ = self.pattern_stiffness(self._states("closed"))
             c += beta * k
         return np.asarray(c, dtype=np.float64)
+
+    def to_system(self) -> VibrationSystem:
+        """Return the structure as the :class:`~clearjoint.system.VibrationSystem` solvers take.
+
+        MODEL.md 5.2: M the lumped masses, C the member dashpots plus Rayleigh damping,
+        K the members without a joint (each joint's law, in series with its member,
+        carries its own k0), b_j the joint members' directions; each joint's friction
+        and restitution become its losses. Dense (N, N) up to ``SPARSE_ABOVE`` DOFs,
+        sparse above.
+        """
+        b = self._b
+        plain = [i for i, m in enumerate(self.members) if m.joint is None]
+        k = (b[plain].T * self._k_member[plain]) @ b[plain]
+        c = self.damping_matrix()
+        m = np.diag(self.mass_diagonal())
+        if self.n_dof > SPARSE_ABOVE:
+            k, c, m = (scipy.sparse.csr_matrix(a) for a in (k, c, m))
+        return VibrationSystem(
+            mass=m,
+            damping=c,
+            stiffness=k,
+            directions=self.joint_directions.reshape(len(self._laws), self.n_dof),
+            laws=self._laws,
+            dof_names=tuple(self.dof_names),
+            source=self,
+        )
 
     def modes(
         self, pattern: Literal["closed", "open"] = "closed", count: int | None = None
