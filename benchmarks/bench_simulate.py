@@ -18,8 +18,8 @@ import time
 import numpy as np
 
 from clearjoint import Joint
-from clearjoint.simulate import _kernel as kn
-from clearjoint.simulate import core
+from clearjoint.exact import kernel as kn
+from clearjoint.exact import single
 from clearjoint.simulate.reference import reference_time_response
 
 PERIODS = 200
@@ -29,7 +29,7 @@ LOSSES = {"damping_ratio": 0.02, "restitution": 0.8}
 
 
 def event_driven() -> tuple[np.ndarray, int, float]:
-    p = core._parameters(
+    p = single.parameters(
         JOINT,
         CASE["force_amplitude"],
         CASE["omega"],
@@ -37,13 +37,13 @@ def event_driven() -> tuple[np.ndarray, int, float]:
         None,
         LOSSES["restitution"],
     )
-    state = core._initial_state(p, None)
-    core._run(p, state.copy(), 2, p[kn.P_TF], record=False)  # compile outside the clock
+    state = single.initial_state(p, None)
+    single.run_kernel(p, state.copy(), 2, p[kn.P_TF], record=False)  # compile outside the clock
     best = math.inf
     for _ in range(5):
         s = state.copy()
         start = time.perf_counter()
-        run = core._run(p, s, PERIODS, p[kn.P_TF], record=False)
+        run = single.run_kernel(p, s, PERIODS, p[kn.P_TF], record=False)
         best = min(best, time.perf_counter() - start)
     return run.strobe[:, :2], run.events, best
 

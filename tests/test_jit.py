@@ -10,7 +10,7 @@ SCRIPT = """
 import warnings
 warnings.simplefilter("always")
 import numpy as np
-from clearjoint.simulate import _kernel as kn
+from clearjoint.exact import kernel as kn
 p = np.zeros(kn.N_PARAMS)
 p[kn.P_K0], p[kn.P_KC], p[kn.P_GC] = 10.0, 1000.0, 0.5
 print(kn.region_force(p, kn.COMPRESSION))

@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 from clearjoint import ClearanceJoint, Joint
+from clearjoint.exact import kernel as kn
 from clearjoint.harmonic import aft, modes, monodromy, system
 from clearjoint.laws import clearance
-from clearjoint.simulate import _kernel as kn
 from clearjoint.structure.builders import chain
 from clearjoint.structure.motion import _Flow
 from helpers import check_tangent_stiffness
@@ -410,9 +410,10 @@ def test_every_contact_state_agrees_with_the_written_one_edges_included(
 
 
 def test_the_states_are_defined_once() -> None:
-    from clearjoint.structure import _march, model
+    from clearjoint.exact import march
+    from clearjoint.structure import model
 
     assert (clearance.OPEN, clearance.COMPRESSION, clearance.TENSION) == (0, 1, -1)
-    for module in (kn, model, _march):
+    for module in (kn, model, march):
         names = ("FREE" if module is kn else "OPEN", "COMPRESSION", "TENSION")
         assert tuple(getattr(module, name) for name in names) == (0, 1, -1)

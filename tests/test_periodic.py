@@ -420,8 +420,8 @@ def test_compiled_corrector_matches_the_generic_one() -> None:
     # the continuation hands its Newton loop to periodic's compiled corrector: on the same
     # prediction it must land where continuation's own Python loop lands
     from clearjoint.continuation import ContinuationSettings, _correct
+    from clearjoint.exact.single import parameters as _parameters
     from clearjoint.periodic import _map_residual
-    from clearjoint.simulate.core import _parameters
 
     orbit = periodic_orbit(PYHARM, F0, 1.3, damping_ratio=ZETA)
     p = _parameters(PYHARM, F0, 1.3, ZETA, None, 1.0)
@@ -521,8 +521,8 @@ def test_compiled_ordinary_step_follows_the_same_branch_as_the_python_one() -> N
     # residual's compiled ``step``; without that hook it predicts and orients in Python:
     # the two must give the same points, bit for bit (the same arithmetic, compiled)
     from clearjoint.continuation import ContinuationSettings, continue_branch
+    from clearjoint.exact.single import parameters as _parameters
     from clearjoint.periodic import _map_residual
-    from clearjoint.simulate.core import _parameters
 
     orbit = periodic_orbit(PYHARM, F0, 1.0, damping_ratio=ZETA)
     p = _parameters(PYHARM, F0, 1.0, ZETA, None, 1.0)

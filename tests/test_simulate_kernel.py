@@ -1,4 +1,4 @@
-"""simulate._kernel: march limits, the closed-form segment energies, stiff contact."""
+"""exact.kernel: march limits, the closed-form segment energies, stiff contact."""
 
 from __future__ import annotations
 
@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from clearjoint import Friction, Joint
-from clearjoint.simulate import _kernel as kn
-from clearjoint.simulate import core, time_response
+from clearjoint.exact import kernel as kn
+from clearjoint.exact import single
+from clearjoint.simulate import time_response
 
 #: k_contact / k0 = 1e8: free flights of seconds between contacts of a fraction of a ms.
 STIFF = Joint(
@@ -32,7 +33,8 @@ def test_a_march_that_runs_out_of_steps_raises_instead_of_jumping() -> None:
     script = textwrap.dedent(
         """
         from clearjoint import Friction, Joint
-        from clearjoint.simulate import _kernel as kn, time_response, SimulationError
+        from clearjoint.exact import kernel as kn
+        from clearjoint.simulate import time_response, SimulationError
         kn.MAX_MARCH_STEPS = 1
         joint = Joint(mass=1.0, clearance=0.2, gap_stiffness=1.0, compression_stiffness=4.0)
         for kwargs in ({}, {"friction": Friction(0.5, 1.0)}):  # moving state, sticking state
@@ -74,7 +76,7 @@ def test_closed_form_segment_energy_matches_adaptive_quadrature(
     damping: float, region: int
 ) -> None:
     joint = Joint(mass=1.0, clearance=0.2, gap_stiffness=1.0, compression_stiffness=30.0)
-    p = core._parameters(joint, 0.7, 1.3, 0.0, None, 1.0)
+    p = single.parameters(joint, 0.7, 1.3, 0.0, None, 1.0)
     p[kn.P_DAMP] = damping
     rng = np.random.default_rng(region + 7)
     scratch = np.zeros((3, 6), dtype=np.complex128)

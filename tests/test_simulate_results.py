@@ -10,8 +10,9 @@ import pytest
 from matplotlib.figure import Figure
 
 from clearjoint import Friction, Joint
+from clearjoint.exact.single import STAGE_NAMES, _stages
+from clearjoint.results import Stage
 from clearjoint.simulate import Motion, SteadyState, steady_state, time_response
-from clearjoint.simulate.core import STAGE_NAMES, Stage, _stages
 
 JOINT = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, tension_stiffness=5e7)
 LINEAR = Joint(mass=2.0, clearance=0.0, compression_stiffness=8e7)

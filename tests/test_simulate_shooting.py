@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from clearjoint import Friction, Joint
-from clearjoint.simulate import _shooting as sh
-from clearjoint.simulate import core, steady_state, time_response
-from clearjoint.simulate._shooting import shoot
+from clearjoint.exact import shooting as sh
+from clearjoint.exact import single
+from clearjoint.exact.shooting import shoot
+from clearjoint.simulate import steady_state, time_response
 from clearjoint.simulate.reference import reference_time_response
 
 #: pyHarm's SDOF clearance case: m = 1, c_v = 0.05, k0 = 1, edges at +-0.1745, contact adds 3.
@@ -55,7 +56,7 @@ def _finite_difference(p: np.ndarray, z: np.ndarray) -> np.ndarray:
 def test_monodromy_by_saltation_matches_a_finite_difference_of_the_map(
     force: float, omega: float, losses: dict[str, object]
 ) -> None:
-    p = core._parameters(
+    p = single.parameters(
         PYHARM,
         force,
         omega,
@@ -74,7 +75,7 @@ def _end_and_sensitivity(
 ) -> tuple[np.ndarray, np.ndarray, float, int]:
     """P_1(z; lam), the sensitivity dP/dlam shoot_map carries, its exactness flag, events."""
     q = p.copy()
-    sh._set_parameter(q, parameter, lam)
+    sh.set_parameter(q, parameter, lam)
     state = np.zeros(4)
     sh.start_state(q, float(z[0]), float(z[1]), state)
     out = np.zeros(sh.N_OUT)
@@ -117,7 +118,7 @@ def test_parameter_sensitivity_matches_a_central_difference_of_the_map(
 ) -> None:
     # dP/domega and dP/dF0 carried through the segments and events (saltation) against a
     # central difference of the exact map (an independent route: two more evaluations)
-    p = core._parameters(
+    p = single.parameters(
         PYHARM,
         force,
         omega,
@@ -148,7 +149,7 @@ def test_parameter_sensitivity_matches_a_central_difference_of_the_map(
 def test_parameter_sensitivity_falls_back_to_a_difference_at_exact_undamped_resonance() -> None:
     # undamped free play at omega = sqrt(k0 / m) exactly: the secular particular solution is
     # not carried, so shoot_map says so and map_residual differences the map instead
-    p = core._parameters(PYHARM, 0.001, 1.0, 0.0, None, 1.0)
+    p = single.parameters(PYHARM, 0.001, 1.0, 0.0, None, 1.0)
     z = np.array([0.01, 0.0])
     _, _, exact, _ = _end_and_sensitivity(p, z, 0, 1.0)
     assert exact == 0.0

@@ -143,7 +143,7 @@ def _power_coefficients(roots: list[float], lead: float) -> np.ndarray:
 def test_first_root_of_the_edge_polynomial_is_the_first_one(
     roots: list[float], first: float | None, tol: float
 ) -> None:
-    from clearjoint.structure._march import MAX_DEPTH, MAX_TERMS, first_root
+    from clearjoint.exact.march import MAX_DEPTH, MAX_TERMS, first_root
 
     c = _power_coefficients(roots, 1.0)
     if c[0] < 0.0:
@@ -159,7 +159,7 @@ def test_first_root_of_the_edge_polynomial_is_the_first_one(
 
 
 def test_a_dip_that_stays_above_the_edge_is_not_an_event() -> None:
-    from clearjoint.structure._march import MAX_DEPTH, MAX_TERMS, first_root
+    from clearjoint.exact.march import MAX_DEPTH, MAX_TERMS, first_root
 
     # (s - 0.3)^2 + 1e-14 > 0 everywhere: no root, though its minimum is 1e-14
     c = np.array([0.09 + 1e-14, -0.6, 1.0, 0.0])

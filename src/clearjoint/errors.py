@@ -22,3 +22,7 @@ class ParameterTypeError(ClearjointError, TypeError):
 
 class OutputExistsError(ClearjointError, FileExistsError):
     """An output file exists and overwriting it was not asked for."""
+
+
+class SimulationError(ClearjointError, RuntimeError):
+    """The simulation could not do what was asked (no steady state, too many events...)."""

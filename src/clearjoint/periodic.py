@@ -43,17 +43,9 @@ from clearjoint.continuation import (
     continue_branch,
     parameter_range,
 )
-from clearjoint.errors import ParameterError
-from clearjoint.joint import Friction, Joint
-from clearjoint.results.motion import SteadyState
-
-# the results moved to clearjoint.results; imported "as" themselves so that the old path
-# clearjoint.periodic re-exports them (and the API reference documents them once)
-from clearjoint.results.orbit import PeriodicOrbit as PeriodicOrbit
-from clearjoint.results.response import FrequencyResponse as FrequencyResponse
-from clearjoint.results.response import ResponseEvent as ResponseEvent
-from clearjoint.simulate import _kernel as kn
-from clearjoint.simulate._shooting import (
+from clearjoint.errors import ParameterError, SimulationError
+from clearjoint.exact import kernel as kn
+from clearjoint.exact.shooting import (
     N_RES,
     R_DLAM,
     R_EVALS,
@@ -63,26 +55,29 @@ from clearjoint.simulate._shooting import (
     R_XMAX,
     R_XMIN,
     Shot,
-    _set_parameter,
     arclength_step,
     correct_orbit,
     map_residual,
     newton_orbit,
+    set_parameter,
     shoot,
     start_state,
 )
-from clearjoint.simulate.core import (
-    SimulationError,
-    _initial_state,
-    _orbit_from,
-    _parameters,
-    _run,
-)
+from clearjoint.exact.single import initial_state, orbit_from, parameters, run_kernel
+from clearjoint.joint import Friction, Joint
+from clearjoint.results.motion import SteadyState
+
+# the results moved to clearjoint.results; imported "as" themselves so that the old path
+# clearjoint.periodic re-exports them (and the API reference documents them once)
+from clearjoint.results.orbit import PeriodicOrbit as PeriodicOrbit
+from clearjoint.results.response import FrequencyResponse as FrequencyResponse
+from clearjoint.results.response import ResponseEvent as ResponseEvent
 
 __all__ = [
     "frequency_response",
     "orbit_cycle",
     "orbit_monodromy",
+    "period_2_orbit",
     "periodic_orbit",
 ]
 
@@ -148,17 +143,17 @@ def periodic_orbit(
     SimulationError
         Newton's method found no orbit.
     """
-    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
     if isinstance(period_multiple, bool) or not isinstance(period_multiple, int | np.integer):
         raise ParameterError(f"period_multiple must be an integer >= 1, got {period_multiple!r}")
     n = int(period_multiple)
     if n < 1:
         raise ParameterError(f"period_multiple must be an integer >= 1, got {period_multiple!r}")
-    state = _initial_state(p, initial)
+    state = initial_state(p, initial)
     attempts = 1 if initial is not None else 6
     for attempt in range(attempts):
         if initial is None:
-            _run(p, state, _TRANSIENT_PERIODS * 2**attempt, p[kn.P_TF], record=False)
+            run_kernel(p, state, _TRANSIENT_PERIODS * 2**attempt, p[kn.P_TF], record=False)
         found = newton_orbit(p, state[:2], n, _scales(joint, p, state[:2]), tolerance=_TOLERANCE)
         if found is not None:
             z, shot, iterations = found
@@ -174,7 +169,7 @@ def _orbit(
 ) -> PeriodicOrbit:
     state = np.zeros(4)
     start_state(p, float(z[0]), float(z[1]), state)
-    cycle = _orbit_from(p, joint, state, n, 0, None, 0.0, 256)
+    cycle = orbit_from(p, joint, state, n, 0, None, 0.0, 256)
     mu = np.linalg.eigvals(shot.monodromy).astype(np.complex128)
     return PeriodicOrbit(
         initial_state=(float(z[0]), float(z[1])),
@@ -219,11 +214,11 @@ def orbit_cycle(
     -------
     SteadyState
     """
-    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
     z = np.asarray(initial_state, dtype=np.float64)
     state = np.zeros(4)
     start_state(p, float(z[0]), float(z[1]), state)
-    return _orbit_from(p, joint, state, 1, 0, None, 0.0, 64)
+    return orbit_from(p, joint, state, 1, 0, None, 0.0, 64)
 
 
 def orbit_monodromy(
@@ -241,8 +236,80 @@ def orbit_monodromy(
     MODEL.md sec. 5.1: the closed-form flows and saltation matrices of the period-1
     map from (x0, x0') at forcing phase 0; arguments as for :func:`orbit_cycle`.
     """
-    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
     return shoot(p, np.asarray(initial_state, dtype=np.float64), 1).monodromy
+
+
+def period_2_orbit(curve: FrequencyResponse, event: ResponseEvent) -> PeriodicOrbit:
+    """Switch branches at a period doubling: the period-2 orbit born there (MODEL.md sec. 5.1).
+
+    At a period doubling a Floquet multiplier of the period-1 orbit passes -1 and a
+    period-2 orbit branches off along its eigenvector w. From the curve's points
+    around the event (a multiplier below -0.5), nearest first, on either side, Newton
+    on the two-period map P_2 starts at z* +- eps w (eps from 1e-3 to 0.3 of the
+    orbit's size); the first fixed point of P_2 that is not the period-1 orbit z*
+    (further than 1e-6 of its size) is returned.
+
+    Parameters
+    ----------
+    curve : FrequencyResponse
+        A shooting curve (``curve.period_2_orbit(event)`` calls this).
+    event : ResponseEvent
+        One of ``events`` with ``kind == "period_doubling"``.
+
+    Returns
+    -------
+    PeriodicOrbit
+        ``period_multiple == 2``, at the frequency (or force) of the curve point it
+        branched from.
+
+    Raises
+    ------
+    ParameterError
+        The event is not a period doubling, or the curve is not from shooting.
+    SimulationError
+        No period-2 orbit was found near the event.
+    """
+    if curve.method != "shooting" or event.kind != "period_doubling":
+        raise ParameterError(
+            "period_2_orbit takes a 'period_doubling' event of a shooting curve, got "
+            f"{event.kind!r} of a {curve.method!r} curve"
+        )
+    s = curve.settings
+    lam = curve.omega if curve.parameter == "omega" else curve.force_amplitude
+    at = event.omega if curve.parameter == "omega" else event.force_amplitude
+    # both sides: past a supercritical doubling the period-2 orbit lies where the
+    # period-1 orbit is unstable, past a subcritical one where it is stable
+    beyond = np.nonzero(curve.multipliers.real.min(axis=1) < -0.5)[0]
+    beyond = beyond[np.argsort(np.abs(lam[beyond] - at))][:16]
+    for i in beyond:
+        kw = {k: s[k] for k in ("damping_ratio", "friction", "restitution")}
+        w, f = float(curve.omega[i]), float(curve.force_amplitude[i])
+        z = curve.initial_state[i]
+        mono = orbit_monodromy(s["joint"], f, w, z, **kw)
+        mu, vectors = np.linalg.eig(mono)
+        direction = np.real(vectors[:, int(np.argmin(mu.real))])
+        size = np.array([max(curve.amplitude[i], 1e-300), max(curve.amplitude[i], 1e-300) * w])
+        direction = direction / np.max(np.abs(direction) / size)
+        for eps in (1e-3, 1e-2, 3e-2, 1e-1, 3e-1):
+            for sign in (1.0, -1.0):
+                try:
+                    orbit = periodic_orbit(
+                        s["joint"],
+                        f,
+                        w,
+                        period_multiple=2,
+                        initial=z + sign * eps * direction,
+                        **kw,
+                    )
+                except SimulationError:
+                    continue
+                if np.max(np.abs(np.array(orbit.initial_state) - z) / size) > 1e-6:
+                    return orbit
+    raise SimulationError(
+        f"no period-2 orbit found near the period doubling at {event!r}; try "
+        "periodic_orbit(..., period_multiple=2, initial=...) from a steady_state"
+    )
 
 
 # ---- frequency response ---------------------------------------------------------------------
@@ -408,7 +475,7 @@ def _free_play_orbit(p: FloatArray, omega: float, code: int = 0) -> FloatArray |
     """
     q = p.copy()
     lam = omega
-    _set_parameter(q, code, lam)
+    set_parameter(q, code, lam)
     m, c, f0, omega = q[kn.P_MASS], q[kn.P_DAMP], q[kn.P_F0], q[kn.P_W]
     v = -f0 * m * omega / (c * c + (m * omega) ** 2)  # v(0) of the viscous free mass
     # the velocity orbit does not depend on where the edges are: solve it with them far off
@@ -555,7 +622,7 @@ def frequency_response(
         else:
             turned = frequency_response(joint, f0, stop, w0, max_points=max_points, **kw)  # type: ignore[arg-type]
         return _turned_round(turned)
-    p = _parameters(joint, f0, w0, damping_ratio, friction, restitution)
+    p = parameters(joint, f0, w0, damping_ratio, friction, restitution)
     x_scale = max(joint.clearance / 2.0, first.amplitude)
     v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
     code = 0 if parameter == "omega" else 1
@@ -563,10 +630,10 @@ def frequency_response(
     def restart(u: FloatArray, lam: float) -> FloatArray | None:
         """A short transient at ``lam`` from ``u``: the start of Newton across a kink."""
         q = p.copy()
-        _set_parameter(q, code, lam)
-        state = _initial_state(q, u)
+        set_parameter(q, code, lam)
+        state = initial_state(q, u)
         try:
-            _run(q, state, _TRANSIENT_PERIODS, q[kn.P_TF], record=False)
+            run_kernel(q, state, _TRANSIENT_PERIODS, q[kn.P_TF], record=False)
         except SimulationError:
             return None
         return np.asarray(state[:2], dtype=np.float64)
@@ -647,14 +714,14 @@ def frequency_response(
     rows = np.array(branch.data)
     lam_all = branch.lam
     lam_tangent = branch.tangent[:, -1]
-    initial_state = branch.u.copy()
+    start_states = branch.u.copy()
     free_play = np.zeros(branch.lam.size, dtype=bool)
     reason = branch.reason
     if tail is not None:
         lam_all = np.concatenate((lam_all, tail[:, N_RES]))
         rows = np.concatenate((rows, tail[:, :N_RES]))
         lam_tangent = np.concatenate((lam_tangent, np.full(len(tail), np.sign(stop - start))))
-        initial_state = np.concatenate((initial_state, tail[:, R_RES : R_RES + 2]))
+        start_states = np.concatenate((start_states, tail[:, R_RES : R_RES + 2]))
         free_play = np.concatenate((free_play, np.ones(len(tail), dtype=bool)))
         reason = "reached" if tail[-1, N_RES] == stop else "max_points"
     short = reason.startswith("passed the end")  # continue_branch says so itself
@@ -682,10 +749,10 @@ def frequency_response(
         stuck = []
         for i in (int(k) - 1, int(k)):
             q = p.copy()
-            _set_parameter(q, code, float(branch.lam[i]))
+            set_parameter(q, code, float(branch.lam[i]))
             state = np.zeros(4)
             start_state(q, float(branch.u[i, 0]), float(branch.u[i, 1]), state)
-            stuck.append(_orbit_from(q, joint, state, 1, 0, None, 0.0, 8).stick_time > 0.0)
+            stuck.append(orbit_from(q, joint, state, 1, 0, None, 0.0, 8).stick_time > 0.0)
         sticking.append(stuck[0] != stuck[1])
     events = _events(
         joint,
@@ -721,11 +788,12 @@ def frequency_response(
         amplitude=amplitude,
         stable=stable,
         multipliers=mu,
-        initial_state=initial_state,
+        initial_state=start_states,
         events=events,
         parameter=parameter,
         stop_reason=reason,
         free_play=free_play,
+        solver=__name__,
         settings={
             "joint": joint,
             "damping_ratio": damping_ratio,
@@ -756,6 +824,7 @@ def _turned_round(curve: FrequencyResponse) -> FrequencyResponse:
         stop_reason=reason,
         settings=curve.settings,
         free_play=None if curve.free_play is None else curve.free_play[::-1].copy(),
+        solver=curve.solver,
     )
 
 

@@ -4,13 +4,15 @@
 (exact shooting, MODEL.md sec. 5.1) and ``clearjoint.harmonic.frequency_response``
 (harmonic balance, MODEL.md sec. 5.3-5.4) return, with ``method`` saying which;
 :class:`ResponseEvent` marks a fold, period doubling, grazing... along it. This
-module imports no solver: the two methods that re-run exact orbits
-(:meth:`FrequencyResponse.cycle`, :meth:`FrequencyResponse.period_2_orbit`) import
-``clearjoint.periodic`` when they are called.
+module imports no solver: a shooting curve carries the name of the module that made it
+(``solver``, "clearjoint.periodic"), and the two methods that re-run exact orbits
+(:meth:`FrequencyResponse.cycle`, :meth:`FrequencyResponse.period_2_orbit`) call back
+into that module's ``orbit_cycle`` and ``period_2_orbit``.
 """
 
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -201,6 +203,7 @@ class FrequencyResponse:
     method: str = "shooting"
     free_play: NDArray[np.bool_] | None = field(repr=False, default=None)
     dof_names: tuple[str, ...] | None = field(repr=False, default=None)
+    solver: str | None = field(repr=False, default=None)
 
     def __repr__(self) -> str:
         kinds = ", ".join(
@@ -219,20 +222,23 @@ class FrequencyResponse:
             f"{kinds}, {self.stop_reason})"
         )
 
+    def _solver(self, what: str) -> Any:
+        """The module that made this shooting curve, which re-runs its orbits."""
+        if self.method != "shooting" or self.solver is None:
+            raise ParameterError(
+                f"{what} re-runs exact orbits of a shooting curve, and this is a "
+                f"{self.method!r} curve; for one of its points use "
+                "clearjoint.periodic.periodic_orbit(..., initial=initial_state[index])"
+            )
+        return importlib.import_module(self.solver)
+
     def cycle(self, index: int) -> SteadyState:
         """Return the orbit at point ``index`` as a SteadyState (stages, ledger), re-run exactly.
 
-        Re-runs the shooting solver: ``clearjoint.periodic`` is imported here, inside
-        the method, so that this module imports no solver.
+        MODEL.md sec. 5.1; by the solver that made the curve (``solver``).
         """
-        from clearjoint.periodic import orbit_cycle
-
-        if self.method != "shooting":
-            raise ParameterError(
-                "cycle() re-runs exact orbits of a shooting curve; for a harmonic-balance point "
-                "use clearjoint.periodic.periodic_orbit(..., initial=initial_state[index])"
-            )
-        return orbit_cycle(
+        solver = self._solver("cycle()")
+        return solver.orbit_cycle(  # type: ignore[no-any-return]
             self.settings["joint"],
             float(self.force_amplitude[index]),
             float(self.omega[index]),
@@ -243,23 +249,8 @@ class FrequencyResponse:
     def period_2_orbit(self, event: ResponseEvent) -> PeriodicOrbit:
         """Switch branches at a period doubling: the period-2 orbit born there (MODEL.md sec. 5.1).
 
-        At a period doubling a Floquet multiplier of the period-1 orbit passes -1 and a
-        period-2 orbit branches off along its eigenvector w. From the curve's points
-        around the event (a multiplier below -0.5), nearest first, on either side, Newton
-        on the two-period map P_2 starts at z* +- eps w (eps from 1e-3 to 0.3 of the
-        orbit's size); the first fixed point of P_2 that is not the period-1 orbit z*
-        (further than 1e-6 of its size) is returned.
-
-        Parameters
-        ----------
-        event : ResponseEvent
-            One of ``events`` with ``kind == "period_doubling"``.
-
-        Returns
-        -------
-        PeriodicOrbit
-            ``period_multiple == 2``, at the frequency (or force) of the curve point it
-            branched from.
+        By the solver that made the curve (``solver``): see
+        :func:`clearjoint.periodic.period_2_orbit`.
 
         Raises
         ------
@@ -267,56 +258,14 @@ class FrequencyResponse:
             The event is not a period doubling, or the curve is not from shooting.
         SimulationError
             No period-2 orbit was found near the event.
-
-        Notes
-        -----
-        Re-runs the shooting solver: ``clearjoint.periodic`` (and ``clearjoint.simulate``
-        for its error) is imported here, inside the method, so that this module imports no
-        solver.
         """
-        from clearjoint.periodic import orbit_monodromy, periodic_orbit
-        from clearjoint.simulate import SimulationError
-
-        if self.method != "shooting" or event.kind != "period_doubling":
+        solver = self._solver("period_2_orbit")
+        if event.kind != "period_doubling":
             raise ParameterError(
                 "period_2_orbit takes a 'period_doubling' event of a shooting curve, got "
                 f"{event.kind!r} of a {self.method!r} curve"
             )
-        s = self.settings
-        lam = self.omega if self.parameter == "omega" else self.force_amplitude
-        at = event.omega if self.parameter == "omega" else event.force_amplitude
-        # both sides: past a supercritical doubling the period-2 orbit lies where the
-        # period-1 orbit is unstable, past a subcritical one where it is stable
-        beyond = np.nonzero(self.multipliers.real.min(axis=1) < -0.5)[0]
-        beyond = beyond[np.argsort(np.abs(lam[beyond] - at))][:16]
-        for i in beyond:
-            kw = self._losses()
-            w, f = float(self.omega[i]), float(self.force_amplitude[i])
-            z = self.initial_state[i]
-            mono = orbit_monodromy(s["joint"], f, w, z, **kw)
-            mu, vectors = np.linalg.eig(mono)
-            direction = np.real(vectors[:, int(np.argmin(mu.real))])
-            size = np.array([max(self.amplitude[i], 1e-300), max(self.amplitude[i], 1e-300) * w])
-            direction = direction / np.max(np.abs(direction) / size)
-            for eps in (1e-3, 1e-2, 3e-2, 1e-1, 3e-1):
-                for sign in (1.0, -1.0):
-                    try:
-                        orbit = periodic_orbit(
-                            s["joint"],
-                            f,
-                            w,
-                            period_multiple=2,
-                            initial=z + sign * eps * direction,
-                            **kw,
-                        )
-                    except SimulationError:
-                        continue
-                    if np.max(np.abs(np.array(orbit.initial_state) - z) / size) > 1e-6:
-                        return orbit
-        raise SimulationError(
-            f"no period-2 orbit found near the period doubling at {event!r}; try "
-            "periodic_orbit(..., period_multiple=2, initial=...) from a steady_state"
-        )
+        return solver.period_2_orbit(self, event)  # type: ignore[no-any-return]
 
     def _losses(self) -> dict[str, Any]:
         """Return the shooting curve's losses as the solver's keywords (from ``settings``)."""

@@ -20,9 +20,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
+from clearjoint.exact import kernel as kn
+from clearjoint.exact.single import initial_state, parameters
 from clearjoint.joint import Friction, Joint
-from clearjoint.simulate import _kernel as kn
-from clearjoint.simulate.core import _initial_state, _parameters
 
 FloatArray = NDArray[np.float64]
 
@@ -127,8 +127,8 @@ def reference_time_response(
     ``steps_per_period`` to see finer ones. The event-driven solver has no such
     blind spot.
     """
-    p = _parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
-    state = _initial_state(p, initial)
+    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    state = initial_state(p, initial)
     x, v = float(state[kn.S_X]), float(state[kn.S_V])
     region, slip = int(state[kn.S_REGION]), int(state[kn.S_SLIP])
     f0, w = p[kn.P_F0], p[kn.P_W]

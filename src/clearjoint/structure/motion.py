@@ -15,7 +15,7 @@ F.v sin(w t) and the viscous power v^T C v are polynomials in tau, integrated te
 term. A_s y is applied matrix-free from sparse pieces (the plain members' stiffness, C,
 and each joint's direction b_j with its stiffness and offset in its present state), so
 a new contact pattern costs nothing to set up; the whole march runs compiled, in one
-call (``clearjoint.structure._march``).
+call (``clearjoint.exact.march``).
 
 Events (a joint's shortening delta_j reaches a gap edge) are found without a miss: over
 a step each edge distance g is the polynomial given by the step's Taylor series up to a
@@ -41,10 +41,10 @@ import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.exact import march
 from clearjoint.laws import clearance
 from clearjoint.results import EnergyLedger
 from clearjoint.simulate.core import SimulationError
-from clearjoint.structure import _march
 from clearjoint.structure.model import Structure, StructureError
 
 FloatArray = NDArray[np.float64]
@@ -57,7 +57,7 @@ MAX_EVENTS_PER_STEP = 1000
 
 
 class _Flow:
-    """A structure's exact flow, set up once for ``_march.march`` (sparse pieces, scales)."""
+    """A structure's exact flow, set up once for ``march.march`` (sparse pieces, scales)."""
 
     def __init__(self, structure: Structure, force: FloatArray, omega: float) -> None:
         s = structure
@@ -319,7 +319,7 @@ def _patterns_visited(
     """How many distinct contact patterns the event sequence passes through."""
     if start.size == 0:
         return 1
-    history = np.ascontiguousarray(_march.pattern_history(start, joints, new_states))
+    history = np.ascontiguousarray(march.pattern_history(start, joints, new_states))
     rows = history.view(np.dtype((np.void, history.shape[1])))
     return int(np.unique(rows).size)
 
@@ -342,7 +342,7 @@ def _run(
     rows = np.repeat(np.arange(n), np.diff(a.indptr))
     a_u = flow.k_linear[rows, a.indices] / (flow.m[rows] * flow.omega_ref)
     a_v = flow.c[rows, a.indices] / flow.m[rows]
-    y_end, out_y, out_p, energy, impact, ev_t, ev_j, ev_s, steps, status = _march.march(
+    y_end, out_y, out_p, energy, impact, ev_t, ev_j, ev_s, steps, status = march.march(
         y,
         states,
         float(duration),
@@ -373,12 +373,12 @@ def _run(
         flow.norm_a,
         max_events,
     )
-    if status == _march.CHATTER:
+    if status == march.CHATTER:
         raise SimulationError(
             f"more than {max_events} gap-edge events in {float(ev_t[-1]):.4g} s (chattering "
             f"at joint {int(ev_j[-1])}); add damping or a restitution below 1"
         )
-    if status != _march.DONE:
+    if status != march.DONE:
         raise SimulationError(
             "the pattern flow's Taylor series did not converge even on a step 1e-12 of the "
             "base step; check the structure's stiffness and mass for extreme values"

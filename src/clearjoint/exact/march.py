@@ -29,9 +29,9 @@ from typing import Any
 
 import numpy as np
 
+from clearjoint.exact.kernel import certified_step
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.laws import clearance
-from clearjoint.simulate._kernel import certified_step
 
 #: Most Taylor terms per step; a step that needs more is halved.
 MAX_TERMS = 60

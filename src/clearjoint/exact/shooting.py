@@ -27,8 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.continuation import extrapolate, tangent_solve
+from clearjoint.exact import kernel as kn
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
-from clearjoint.simulate import _kernel as kn
 
 FloatArray = NDArray[np.float64]
 
@@ -402,7 +402,7 @@ N_RES = 13
 
 
 @njit(cache=True)
-def _set_parameter(p: np.ndarray, parameter: int, value: float) -> None:
+def set_parameter(p: np.ndarray, parameter: int, value: float) -> None:
     if parameter == 0:
         p[kn.P_W] = value
         p[kn.P_TF] = 2.0 * math.pi / value
@@ -433,7 +433,7 @@ def map_residual(
     Returns a kernel status code.
     """
     q = p.copy()
-    _set_parameter(q, parameter, lam)
+    set_parameter(q, parameter, lam)
     state = np.zeros(4)
     start_state(q, x, v, state)
     o1 = np.zeros(N_OUT)
@@ -447,7 +447,7 @@ def map_residual(
             out[R_DLAM + 1] = o1[O_DL1]
         else:
             delta = 1e-7 * lam
-            _set_parameter(q, parameter, lam + delta)
+            set_parameter(q, parameter, lam + delta)
             shifted = np.zeros(4)
             start_state(q, x, v, shifted)
             o2 = np.zeros(N_OUT)
