@@ -119,67 +119,37 @@ def _float_or_nan(value: Any) -> float:
     return math.nan if value is None else float(value)
 
 
+def _entry(command: str, kind: str, shape: Sequence[int], values: list[Any]) -> Entry:
+    return {"command": command, "kind": kind, "shape": list(shape), "values": values}
+
+
 def value_entry(command: str, value: Any) -> Entry:
     """Return one entry (kind, shape, flat values) for a number, string or array-like.
 
     Booleans stay booleans, strings stay strings; numbers (and JSON null, read as NaN)
     become a float array. A ragged or mixed list is written as its JSON text (a string).
     """
-    array = np.asarray(value, dtype=object) if not isinstance(value, np.ndarray) else value
-    if array.dtype.kind in "US":
-        return {
-            "command": command,
-            "kind": "str",
-            "shape": list(array.shape),
-            "values": [str(v) for v in array.ravel()],
-        }
-    if array.dtype.kind == "b":
-        return {
-            "command": command,
-            "kind": "bool",
-            "shape": list(array.shape),
-            "values": [bool(v) for v in array.ravel()],
-        }
-    if array.dtype.kind in "iuf":
-        return {
-            "command": command,
-            "kind": "float",
-            "shape": list(array.shape),
-            "values": [float(v) for v in array.ravel()],
-        }
+    array = value if isinstance(value, np.ndarray) else np.asarray(value, dtype=object)
     if array.dtype.kind == "c":
         return value_entry(command, np.stack([array.real, array.imag], axis=-1))
     flat = list(array.ravel())
-    if flat and all(isinstance(v, bool | np.bool_) for v in flat):
-        return {
-            "command": command,
-            "kind": "bool",
-            "shape": list(array.shape),
-            "values": [bool(v) for v in flat],
-        }
-    if all(
+    kind = {"U": "str", "S": "str", "b": "bool", "i": "float", "u": "float", "f": "float"}
+    if array.dtype.kind in kind:
+        pass
+    elif flat and all(isinstance(v, bool | np.bool_) for v in flat):
+        kind["O"] = "bool"
+    elif any(v is not None for v in flat) and all(
         v is None or (isinstance(v, int | float | np.number) and not isinstance(v, bool))
         for v in flat
-    ) and any(v is not None for v in flat):
-        return {
-            "command": command,
-            "kind": "float",
-            "shape": list(array.shape),
-            "values": [_float_or_nan(v) for v in flat],
-        }
-    if all(isinstance(v, str) for v in flat):
-        return {
-            "command": command,
-            "kind": "str",
-            "shape": list(array.shape),
-            "values": [str(v) for v in flat],
-        }
-    return {
-        "command": command,
-        "kind": "str",
-        "shape": [],
-        "values": [json.dumps(_plain(value), sort_keys=True)],
-    }
+    ):
+        kind["O"] = "float"
+    elif all(isinstance(v, str) for v in flat):
+        kind["O"] = "str"
+    else:
+        return _entry(command, "str", [], [json.dumps(_plain(value), sort_keys=True)])
+    converters: dict[str, Callable[[Any], Any]] = {"str": str, "bool": bool, "float": _float_or_nan}
+    convert = converters[kind[array.dtype.kind]]
+    return _entry(command, kind[array.dtype.kind], array.shape, [convert(v) for v in flat])
 
 
 def missing_entry(command: str, why: str) -> Entry:
@@ -538,50 +508,16 @@ def write_structure(w: Writer, quick: bool) -> None:
 
 def write_cli_small(w: Writer) -> None:
     """Add the stiffness, dissipation and simulate commands of the docs (--json)."""
-    w.cli_json(
-        "cli/stiffness",
-        [
-            "stiffness",
-            "--mass",
-            "2kg",
-            "--stiffness",
-            "8e7N/m",
-            "--clearance",
-            "0.106mm",
-            "--amplitude",
-            "1um,5um,20um",
-        ],
+    stiffness = "stiffness --mass 2kg --stiffness 8e7N/m --clearance 0.106mm"
+    w.cli_json("cli/stiffness", [*stiffness.split(), "--amplitude", "1um,5um,20um"])
+    # the command of docs/dissipation.md
+    docs = (
+        "dissipation --mass 2kg --stiffness 8e7N/m --tension-stiffness 5e7N/m "
+        "--clearance 0.106mm --amplitude 5um,20um,40um --friction-coefficient 0.2 "
+        "--lateral-load 300N --restitution 0.8 --pin-radius 5mm --pin-length 25mm "
+        "--contact-friction-coefficient 0.15 --damping-ratio 0.01"
     )
-    w.cli_json(
-        "cli/dissipation",
-        [
-            "dissipation",
-            "--mass",
-            "2kg",
-            "--stiffness",
-            "8e7N/m",
-            "--tension-stiffness",
-            "5e7N/m",
-            "--clearance",
-            "0.106mm",
-            "--amplitude",
-            "5um,20um,40um",
-            "--friction-coefficient",
-            "0.2",
-            "--lateral-load",
-            "300N",
-            "--restitution",
-            "0.8",
-            "--pin-radius",
-            "5mm",
-            "--pin-length",
-            "25mm",
-            "--contact-friction-coefficient",
-            "0.15",
-            "--damping-ratio",
-            "0.01",
-        ],
-    )
+    w.cli_json("cli/dissipation", docs.split())
     w.cli_json(
         "cli/dissipation_study",
         ["dissipation", "--study", "examples/study.toml", "--amplitude", "20um"],
@@ -778,11 +714,11 @@ def _largest_difference(a: np.ndarray, b: np.ndarray, rtol: float, floor: float)
     nan_a, nan_b = np.isnan(a), np.isnan(b)
     if np.any(nan_a != nan_b):
         i = int(np.flatnonzero(nan_a != nan_b)[0])
-        return f"NaN on one side only at {_index(i, a.shape)}: {a.flat[i]!r} vs {b.flat[i]!r}"
+        return f"NaN on one side only at {_where(i, a, b)}"
     inf = np.isinf(a) | np.isinf(b)
     if np.any(inf & (a != b)):
         i = int(np.flatnonzero(inf & (a != b))[0])
-        return f"infinite at {_index(i, a.shape)}: {a.flat[i]!r} vs {b.flat[i]!r}"
+        return f"infinite at {_where(i, a, b)}"
     finite = ~(nan_a | inf)
     if not np.any(finite):
         return ""
@@ -795,10 +731,11 @@ def _largest_difference(a: np.ndarray, b: np.ndarray, rtol: float, floor: float)
     i = int(np.argmax(relative))
     if relative.flat[i] <= rtol:
         return ""
-    return (
-        f"largest relative difference {relative.flat[i]:.3g} at {_index(i, a.shape)}: "
-        f"{a.flat[i]!r} vs {b.flat[i]!r}"
-    )
+    return f"largest relative difference {relative.flat[i]:.3g} at {_where(i, a, b)}"
+
+
+def _where(i: int, a: np.ndarray, b: np.ndarray) -> str:
+    return f"{_index(i, a.shape)}: {float(a.flat[i])!r} vs {float(b.flat[i])!r}"
 
 
 def _index(i: int, shape: tuple[int, ...]) -> str:
@@ -952,23 +889,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "write":
         entries = write(args.out, quick=args.quick, root=args.root)
         return 0 if entries else 1
+    options = {"rtol": args.rtol, "floor": args.floor, "only_problems": args.only_problems}
     if args.command == "compare":
-        return compare_files(
-            args.first,
-            args.second,
-            rtol=args.rtol,
-            floor=args.floor,
-            only_problems=args.only_problems,
-        )
-    return checkouts(
-        args.first,
-        args.second,
-        quick=args.quick,
-        out=args.out,
-        rtol=args.rtol,
-        floor=args.floor,
-        only_problems=args.only_problems,
-    )
+        return compare_files(args.first, args.second, **options)
+    return checkouts(args.first, args.second, quick=args.quick, out=args.out, **options)
 
 
 if __name__ == "__main__":
