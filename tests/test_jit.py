@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
+from pathlib import Path
+
+import clearjoint
 
 SCRIPT = """
 import warnings
@@ -29,3 +33,29 @@ def test_no_writable_cache_folder_compiles_without_one_and_says_so() -> None:
     assert result.stdout.strip() == "(1010.0, 500.0)"  # K = k0 + k_c, Fc = k_c g_c
     assert "set NUMBA_CACHE_DIR to a writable folder" in result.stderr
     assert result.stderr.count("CacheWarning") == 1
+
+
+def test_a_change_to_the_law_reaches_the_cached_kernels_that_inline_it(tmp_path: Path) -> None:
+    # numba's cache tracks a kernel's own file only; the kernel inlines laws/clearance.py
+    package = tmp_path / "clearjoint"
+    shutil.copytree(
+        Path(clearjoint.__file__).parent, package, ignore=shutil.ignore_patterns("__pycache__")
+    )
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    env.pop("NUMBA_CACHE_DIR", None)
+
+    def region_force() -> str:
+        done = subprocess.run(
+            [sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, check=False
+        )
+        assert done.returncode == 0, done.stderr
+        return done.stdout.strip()
+
+    assert region_force() == "(1010.0, 500.0)"
+    assert list(package.rglob("*.nbi"))  # compiled and cached
+    law = package / "laws" / "clearance.py"
+    text = law.read_text(encoding="utf-8")
+    assert text.count("return k0 + k_c, k_c * g_c") == 1
+    law.write_text(text.replace("return k0 + k_c, k_c * g_c", "return k0 + k_c, 2.0 * k_c * g_c"))
+    assert region_force() == "(1010.0, 1000.0)"  # the kernel was compiled anew
+    assert region_force() == "(1010.0, 1000.0)"  # and cached again
