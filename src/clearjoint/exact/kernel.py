@@ -263,7 +263,7 @@ def evaluate(q: np.ndarray, slip: int, tau: float) -> tuple[float, float, float,
 
 @njit(cache=True)
 def derivative_bounds(q: np.ndarray, tau_max: float) -> tuple[float, float]:
-    """Bounds on |x'''| and |x''''| over 0 <= tau <= tau_max in one state.
+    """Bounds on abs(x''') and abs(x'''') over 0 <= tau <= tau_max in one state.
 
     Homogeneous part: its energy (m v^2 + k x^2)/2 never grows, so each
     derivative is bounded by (w_k + c/m)^n sqrt(x_h^2 + v_h^2 m/k); with k = 0 it

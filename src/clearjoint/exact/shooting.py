@@ -364,7 +364,7 @@ def newton_orbit(
     scale : (2,) ndarray
         Sizes of x and x' that the tolerance is relative to.
     tolerance : float
-        Converged when |P_p(z) - z| / scale <= tolerance in both components.
+        Converged when abs(P_p(z) - z) / scale <= tolerance in both components.
 
     Returns
     -------
