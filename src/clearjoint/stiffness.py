@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal, Protocol
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import checks as _checks
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Joint
+from clearjoint.laws import Spring
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -262,24 +263,7 @@ def _free_play_action(
     return gap * speed
 
 
-class _Spring(Protocol):
-    """What the period's kernel reads of a joint: a :class:`Joint`, or its validated values."""
-
-    @property
-    def mass(self) -> float: ...
-    @property
-    def gap_stiffness(self) -> float: ...
-    @property
-    def compression_stiffness(self) -> float: ...
-    @property
-    def tension_stiffness(self) -> float: ...
-    @property
-    def compression_gap(self) -> float: ...
-    @property
-    def tension_gap(self) -> float: ...
-
-
-def _edge_speeds_squared(joint: _Spring, amplitude: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _edge_speeds_squared(joint: Spring, amplitude: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Squared speeds at the compression and tension edges for energy H = V(g_c + A).
 
     Written without cancellation: 2H/m - w0^2 g^2 factored by hand. The tension
@@ -293,7 +277,7 @@ def _edge_speeds_squared(joint: _Spring, amplitude: FloatArray) -> tuple[FloatAr
     return v_c2, v_t2
 
 
-def _omegas(joint: _Spring) -> tuple[float, float, float]:
+def _omegas(joint: Spring) -> tuple[float, float, float]:
     m, k0 = joint.mass, joint.gap_stiffness
     return (
         math.sqrt(k0 / m),
@@ -302,7 +286,7 @@ def _omegas(joint: _Spring) -> tuple[float, float, float]:
     )
 
 
-def _edge_offsets(joint: _Spring) -> tuple[float, float]:
+def _edge_offsets(joint: Spring) -> tuple[float, float]:
     """y0 = k0 g_s / (k0 + k_s): how far each gap edge lies outside its contact equilibrium."""
     k0 = joint.gap_stiffness
     y0_c = k0 * joint.compression_gap / (k0 + joint.compression_stiffness)
@@ -310,7 +294,7 @@ def _edge_offsets(joint: _Spring) -> tuple[float, float]:
     return y0_c, y0_t
 
 
-def _period(joint: _Spring, amplitude: FloatArray) -> FloatArray:
+def _period(joint: Spring, amplitude: FloatArray) -> FloatArray:
     """The exact period for validated amplitudes (the fast path of :func:`period`)."""
     omega_0, omega_c, omega_t = _omegas(joint)
     y0_c, y0_t = _edge_offsets(joint)

@@ -33,32 +33,17 @@ another file: after editing this module, clear the ``__pycache__`` folders (or s
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
+from clearjoint.laws import Law
 
 FloatArray = NDArray[np.float64]
 
 #: Contact states of a joint (the event-driven kernel calls OPEN its FREE region).
 OPEN, COMPRESSION, TENSION = 0, 1, -1
-
-
-class Law(Protocol):
-    """What the array helpers read of a law: a :class:`~clearjoint.ClearanceJoint`."""
-
-    @property
-    def gap_stiffness(self) -> float: ...
-    @property
-    def compression_stiffness(self) -> float: ...
-    @property
-    def tension_stiffness(self) -> float: ...
-    @property
-    def compression_gap(self) -> float: ...
-    @property
-    def tension_gap(self) -> float: ...
 
 
 # ---- one relative displacement (compiled, for the kernels) -------------------------------
