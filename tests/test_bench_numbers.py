@@ -1,4 +1,4 @@
-"""benchmarks/numbers.py: the comparison of two written sets of numbers (not the writing).
+"""benchmarks/compare_numbers.py: the comparison of two written sets of numbers (not the writing).
 
 Each case builds two small sets of entries by hand, as ``write`` would have written
 them, and checks the verdict of ``compare``.
@@ -18,7 +18,7 @@ import pytest
 
 @pytest.fixture(scope="module")
 def numbers() -> ModuleType:
-    path = Path(__file__).parents[1] / "benchmarks" / "numbers.py"
+    path = Path(__file__).parents[1] / "benchmarks" / "compare_numbers.py"
     spec = importlib.util.spec_from_file_location("bench_numbers", path)
     assert spec is not None
     assert spec.loader is not None

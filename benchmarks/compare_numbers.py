@@ -9,9 +9,9 @@ code before the refactor and after it.
 
 Run on demand::
 
-    python3.11 benchmarks/numbers.py write OUT.json [--quick]
-    python3.11 benchmarks/numbers.py compare A.json B.json [--rtol 1e-9] [--floor 1e-6]
-    python3.11 benchmarks/numbers.py checkouts OLD NEW [--quick] [--out DIR]
+    python3.11 benchmarks/compare_numbers.py write OUT.json [--quick]
+    python3.11 benchmarks/compare_numbers.py compare A.json B.json [--rtol 1e-9] [--floor 1e-6]
+    python3.11 benchmarks/compare_numbers.py checkouts OLD NEW [--quick] [--out DIR]
 
 ``write`` runs everything below with the clearjoint it imports (it prints that module's
 path: put ``PYTHONPATH=CHECKOUT/src`` first, since the editable install points at
@@ -95,18 +95,13 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-# Run as a script, this file's folder comes first on sys.path, and this file's name would
-# hide the standard library's ``numbers`` that numpy imports: take the folder off first.
-if sys.path and os.path.abspath(sys.path[0]) == os.path.dirname(os.path.abspath(__file__)):
-    del sys.path[0]
-
 import numpy as np
 
 Entry = dict[str, Any]
 Entries = dict[str, Entry]
 
 QUICK_CAMPAIGN = """\
-# benchmarks/numbers.py --quick: the shipped campaign on a 3 x 3 grid (27 tests)
+# benchmarks/compare_numbers.py --quick: the shipped campaign on a 3 x 3 grid (27 tests)
 [grid]
 frequencies = ["20Hz", "60Hz", "100Hz"]
 force_amplitudes = ["800N", "1600N", "3000N"]
