@@ -66,8 +66,10 @@ def _dense(matrix: Matrix) -> FloatArray:
 class _Flow:
     """A structure's exact flow, set up once for ``march.march`` (sparse pieces, scales)."""
 
-    def __init__(self, system: VibrationSystem, force: FloatArray, omega: float) -> None:
-        s = system
+    def __init__(
+        self, system: VibrationSystem | Structure, force: FloatArray, omega: float
+    ) -> None:
+        s = as_system(system)
         self.n = n = s.n_dof
         self.m = s.mass_diagonal()
         self.c = _dense(s.damping)
