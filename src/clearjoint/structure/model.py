@@ -662,7 +662,8 @@ def system_modes(
         A consistent (non-diagonal) mass matrix; a pattern or count not understood.
     """
     sys_ = as_system(system)
-    k, _ = sys_.pattern_stiffness(pattern_states(sys_, pattern))
+    states = pattern if isinstance(pattern, str) else np.asarray(pattern, dtype=np.int64)
+    k, _ = sys_.pattern_stiffness(pattern_states(sys_, states))
     omega, shapes = _pattern_modes(k, sys_.mass_diagonal(), count)
     source = sys_.source if isinstance(sys_.source, Structure) else None
     name = pattern if isinstance(pattern, str) else "custom"
