@@ -18,13 +18,15 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
-from clearjoint.joint import ClearanceJoint, Friction, Joint
+from clearjoint.joint import Friction, Joint
 from clearjoint.laws import clearance
 from clearjoint.stiffness import viscous_coefficient
+from clearjoint.system import VibrationSystem, as_system
 
 FloatArray = NDArray[np.float64]
 
@@ -133,26 +135,34 @@ def _refuse_losses(
         )
 
 
-def _refuse_structure_losses(law: ClearanceJoint, index: int) -> None:
-    """Refuse a structure joint's friction over the free-play stroke only, or impacts.
+def _refuse_system_losses(system: VibrationSystem) -> None:
+    """Refuse a joint's friction over the free-play stroke only, or impacts (``system.losses``).
 
     Friction over the whole path (region "everywhere") is carried, regularised; a
-    member holds it only when it is rigid (:meth:`ClearanceJoint.in_series`).
+    structure's member holds it only when it is rigid (:meth:`ClearanceJoint.in_series`).
     """
-    rubs = law.friction is not None and law.friction.force > 0.0
-    if rubs and law.friction is not None and law.friction.region != "everywhere":
-        raise HarmonicError(
-            f"Coulomb friction over the free-play stroke only (joint of member {index}) is "
-            "not carried by clearjoint.harmonic; set region='everywhere' (friction over the "
-            "whole path, carried regularised) or friction=None, or study that joint alone "
-            "with clearjoint.periodic (exact stick-slip)"
-        )
-    if law.restitution != 1.0:
-        raise HarmonicError(
-            f"restitution {law.restitution!r} (joint of member {index}) is an impact event "
-            "that harmonic balance cannot carry; use clearjoint.structure.time_response for "
-            "the exact motion with impacts, or set restitution=1"
-        )
+    for j, loss in enumerate(system.losses):
+        where = _joint_name(system, j)
+        rubs = loss.friction is not None and loss.friction.force > 0.0
+        if rubs and loss.friction is not None and loss.friction.region != "everywhere":
+            raise HarmonicError(
+                f"Coulomb friction over the free-play stroke only ({where}) is "
+                "not carried by clearjoint.harmonic; set region='everywhere' (friction over the "
+                "whole path, carried regularised) or friction=None, or study that joint alone "
+                "with clearjoint.periodic (exact stick-slip)"
+            )
+        if loss.restitution != 1.0:
+            raise HarmonicError(
+                f"restitution {loss.restitution!r} ({where}) is an impact event "
+                "that harmonic balance cannot carry; use clearjoint.structure.time_response for "
+                "the exact motion with impacts, or set restitution=1"
+            )
+
+
+def _joint_name(system: VibrationSystem, j: int) -> str:
+    """How a message names joint ``j``: by its member for a structure, else by index."""
+    members = getattr(system.source, "joint_members", None)
+    return f"joint of member {members[j]}" if members is not None else f"joint {j}"
 
 
 def from_joint(
@@ -194,50 +204,56 @@ def from_joint(
 
 
 def from_structure(structure: Any, friction_speed: float = 0.0) -> LinearSystem:
-    """The system of a :class:`~clearjoint.structure.Structure` (dense matrices).
+    """The system of a :class:`~clearjoint.structure.Structure`: :func:`from_system` of its
+    ``to_system()``."""
+    return from_system(structure.to_system(), friction_speed)
 
-    Coulomb friction of a (rigid member's) joint over its whole path is carried as
-    mu_s P tanh(v_j / v_eps) on its relative speed v_j = b_j . u', v_eps =
-    ``friction_speed`` (m/s, > 0 when some joint has friction); joints without
-    friction get a friction force of 0.
+
+def from_system(system: VibrationSystem, friction_speed: float = 0.0) -> LinearSystem:
+    """The harmonic-balance view of a :class:`~clearjoint.system.VibrationSystem` (dense).
+
+    MODEL.md 5.2. Coulomb friction of a joint over its whole path
+    (``system.friction_force()``) is carried as mu_s P tanh(v_j / v_eps) on its relative
+    speed v_j = b_j . u', v_eps = ``friction_speed`` (m/s, > 0 when some joint has
+    friction); joints without friction get a friction force of 0. Friction over the
+    free-play stroke only and restitution below 1 (``system.losses``) are refused.
     """
-    laws: tuple[ClearanceJoint, ...] = structure.joint_laws
-    for index, law in zip(structure.joint_members, laws, strict=True):
-        _refuse_structure_losses(law, index)
-    n_j = len(laws)
-    rub = np.array([0.0 if law.friction is None else law.friction.force for law in laws])
+    _refuse_system_losses(system)
+    rub = system.friction_force()
     forces = None
     if np.any(rub > 0.0):
         if not friction_speed > 0.0:  # a caller that gave no regularisation speed
-            member = structure.joint_members[int(np.argmax(rub > 0.0))]
+            where = _joint_name(system, int(np.argmax(rub > 0.0)))
             raise HarmonicError(
-                f"Coulomb friction in the joint of member {member} needs a regularisation "
+                f"Coulomb friction in the {where} needs a regularisation "
                 f"speed v_eps > 0 (got {friction_speed!r} m/s); pass friction_regularization "
                 "or build through frequency_response / nonlinear_modes, which set it"
             )
         forces = rub
         friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
-    k_lin, _ = structure.pattern_stiffness(np.full(n_j, clearance.OPEN, dtype=np.int64))
-    # pattern_stiffness("open") holds each joint's k0; the laws carry k0 themselves.
-    b = structure.joint_directions
-    k0 = np.array([law.gap_stiffness for law in laws])
-    k_lin = k_lin - (b.T * k0) @ b
+    k0, k_c, k_t, g_c, g_t = system.law_arrays()
     return LinearSystem(
-        mass=np.diag(structure.mass_diagonal()),
-        damping=np.asarray(structure.damping_matrix(), dtype=np.float64),
-        stiffness=np.asarray(k_lin, dtype=np.float64),
-        directions=np.asarray(b, dtype=np.float64).reshape(n_j, structure.n_dof),
+        mass=_dense(system.mass),
+        damping=_dense(system.damping),
+        stiffness=_dense(system.stiffness),
+        directions=np.asarray(system.directions, dtype=np.float64),
         k0=k0,
-        k_c=np.array([law.compression_stiffness for law in laws]),
-        k_t=np.array([law.tension_stiffness for law in laws]),
-        g_c=np.array([law.compression_gap for law in laws]),
-        g_t=np.array([law.tension_gap for law in laws]),
-        dof_names=list(structure.dof_names),
+        k_c=k_c,
+        k_t=k_t,
+        g_c=g_c,
+        g_t=g_t,
+        dof_names=list(system.dof_names),
         is_joint=False,
-        source=structure,
+        source=system.source if system.source is not None else system,
         friction_force=forces,
         friction_speed=float(friction_speed),
     )
+
+
+def _dense(matrix: Any) -> FloatArray:
+    """``matrix`` as a dense float64 array (sparse ones expanded)."""
+    dense = matrix.toarray() if scipy.sparse.issparse(matrix) else matrix
+    return np.asarray(dense, dtype=np.float64)
 
 
 def build(
@@ -247,20 +263,26 @@ def build(
     restitution: float,
     friction_speed: float = 0.0,
 ) -> LinearSystem:
-    """A :class:`LinearSystem` from a Joint (with its losses) or a Structure."""
+    """A :class:`LinearSystem` from a Joint (with its losses), a Structure or a VibrationSystem.
+
+    A Structure goes through ``to_system()``; a system built from a Joint
+    (``VibrationSystem.from_joint``) stays a Joint's.
+    """
     if isinstance(system, Joint):
         return from_joint(system, damping_ratio, friction, restitution, friction_speed)
     from clearjoint.structure.model import Structure
 
-    if isinstance(system, Structure):
+    if isinstance(system, Structure | VibrationSystem):
         if damping_ratio or friction is not None or restitution != 1.0:
             raise ParameterError(
-                "damping_ratio, friction and restitution apply to a Joint; a Structure carries "
-                "its own damping (Member.damping, rayleigh) and joint losses"
+                "damping_ratio, friction and restitution apply to a Joint; a "
+                f"{type(system).__name__} carries its own damping (Member.damping, rayleigh, "
+                "or its C) and joint losses"
             )
-        return from_structure(system, friction_speed)
+        return from_system(as_system(system), friction_speed)
     raise ParameterTypeError(
-        f"system must be a clearjoint.Joint or a clearjoint.structure.Structure, got {system!r}"
+        "system must be a clearjoint.Joint, a clearjoint.structure.Structure or a "
+        f"clearjoint.system.VibrationSystem, got {system!r}"
     )
 
 
@@ -301,12 +323,20 @@ def friction_speed(system: Any, omega: float, given: float | None) -> float:
         return _checks.positive("friction_regularization", given, unit="m/s")
     if isinstance(system, Joint):
         return 1e-3 * omega * max(system.clearance, 1e-6)
-    laws = getattr(system, "joint_laws", ())
-    gaps = [
-        float(law.clearance)
-        for law in laws
-        if law.friction is not None and law.friction.force > 0.0
-    ]
+    if isinstance(system, VibrationSystem):
+        pairs = list(zip(system.laws, system.losses, strict=True))
+        gaps = [
+            float(law.clearance)
+            for law, loss in pairs
+            if loss.friction is not None and loss.friction.force > 0.0
+        ]
+    else:
+        laws = getattr(system, "joint_laws", ())
+        gaps = [
+            float(law.clearance)
+            for law in laws
+            if law.friction is not None and law.friction.force > 0.0
+        ]
     if gaps:
         return 1e-3 * omega * max(max(gaps), 1e-6)
     return 0.0

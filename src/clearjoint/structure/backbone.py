@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from clearjoint.structure.model import StructureError
+from clearjoint.structure.model import StructureError, system_modes
 from clearjoint.structure.motion import StructureMotion
 
 FloatArray = NDArray[np.float64]
@@ -156,7 +156,7 @@ def decay_backbone(motion: StructureMotion, dof: int, mode: int | None = None) -
         A free decay (``free_decay``), sampled finely enough to resolve each cycle; a
         forced motion (input work not 0) is refused.
     dof : int
-        The DOF whose displacement is measured (index into ``structure.dof_names``).
+        The DOF whose displacement is measured (index into ``motion.dof_names``).
     mode : int, optional
         1-based closed-pattern mode to project the motion on first; the amplitude is
         then that mode's contribution at ``dof``.
@@ -165,22 +165,28 @@ def decay_backbone(motion: StructureMotion, dof: int, mode: int | None = None) -
     -------
     Backbone
     """
-    s = motion.structure
+    n_dof = motion.u.shape[1]
     if motion.energy.input != 0.0:  # a forced response's decrement is no damping ratio
         raise StructureError(
             f"decay_backbone reads a free decay, but this motion was forced (input work "
             f"{motion.energy.input:.3g} J); use structure.free_decay for the ring-down"
         )
-    if isinstance(dof, bool) or not isinstance(dof, int | np.integer) or not 0 <= dof < s.n_dof:
-        raise StructureError(f"dof must be an index from 0 to {s.n_dof - 1}, got {dof!r}")
+    if isinstance(dof, bool) or not isinstance(dof, int | np.integer) or not 0 <= dof < n_dof:
+        raise StructureError(f"dof must be an index from 0 to {n_dof - 1}, got {dof!r}")
     u = motion.u[:, dof]
     v = motion.v[:, dof]
     if mode is not None:
-        modes = s.modes("closed")
+        s = motion.structure
+        if s is not None:  # the structure's own modes, in its arithmetic order
+            modes, masses = s.modes("closed"), s.mass_diagonal()
+        elif motion.system is not None:
+            modes, masses = system_modes(motion.system), motion.system.mass_diagonal()
+        else:
+            raise StructureError("mode= needs the motion's structure or system; it has neither")
         if isinstance(mode, bool) or not isinstance(mode, int) or not 1 <= mode <= modes.omega.size:
             raise StructureError(f"mode must be from 1 to {modes.omega.size}, got {mode!r}")
         phi = modes.shapes[:, mode - 1]
-        weight = phi * s.mass_diagonal()
+        weight = phi * masses
         u = (motion.u @ weight) * phi[dof]
         v = (motion.v @ weight) * phi[dof]
         if phi[dof] < 0.0:

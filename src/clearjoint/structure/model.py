@@ -29,7 +29,7 @@ from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
 from clearjoint.joint import ClearanceJoint, positive_or_inf
 from clearjoint.laws import clearance
-from clearjoint.system import VibrationSystem
+from clearjoint.system import Matrix, VibrationSystem, as_system, pattern_states
 
 FloatArray = NDArray[np.float64]
 
@@ -123,12 +123,23 @@ class Modes:
         Mass-normalised mode shapes (u^T M u = 1), one per column, over the free DOFs.
     pattern : str
         "closed" (every joint in compression contact) or "open" (every joint in free-play).
+    structure : Structure or None
+        The structure drawn by :meth:`plot`; None for a system given as matrices.
+    dof_names : tuple of str
+        A name per DOF (default: the structure's).
     """
 
     omega: FloatArray
     shapes: FloatArray
     pattern: str
-    structure: Structure = field(repr=False)
+    structure: Structure | None = field(repr=False)
+    dof_names: tuple[str, ...] = field(default=(), repr=False)
+
+    def __post_init__(self) -> None:
+        if not self.dof_names:
+            names = () if self.structure is None else tuple(self.structure.dof_names)
+            names = names or tuple(f"u{i + 1}" for i in range(self.shapes.shape[0]))
+            object.__setattr__(self, "dof_names", names)
 
     @property
     def frequency_hz(self) -> FloatArray:
@@ -146,8 +157,17 @@ class Modes:
 
         if ax is None:
             _, ax = plt.subplots()
-        s = self.structure
         n = min(modes, self.omega.size)
+        s = self.structure
+        if s is None:  # a system given as matrices: the shapes against DOF index
+            for k in range(n):
+                label = f"mode {k + 1}: {self.frequency_hz[k]:.4g} Hz"
+                ax.plot(self.shapes[:, k], marker="o", color=f"C{k}", label=label)
+            ax.set_xlabel("DOF index")
+            ax.set_ylabel("mode shape (1/sqrt(kg))")
+            ax.set_title(f"{self.pattern} pattern")
+            ax.legend(fontsize="small")
+            return ax
         for k in range(n):
             shape = s.node_displacements(self.shapes[:, k])
             size = float(np.max(np.abs(shape))) or 1.0
@@ -169,7 +189,7 @@ class Modes:
                 "frequency": ("mode", self.frequency_hz, {"units": "Hz"}),
                 "shape": (("dof", "mode"), self.shapes, {"units": "1/sqrt(kg)"}),
             },
-            coords={"mode": np.arange(1, self.omega.size + 1), "dof": self.structure.dof_names},
+            coords={"mode": np.arange(1, self.omega.size + 1), "dof": list(self.dof_names)},
             attrs={"pattern": self.pattern},
         )
 
@@ -186,7 +206,7 @@ class Modes:
         import pandas as pd
 
         columns: dict[str, Any] = {"omega_rad_per_s": self.omega, "frequency_hz": self.frequency_hz}
-        names = self.structure.dof_names
+        names = self.dof_names
         columns.update({f"shape[{name}]": self.shapes[k] for k, name in enumerate(names)})
         return pd.DataFrame(columns, index=pd.Index(np.arange(1, self.omega.size + 1), name="mode"))
 
@@ -533,24 +553,7 @@ class Structure:
         if pattern not in ("closed", "open"):
             raise StructureError(f"pattern must be 'closed' or 'open', got {pattern!r}")
         k, _ = self.pattern_stiffness(self._states(pattern))
-        m = self.mass_diagonal()
-        n = self.n_dof
-        if count is not None and (not isinstance(count, int) or count < 1):
-            raise StructureError(f"count must be a positive integer, got {count!r}")
-        if n > SPARSE_ABOVE and count is not None and count < n - 1:
-            # shift-invert just below 0: an open pattern with k0 = 0 has a singular K, so
-            # K - 0 M cannot be factorised; K + s M (s > 0, far below the spectrum) can
-            shift = 1e-9 * float(np.max(np.diag(k) / m))
-            w2, shapes = scipy.sparse.linalg.eigsh(
-                scipy.sparse.csc_matrix(k), k=count, M=scipy.sparse.diags(m), sigma=-shift
-            )
-            order = np.argsort(w2)
-            w2, shapes = w2[order], shapes[:, order]
-        else:
-            w2, shapes = scipy.linalg.eigh(k, np.diag(m))
-            if count is not None:
-                w2, shapes = w2[:count], shapes[:, :count]
-        omega = np.sqrt(np.clip(w2, 0.0, None))
+        omega, shapes = _pattern_modes(k, self.mass_diagonal(), count)
         return Modes(omega=omega, shapes=shapes, pattern=pattern, structure=self)
 
     # ---- drawing ----------------------------------------------------------------------------
@@ -606,4 +609,64 @@ def edge_positions(laws: Sequence[ClearanceJoint]) -> tuple[FloatArray, FloatArr
     return (
         np.array([law.compression_gap for law in laws]),
         np.array([law.tension_gap for law in laws]),
+    )
+
+
+def _pattern_modes(k: Matrix, m: FloatArray, count: int | None) -> tuple[FloatArray, FloatArray]:
+    """Return omega (rad/s) and mass-normalised shapes of K phi = omega^2 diag(m) phi.
+
+    Dense, or scipy's eigsh for the ``count`` lowest modes when N > ``SPARSE_ABOVE``
+    (MODEL.md 5.2).
+    """
+    n = m.size
+    if count is not None and (not isinstance(count, int) or count < 1):
+        raise StructureError(f"count must be a positive integer, got {count!r}")
+    if n > SPARSE_ABOVE and count is not None and count < n - 1:
+        # shift-invert just below 0: an open pattern with k0 = 0 has a singular K, so
+        # K - 0 M cannot be factorised; K + s M (s > 0, far below the spectrum) can
+        shift = 1e-9 * float(np.max(np.asarray(k.diagonal()) / m))
+        w2, shapes = scipy.sparse.linalg.eigsh(
+            scipy.sparse.csc_matrix(k), k=count, M=scipy.sparse.diags(m), sigma=-shift
+        )
+        order = np.argsort(w2)
+        w2, shapes = w2[order], shapes[:, order]
+    else:
+        dense = k.toarray() if scipy.sparse.issparse(k) else k
+        w2, shapes = scipy.linalg.eigh(dense, np.diag(m))
+        if count is not None:
+            w2, shapes = w2[:count], shapes[:, :count]
+    return np.sqrt(np.clip(w2, 0.0, None)), shapes
+
+
+def system_modes(
+    system: VibrationSystem | Structure,
+    pattern: str | ArrayLike = "closed",
+    count: int | None = None,
+) -> Modes:
+    """Return the natural frequencies and mass-normalised shapes of a system's contact pattern.
+
+    MODEL.md 5.2: K_s phi = omega^2 M phi with K_s = K + sum_j K_j,s b_j b_j^T.
+
+    Parameters
+    ----------
+    system : VibrationSystem or Structure
+        A Structure goes through ``as_system``; M must be lumped (diagonal).
+    pattern : "closed", "open" or (n_j,) per-joint states
+        0 open, 1 compression, -1 tension.
+    count : int, optional
+        Only the ``count`` lowest modes (eigsh above ``SPARSE_ABOVE`` DOFs).
+
+    Raises
+    ------
+    ParameterError
+        A consistent (non-diagonal) mass matrix; a pattern or count not understood.
+    """
+    sys_ = as_system(system)
+    states = pattern if isinstance(pattern, str) else np.asarray(pattern, dtype=np.int64)
+    k, _ = sys_.pattern_stiffness(pattern_states(sys_, states))
+    omega, shapes = _pattern_modes(k, sys_.mass_diagonal(), count)
+    source = sys_.source if isinstance(sys_.source, Structure) else None
+    name = pattern if isinstance(pattern, str) else "custom"
+    return Modes(
+        omega=omega, shapes=shapes, pattern=name, structure=source, dof_names=sys_.dof_names
     )

@@ -45,7 +45,8 @@ from clearjoint.exact import march
 from clearjoint.laws import clearance
 from clearjoint.results import EnergyLedger
 from clearjoint.simulate.core import SimulationError
-from clearjoint.structure.model import Structure, StructureError
+from clearjoint.structure.model import Structure, StructureError, system_modes
+from clearjoint.system import Matrix, VibrationSystem, as_system
 
 FloatArray = NDArray[np.float64]
 
@@ -56,28 +57,34 @@ BASE_STEP_PERIODS = 1.0 / 8.0
 MAX_EVENTS_PER_STEP = 1000
 
 
+def _dense(matrix: Matrix) -> FloatArray:
+    """``matrix`` as a dense float64 array (the flow's set-up works on dense pieces)."""
+    dense = matrix.toarray() if scipy.sparse.issparse(matrix) else matrix
+    return np.asarray(dense, dtype=np.float64)
+
+
 class _Flow:
     """A structure's exact flow, set up once for ``march.march`` (sparse pieces, scales)."""
 
-    def __init__(self, structure: Structure, force: FloatArray, omega: float) -> None:
-        s = structure
+    def __init__(
+        self, system: VibrationSystem | Structure, force: FloatArray, omega: float
+    ) -> None:
+        s = as_system(system)
         self.n = n = s.n_dof
         self.m = s.mass_diagonal()
-        self.c = s.damping_matrix()
+        self.c = _dense(s.damping)
         self.force = force
         self.omega = omega
-        self.b = s.joint_directions
-        self.laws = s.joint_laws
+        self.b = s.directions
+        self.laws = s.laws
         law_parameters = clearance.parameters(self.laws)
         self.g_c, self.g_t = law_parameters[3:]
-        self.restitution = np.array([law.restitution for law in self.laws], dtype=np.float64)
+        self.restitution = s.restitution()
         inv_m = 1.0 / self.m
         self.impulse_dirs = self.b * inv_m  # rows M^-1 b_j
         self.m_eff = 1.0 / np.maximum(np.einsum("jn,jn->j", self.b, self.impulse_dirs), 1e-300)
-        plain = [i for i, mem in enumerate(s.members) if mem.joint is None]
-        bm = s.member_directions[plain]
-        self.k_linear = (bm.T * s._k_member[plain]) @ bm
-        self.structure = s
+        self.k_linear = _dense(s.stiffness)
+        self.system = s
         n_j = len(self.laws)
         # each joint's (stiffness, offset) in state -1, 0, 1 (column state + 1)
         self.k_table, self.r_table = clearance.state_tables(*law_parameters)
@@ -147,7 +154,7 @@ class StructureMotion:
     t : (n,) ndarray
         Sample times, s.
     u, v : (n, N) ndarray
-        Displacements (m) and velocities (m/s) of the DOFs (``structure.dof_names``).
+        Displacements (m) and velocities (m/s) of the DOFs (``dof_names``).
     pattern : (n, J) ndarray of int8
         Each joint's state at each sample: 0 open, 1 compression, -1 tension.
     energy : EnergyLedger
@@ -158,12 +165,19 @@ class StructureMotion:
     event_times : (E,) ndarray
         When each event happened, s.
     event_joints : (E,) ndarray of int
-        Which joint (index into ``structure.joint_members``) each event belongs to.
+        Which joint (row of the system's ``directions``; for a structure, index into
+        ``structure.joint_members``) each event belongs to.
     patterns_visited : int
         How many distinct contact patterns were met.
     steps : int
         Steps of the exact flow taken (one ends at each event; the others are at most the
         base step, an eighth of the shortest period).
+    structure : Structure or None
+        The structure moved (``system.source``); None for a system given as matrices.
+    dof_names : tuple of str
+        A name per DOF, from the system.
+    system : VibrationSystem or None
+        The system moved.
     """
 
     t: FloatArray
@@ -176,10 +190,18 @@ class StructureMotion:
     event_joints: NDArray[np.int64]
     patterns_visited: int
     final_state: tuple[FloatArray, FloatArray] = field(repr=False)
-    structure: Structure = field(repr=False)
+    structure: Structure | None = field(repr=False)
     omega: float = 0.0
     initial_energy: float = 0.0
     steps: int = 0
+    dof_names: tuple[str, ...] = field(default=(), repr=False)
+    system: VibrationSystem | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        if not self.dof_names:
+            names = () if self.structure is None else tuple(self.structure.dof_names)
+            names = names or tuple(f"u{i + 1}" for i in range(self.u.shape[1]))
+            object.__setattr__(self, "dof_names", names)
 
     @property
     def balance_error(self) -> float:
@@ -205,7 +227,7 @@ class StructureMotion:
             dof = int(np.argmax(np.ptp(self.u, axis=0)))
         ax.plot(self.t, 1e3 * self.u[:, dof], lw=0.8)
         ax.set_xlabel("time (s)")
-        ax.set_ylabel(f"{self.structure.dof_names[dof]} displacement (mm)")
+        ax.set_ylabel(f"{self.dof_names[dof]} displacement (mm)")
         return ax
 
     def to_xarray(self) -> Any:
@@ -225,7 +247,7 @@ class StructureMotion:
             },
             coords={
                 "time": ("time", self.t, {"units": "s"}),
-                "dof": self.structure.dof_names,
+                "dof": list(self.dof_names),
                 "joint": np.arange(self.pattern.shape[1]),
             },
             attrs={"events": self.events, "omega_rad_per_s": self.omega, **ledger},
@@ -238,18 +260,18 @@ class StructureMotion:
         -------
         pandas.DataFrame
             Index ``time_s``; columns ``u_m[<dof name>]`` then ``v_m_per_s[<dof name>]``
-            for each DOF (``structure.dof_names``). The contact patterns, events and
+            for each DOF (``dof_names``). The contact patterns, events and
             energy ledger are in :meth:`to_xarray`.
         """
         import pandas as pd
 
-        names = self.structure.dof_names
+        names = self.dof_names
         columns = {f"u_m[{name}]": self.u[:, k] for k, name in enumerate(names)}
         columns.update({f"v_m_per_s[{name}]": self.v[:, k] for k, name in enumerate(names)})
         return pd.DataFrame(columns, index=pd.Index(self.t, name="time_s"))
 
 
-def _vector(name: str, value: ArrayLike, structure: Structure) -> FloatArray:
+def _vector(name: str, value: ArrayLike, structure: Structure | VibrationSystem) -> FloatArray:
     array = np.asarray(value, dtype=np.float64)
     n = structure.n_dof
     names = ", ".join(structure.dof_names[:4]) + (", ..." if n > 4 else "")
@@ -268,7 +290,7 @@ def _vector(name: str, value: ArrayLike, structure: Structure) -> FloatArray:
     return array
 
 
-def _initial(structure: Structure, initial: Any) -> tuple[FloatArray, FloatArray]:
+def _initial(structure: Structure | VibrationSystem, initial: Any) -> tuple[FloatArray, FloatArray]:
     n = structure.n_dof
     if initial is None:
         return np.zeros(n), np.zeros(n)
@@ -286,12 +308,17 @@ def _initial(structure: Structure, initial: Any) -> tuple[FloatArray, FloatArray
     )
 
 
-def _check_joints(structure: Structure) -> None:
-    for index in structure.joint_members:
-        joint = structure.members[index].joint
-        if joint is not None and joint.friction is not None:
+def _check_joints(system: VibrationSystem) -> None:
+    source = system.source
+    for j, loss in enumerate(system.losses):
+        if loss.friction is not None:
+            where = (
+                f"member {source.joint_members[j]}"
+                if isinstance(source, Structure)
+                else f"joint {j}"
+            )
             raise StructureError(
-                f"member {index}: Coulomb friction in a joint of a structure is not carried "
+                f"{where}: Coulomb friction in a joint of a structure is not carried "
                 "(sticking would be a constraint the exact pattern flow does not model); "
                 "set friction=None, or use clearjoint.simulate for a single joint"
             )
@@ -405,15 +432,17 @@ def _run(
         event_joints=np.asarray(ev_j, dtype=np.int64),
         patterns_visited=_patterns_visited(states, ev_j, ev_s),
         final_state=(u_end, v_end),
-        structure=flow.structure,
+        structure=flow.system.source if isinstance(flow.system.source, Structure) else None,
         omega=flow.omega,
         initial_energy=flow.mechanical_energy(u0, v0),
         steps=int(steps),
+        dof_names=flow.system.dof_names,
+        system=flow.system,
     )
 
 
 def time_response(
-    structure: Structure,
+    structure: Structure | VibrationSystem,
     force: ArrayLike,
     omega: float,
     duration: float,
@@ -428,9 +457,11 @@ def time_response(
 
     Parameters
     ----------
-    structure : Structure
+    structure : Structure or VibrationSystem
+        A Structure is turned into its system once (``as_system``); the system's M
+        must be lumped (diagonal).
     force : (N,) array_like
-        Per-DOF force amplitudes F, N (``structure.dof_names`` gives the order).
+        Per-DOF force amplitudes F, N (``dof_names`` gives the order).
     omega : float
         Forcing circular frequency, rad/s, > 0.
     duration : float
@@ -448,24 +479,22 @@ def time_response(
     ------
     StructureError
         A force or initial vector of the wrong length, friction in a joint.
+    ParameterError
+        A consistent (non-diagonal) mass matrix.
     SimulationError
         Chattering (too many events).
     """
-    if not isinstance(structure, Structure):
-        raise StructureError(
-            f"structure must be a clearjoint.structure.Structure, got {structure!r}"
-        )
-    _check_joints(structure)
-    f = _vector("force", force, structure)
+    system = _system(structure)
+    f = _vector("force", force, system)
     w = _checks.positive("omega", omega, unit="rad/s")
     duration = _checks.positive("duration", duration, unit="s")
-    u0, v0 = _initial(structure, initial)
+    u0, v0 = _initial(system, initial)
     times = _sample_times(duration, 2.0 * math.pi / w, samples_per_period)
-    return _run(_Flow(structure, f, w), u0, v0, duration, times)
+    return _run(_Flow(system, f, w), u0, v0, duration, times)
 
 
 def free_decay(
-    structure: Structure,
+    structure: Structure | VibrationSystem,
     initial: Any,
     duration: float,
     *,
@@ -474,15 +503,28 @@ def free_decay(
     """Return the exact free motion from ``initial`` = (u0, v0) over ``duration`` s.
 
     Sampled ``samples_per_period`` times per period of the first closed-pattern mode.
-    Same solver as :func:`time_response` with no forcing.
+    Same solver as :func:`time_response` with no forcing; a Structure or a
+    VibrationSystem (lumped M).
     """
-    if not isinstance(structure, Structure):
-        raise StructureError(
-            f"structure must be a clearjoint.structure.Structure, got {structure!r}"
-        )
-    _check_joints(structure)
+    system = _system(structure)
     duration = _checks.positive("duration", duration, unit="s")
-    u0, v0 = _initial(structure, initial)
-    first = float(structure.modes("closed").omega[0])
+    u0, v0 = _initial(system, initial)
+    source = system.source
+    # a structure's own modes keep its arithmetic order (the sample times to the bit)
+    modes = source.modes("closed") if isinstance(source, Structure) else system_modes(system)
+    first = float(modes.omega[0])
     times = _sample_times(duration, 2.0 * math.pi / first, samples_per_period)
-    return _run(_Flow(structure, np.zeros(structure.n_dof), 0.0), u0, v0, duration, times)
+    return _run(_Flow(system, np.zeros(system.n_dof), 0.0), u0, v0, duration, times)
+
+
+def _system(structure: Any) -> VibrationSystem:
+    """A Structure's system (built once) or a VibrationSystem, checked for the flow."""
+    if not isinstance(structure, Structure | VibrationSystem):
+        raise StructureError(
+            "structure must be a clearjoint.structure.Structure or a "
+            f"clearjoint.system.VibrationSystem, got {structure!r}"
+        )
+    system = as_system(structure)
+    _check_joints(system)
+    system.mass_diagonal()  # a consistent mass is refused here, in one line
+    return system

@@ -1,0 +1,129 @@
+"""The structure solvers on a VibrationSystem (issue 23): a Structure and its system agree,
+and a system given only as matrices runs every structure solver (MODEL.md 5.2-5.3)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearjoint import ClearanceJoint
+from clearjoint.harmonic import frequency_response
+from clearjoint.structure import Structure, chain, decay_backbone, free_decay, time_response
+from clearjoint.structure.model import system_modes
+from clearjoint.system import VibrationSystem, VibrationSystemError
+
+LAW = ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4)
+
+
+@pytest.fixture
+def links() -> Structure:
+    """Three masses, a joint in the first and the last link, dashpots on each."""
+    return chain([1.0, 1.5, 2.0], [3e5, 2e5, 1e5], [LAW, None, LAW], [4.0, 3.0, 2.0])
+
+
+def _hand_chain(mass: np.ndarray | None = None) -> VibrationSystem:
+    """A 3-mass chain written out as matrices: springs ground-1, 1-2, 2-3, two joints."""
+    k1, k2, k3 = 3e5, 2e5, 1e5
+    stiffness = np.array([[k1 + k2, -k2, 0.0], [-k2, k2 + k3, -k3], [0.0, -k3, k3]])
+    m = np.diag([1.0, 1.5, 2.0]) if mass is None else mass
+    return VibrationSystem(
+        mass=m,
+        damping=1e-4 * stiffness + 0.5 * np.eye(3),
+        stiffness=stiffness,
+        directions=np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 1.0]]),
+        laws=(LAW, ClearanceJoint(0.1e-3, 6e5, gap_stiffness=5e4)),
+        dof_names=("a", "b", "c"),
+    )
+
+
+def test_time_response_of_a_structure_and_of_its_system_are_equal(links: Structure) -> None:
+    force = np.array([0.0, 0.0, 30.0])
+    one = time_response(links, force, 400.0, 0.05)
+    two = time_response(links.to_system(), force, 400.0, 0.05)
+    np.testing.assert_array_equal(one.u, two.u)
+    np.testing.assert_array_equal(one.v, two.v)
+    np.testing.assert_array_equal(one.event_times, two.event_times)
+    assert one.dof_names == two.dof_names == tuple(links.dof_names)
+    assert two.structure is links
+
+
+def test_free_decay_and_backbone_of_a_structure_and_of_its_system_are_equal(
+    links: Structure,
+) -> None:
+    initial = (np.array([1e-3, 2e-3, 3e-3]), np.zeros(3))
+    one = free_decay(links, initial, 0.1)
+    two = free_decay(links.to_system(), initial, 0.1)
+    np.testing.assert_array_equal(one.t, two.t)
+    np.testing.assert_array_equal(one.u, two.u)
+    b1, b2 = decay_backbone(one, 2, mode=1), decay_backbone(two, 2, mode=1)
+    np.testing.assert_array_equal(b1.amplitude, b2.amplitude)
+
+
+def test_modes_of_a_structure_and_of_its_system_agree(links: Structure) -> None:
+    for pattern in ("closed", "open"):
+        mine = links.modes(pattern)
+        one, two = system_modes(links, pattern), system_modes(links.to_system(), pattern)
+        np.testing.assert_array_equal(one.omega, two.omega)
+        np.testing.assert_array_equal(one.shapes, two.shapes)
+        # the system assembles K in another order: equal to round-off, not bitwise
+        np.testing.assert_allclose(mine.omega, one.omega, rtol=1e-12)
+        assert one.structure is links
+        assert one.dof_names == tuple(links.dof_names)
+
+
+def test_harmonic_response_of_a_structure_and_of_its_system_are_equal(links: Structure) -> None:
+    force = np.array([0.0, 0.0, 30.0])
+    kwargs = {"harmonics": 5, "max_points": 4, "check_points": 0}
+    one = frequency_response(links, force, 300.0, 320.0, **kwargs)
+    two = frequency_response(links.to_system(), force, 300.0, 320.0, **kwargs)
+    np.testing.assert_array_equal(one.omega, two.omega)
+    np.testing.assert_array_equal(one.x_max, two.x_max)
+
+
+def test_a_system_of_matrices_runs_time_response_free_decay_and_modes() -> None:
+    system = _hand_chain()
+    motion = time_response(system, [0.0, 0.0, 20.0], 300.0, 0.03)
+    assert motion.structure is None
+    assert motion.dof_names == ("a", "b", "c")
+    assert motion.balance_error < 1e-8
+    assert next(iter(motion.to_pandas().columns)) == "u_m[a]"
+    decay = free_decay(system, (np.array([1e-3, 0.0, -1e-3]), np.zeros(3)), 0.05)
+    assert decay.energy.input == 0.0
+    assert decay.balance_error < 1e-8
+    modes = system_modes(system, "closed")
+    assert modes.structure is None
+    assert modes.omega.size == 3
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    assert modes.plot() is not None  # against DOF index: no structure to draw
+    assert motion.plot() is not None
+
+
+def test_the_linear_limit_of_harmonic_balance_on_a_system_is_the_closed_form_frf() -> None:
+    """Inside the gaps the joints stay open: x = (K_open - w^2 M + i w C)^-1 F."""
+    system = _hand_chain()
+    force = np.array([0.0, 0.0, 1e-3])
+    omega = np.array([150.0, 250.0])
+    fr = frequency_response(system, force, omega[0], omega[-1], harmonics=3, check_points=0)
+    assert fr.coefficients is not None
+    b = system.directions
+    k_open = system.stiffness + (b.T * system.law_arrays().k0) @ b
+    for w, coef in zip(fr.omega, fr.coefficients, strict=True):
+        dynamic = k_open - w**2 * system.mass + 1j * w * system.damping
+        x = np.linalg.solve(dynamic, force)
+        np.testing.assert_allclose(np.hypot(coef[1], coef[2]), np.abs(x), rtol=1e-6)
+        assert np.max(np.abs(b @ x)) < 0.1e-3  # inside every gap
+
+
+def test_a_consistent_mass_is_refused_by_the_solvers_that_need_a_lumped_one() -> None:
+    consistent = np.array([[1.0, 0.2, 0.0], [0.2, 1.5, 0.2], [0.0, 0.2, 2.0]])
+    system = _hand_chain(consistent)
+    with pytest.raises(VibrationSystemError, match="lumped"):
+        time_response(system, [0.0, 0.0, 1.0], 300.0, 0.01)
+    with pytest.raises(VibrationSystemError, match="lumped"):
+        free_decay(system, (np.zeros(3), np.ones(3)), 0.01)
+    with pytest.raises(VibrationSystemError, match="lumped"):
+        system_modes(system)
+    assert math.isfinite(float(system.mass[0, 1]))
