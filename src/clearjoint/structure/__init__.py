@@ -3,12 +3,14 @@
 ``Structure`` holds nodes with lumped masses, axial members (each optionally with a
 :class:`~clearjoint.ClearanceJoint` in series), supports and damping; ``chain`` and
 ``truss`` build one; ``time_response`` and ``free_decay`` give its exact event-driven
-motion with an energy ledger.
+motion with an energy ledger, and ``system_modes`` the linear modes of a contact pattern.
+Each of them takes a Structure or the :class:`~clearjoint.system.VibrationSystem` it
+produces (``Structure.to_system()``), or one built from matrices.
 """
 
 from clearjoint.structure.backbone import Backbone, decay_backbone
 from clearjoint.structure.builders import chain, mast, truss
-from clearjoint.structure.model import Member, Modes, Structure, StructureError
+from clearjoint.structure.model import Member, Modes, Structure, StructureError, system_modes
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
 
 __all__ = [
@@ -22,6 +24,7 @@ __all__ = [
     "decay_backbone",
     "free_decay",
     "mast",
+    "system_modes",
     "time_response",
     "truss",
 ]
