@@ -5,13 +5,14 @@ Run from the repository root: ``python3.11 docs/develop/make_architecture_figure
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import FancyBboxPatch  # noqa: E402
+import matplotlib.pyplot as plt
+from matplotlib.patches import FancyBboxPatch
 
 OUT = Path(__file__).resolve().parents[1] / "figures" / "architecture.png"
 
@@ -52,29 +53,43 @@ def draw(path: Path = OUT) -> Path:
         y = i * (height + gap)
         ax.add_patch(
             FancyBboxPatch(
-                (0.0, y), width, height, boxstyle="round,pad=0.02",
-                facecolor="#e8eef7" if i % 2 else "#d5e1f2", edgecolor="#4a6890",
+                (0.0, y),
+                width,
+                height,
+                boxstyle="round,pad=0.02",
+                facecolor="#e8eef7" if i % 2 else "#d5e1f2",
+                edgecolor="#4a6890",
             )
         )
         ax.text(0.12, y + height / 2, name, va="center", fontsize=11, fontweight="bold")
         ax.text(2.25, y + height / 2, what, va="center", fontsize=9)
     x = width + 0.35
     ys = [i * (height + gap) + height / 2 for i, _ in CALL]
-    for (i, label), y in zip(CALL, ys):
+    for (_, label), y in zip(CALL, ys, strict=True):
         ax.plot([width, x], [y, y], color="#b04020", lw=1.0)
         ax.text(x + 0.1, y, label, va="center", fontsize=9, color="#b04020")
-    for y0, y1 in zip(ys[:6], ys[1:6]):
+    for y0, y1 in itertools.pairwise(ys[:6]):  # down to the law; the result goes back up
         ax.annotate(
-            "", xy=(x, y1), xytext=(x, y0),
+            "",
+            xy=(x, y1),
+            xytext=(x, y0),
             arrowprops={"arrowstyle": "-|>", "color": "#b04020", "lw": 1.6},
         )
     ax.annotate(  # the result goes back up to studies
-        "", xy=(x - 0.15, ys[1] - 0.1), xytext=(x - 0.15, ys[6]),
+        "",
+        xy=(x - 0.15, ys[1] - 0.1),
+        xytext=(x - 0.15, ys[6]),
         arrowprops={"arrowstyle": "-|>", "color": "#b04020", "lw": 1.0, "ls": "--"},
     )
     top = len(LAYERS) * (height + gap)
-    ax.text(x, top + 0.05, "clearjoint frf examples/frf.toml", fontsize=9,
-            color="#b04020", family="monospace")
+    ax.text(
+        x,
+        top + 0.05,
+        "clearjoint frf examples/frf.toml",
+        fontsize=9,
+        color="#b04020",
+        family="monospace",
+    )
     ax.text(0.0, top + 0.05, "imports point down only", fontsize=9, style="italic")
     ax.set_xlim(-0.1, x + 2.6)
     ax.set_ylim(-0.1, top + 0.35)
