@@ -21,10 +21,10 @@ LAYERS = (
     ("units, checks", "units.py, io_toml.py, checks.py, errors.py"),
     ("laws", "laws/clearance.py: force, tangent, contact state"),
     ("joint, system", "joint.py (Joint, Losses), system.py (VibrationSystem)"),
-    ("exact flow", "exact/: kernel, single, shooting, march"),
-    ("continuation", "continuation.py: pseudo-arclength"),
-    ("solvers", "stiffness, simulate/, periodic, structure/,\nharmonic/, dissipation"),
     ("results", "results/: FrequencyResponse, PeriodicOrbit, Motion, ..."),
+    ("continuation", "continuation.py: pseudo-arclength"),
+    ("exact flow", "exact/: kernel, single, shooting, march"),
+    ("solvers", "stiffness, simulate/, periodic, structure/,\nharmonic/, dissipation"),
     ("records, rig, identify", "records/, rig.py, identify/"),
     ("analysis", "fit, findings, verification"),
     ("studies", "studies/: study file + overrides -> objects -> run"),
@@ -37,11 +37,11 @@ LAYERS = (
 CALL = (
     (12, "cli: parse frf args"),
     (9, "studies: Joint, Losses,\nmethod; write netCDF"),
-    (5, "periodic.frequency_response"),
-    (4, "continue_branch"),
-    (3, "shooting, kernel"),
+    (6, "periodic.frequency_response"),
+    (5, "shooting, kernel: the exact map"),
+    (4, "continue_branch along it"),
     (1, "clearance law (inlined)"),
-    (6, "FrequencyResponse, back up"),
+    (3, "FrequencyResponse, back up"),
 )
 
 
