@@ -84,3 +84,57 @@ def refuse_to_overwrite(paths: Iterable[Path], *, force: bool, option: str = "--
         raise OutputExistsError(
             f"will not overwrite {named}; choose another {option} or pass --force"
         )
+
+
+#: Figure formats a ``--plot`` file may take (matplotlib picks the format from the suffix).
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+def figure_target(text: str, option: str, *, force: bool) -> Path:
+    """Return the figure file ``text`` named by ``option``, checked before any work.
+
+    It must end in one of :data:`FIGURE_SUFFIXES`, must not be a folder, and is not
+    overwritten unless ``force``.
+    """
+    path = Path(text)
+    if path.suffix.lower() not in FIGURE_SUFFIXES:
+        raise ParameterError(
+            f"{option} must end in {', '.join(FIGURE_SUFFIXES)}, got {path.name!r}; "
+            f"e.g. {option} result.png"
+        )
+    if path.is_dir():
+        raise ParameterError(
+            f"{option} {path} is a folder; give a file name such as {path}/plot.png"
+        )
+    if path.exists() and not force:
+        raise OutputExistsError(
+            f"will not overwrite {path}; choose another {option} file or pass --force"
+        )
+    return path
+
+
+def netcdf_target(text: str, command: str, *, force: bool, example: str = "") -> Path:
+    """Return the netCDF ``--out`` file ``text`` of ``command``: a .nc name, not overwritten.
+
+    ``example`` is the file name the message suggests (default ``{command}.nc``).
+    """
+    path = Path(text)
+    if path.suffix.lower() != ".nc":
+        raise ParameterError(
+            f"--out {text}: {command} writes netCDF; name the file .nc, "
+            f"e.g. {example or command + '.nc'}"
+        )
+    refuse_to_overwrite([path], force=force)
+    return path
+
+
+def refuse_file_as_folder(path: str | Path, option: str) -> None:
+    """Raise ParameterError if the output folder ``path`` is, or lies under, a file.
+
+    Checked before the work, so that it is not lost at the first write.
+    """
+    for folder in (Path(path), *Path(path).parents):
+        if folder.exists():
+            if not folder.is_dir():
+                raise ParameterError(f"{option} {path}: {folder} is a file; give a folder")
+            return

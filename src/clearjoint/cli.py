@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import json
 import logging
 import math
@@ -25,7 +26,8 @@ from typing import Any, NoReturn
 import numpy as np
 
 from clearjoint import __version__
-from clearjoint.errors import ClearjointError, OutputExistsError, ParameterError
+from clearjoint.checks import figure_target, netcdf_target, refuse_file_as_folder
+from clearjoint.errors import ClearjointError, ParameterError
 
 EXIT_BAD_INPUT = 2
 
@@ -40,6 +42,24 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
 
 
+def _flags(p: argparse.ArgumentParser, **helps: str) -> None:
+    """Add an on/off option ``--NAME`` (``_`` written ``-``) for each keyword, with its help."""
+    for name, text in helps.items():
+        p.add_argument(f"--{name.replace('_', '-')}", action="store_true", help=text)
+
+
+def _options(p: argparse.ArgumentParser, **helps: str) -> None:
+    """Add a text option ``--NAME`` (``_`` written ``-``) for each keyword, with its help."""
+    for name, text in helps.items():
+        p.add_argument(f"--{name.replace('_', '-')}", help=text)
+
+
+def _default(owner: type, name: str, scale: float = 1.0, unit: str = "") -> str:
+    """The default of dataclass field ``owner.name`` in ``--help``, e.g. ``(default 206GPa)``."""
+    value = next(f.default for f in dataclasses.fields(owner) if f.name == name)
+    return f"(default {value / scale:g}{unit})"
+
+
 def _stiffness_parser(sub: Any) -> None:
     p = sub.add_parser(
         "stiffness",
@@ -52,28 +72,36 @@ def _stiffness_parser(sub: Any) -> None:
         ),
     )
     _add_joint_options(p, required=True)
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    _flags(p, json=_JSON_TABLE)
     _add_plot_option(p, force=True)
 
 
+_JSON_TABLE = "print one JSON object instead of a table"
+_JOBS = "processes (default: every core)"
+
+
 def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
+    from clearjoint.joint import Joint
+
     p.add_argument("--mass", required=required, help="moving mass, e.g. 2kg")
     p.add_argument(
         "--stiffness", required=required, help="compression contact stiffness, e.g. 8e7N/m"
     )
-    p.add_argument(
-        "--tension-stiffness",
-        help="tension contact stiffness (default: the study's, or --stiffness)",
+    _options(
+        p,
+        tension_stiffness="tension contact stiffness (default: the study's, or --stiffness)",
+        gap_stiffness=f"stiffness inside the gap k0 {_default(Joint, 'gap_stiffness')}",
     )
-    p.add_argument("--gap-stiffness", help="stiffness inside the gap k0 (default 0)")
     p.add_argument("--clearance", required=required, help="total axial clearance, e.g. 0.106mm")
-    p.add_argument("--gap-offset", help="offset of the gap centre (default 0)")
+    _options(p, gap_offset=f"offset of the gap centre {_default(Joint, 'gap_offset')}")
     p.add_argument(
         "--amplitude", required=True, help="penetration(s) beyond the gap edge, e.g. 1um,5um,20um"
     )
 
 
 def _dissipation_parser(sub: Any) -> None:
+    from clearjoint.joint import Losses, Pin
+
     p = sub.add_parser(
         "dissipation",
         help="energy dissipated per cycle by each mechanism (MODEL.md sec. 2)",
@@ -86,18 +114,25 @@ def _dissipation_parser(sub: Any) -> None:
     )
     p.add_argument("--study", help="take the joint, losses and pin from this study TOML")
     _add_joint_options(p, required=False)
-    p.add_argument("--friction-coefficient", help="sliding-friction coefficient mu_s")
-    p.add_argument("--lateral-load", help="lateral load P, e.g. 300N")
+    _options(
+        p,
+        friction_coefficient="sliding-friction coefficient mu_s",
+        lateral_load="lateral load P, e.g. 300N",
+    )
     p.add_argument("--friction-region", choices=["everywhere", "free-play"])
-    p.add_argument("--restitution", help="coefficient of restitution e (default 1)")
-    p.add_argument("--damping-ratio", help="viscous damping ratio of the linear part")
-    p.add_argument("--pin-radius", help="pin radius, e.g. 5mm (gives a pin)")
-    p.add_argument("--pin-length", help="pin contact length, e.g. 25mm")
-    p.add_argument("--hole-radius", help="hole radius (default: pin radius + clearance/2)")
-    p.add_argument("--youngs-modulus", help="Young's modulus of pin and hole (default 206GPa)")
-    p.add_argument("--poisson-ratio", help="Poisson's ratio of pin and hole (default 0.3)")
-    p.add_argument("--contact-friction-coefficient", help="friction coefficient on the pin mu_c")
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    _options(
+        p,
+        restitution=f"coefficient of restitution e {_default(Losses, 'restitution')}",
+        damping_ratio="viscous damping ratio of the linear part",
+        pin_radius="pin radius, e.g. 5mm (gives a pin)",
+        pin_length="pin contact length, e.g. 25mm",
+        hole_radius="hole radius (default: pin radius + clearance/2)",
+        youngs_modulus="Young's modulus of pin and hole "
+        + _default(Pin, "youngs_modulus", 1e9, "GPa"),
+        poisson_ratio=f"Poisson's ratio of pin and hole {_default(Pin, 'poisson_ratio')}",
+        contact_friction_coefficient="friction coefficient on the pin mu_c",
+    )
+    _flags(p, json=_JSON_TABLE)
     _add_plot_option(p, force=True)
 
 
@@ -115,14 +150,14 @@ def _reproduce_parser(sub: Any) -> None:
     )
     p.add_argument("--out", default="clearjoint-reproduction", help="output folder")
     p.add_argument("--campaign", help="campaign file (TOML); default: the shipped one")
-    p.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
+    p.add_argument("--jobs", type=int, default=None, help=_JOBS)
     p.add_argument(
         "--scheduler",
         help="run the rig's tests on a running Dask scheduler, e.g. tcp://host:8786 "
         "(its workers must see --out)",
     )
     p.add_argument("--workers", type=int, help="run them on a local Dask cluster of N workers")
-    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    _flags(p, force="overwrite existing output files")
 
 
 def _report_parser(sub: Any) -> None:
@@ -136,7 +171,7 @@ def _report_parser(sub: Any) -> None:
     )
     p.add_argument("--records", required=True, help="folder of record files")
     p.add_argument("--out", default="clearjoint-report", help="output folder")
-    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    _flags(p, force="overwrite existing output files")
 
 
 def _simulate_parser(sub: Any) -> None:
@@ -150,11 +185,12 @@ def _simulate_parser(sub: Any) -> None:
         ),
     )
     p.add_argument("study", help="study file (TOML)")
-    p.add_argument(
-        "--out", help="write the motion as a test record to this netCDF file (.nc; see records)"
+    _options(p, out="write the motion as a test record to this netCDF file (.nc; see records)")
+    _flags(
+        p,
+        json="print the summary as one JSON object",
+        force="overwrite --out or --plot if it exists",
     )
-    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
-    p.add_argument("--force", action="store_true", help="overwrite --out or --plot if it exists")
     _add_plot_option(p, force=False)
 
 
@@ -170,9 +206,8 @@ def _rig_parser(sub: Any) -> None:
     )
     p.add_argument("campaign", nargs="?", help="campaign file (TOML); default: the shipped one")
     p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--jobs", type=int, default=None, help="processes (default: every core)")
-    p.add_argument("--force", action="store_true", help="overwrite existing records")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--jobs", type=int, default=None, help=_JOBS)
+    _flags(p, force="overwrite existing records", quiet="no progress bar")
 
 
 def _identify_parser(sub: Any) -> None:
@@ -189,7 +224,7 @@ def _identify_parser(sub: Any) -> None:
     )
     p.add_argument("files", nargs="+", help="record files")
     p.add_argument("--out", required=True, help="results file, .csv or .nc")
-    p.add_argument("--figures", help="write two figures per test into this folder")
+    _options(p, figures="write two figures per test into this folder")
     p.add_argument(
         "--plot",
         metavar="FILE.png",
@@ -198,17 +233,14 @@ def _identify_parser(sub: Any) -> None:
     p.add_argument(
         "--jobs", type=int, default=1, help="processes over the files (default 1; same results)"
     )
-    p.add_argument(
-        "--resample", action="store_true", help="interpolate records that are not uniformly sampled"
-    )
+    _flags(p, resample="interpolate records that are not uniformly sampled")
     p.add_argument(
         "--tolerance",
         type=float,
         default=0.03,
         help="steady-cycle amplitude tolerance (default 0.03)",
     )
-    p.add_argument("--force", action="store_true", help="overwrite existing output and --plot")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _flags(p, force="overwrite existing output and --plot", quiet="no progress bar")
 
 
 def _frf_parser(sub: Any) -> None:
@@ -229,27 +261,29 @@ def _frf_parser(sub: Any) -> None:
     p.add_argument("--to", dest="stop", required=True, help="end: 900Hz (or 2kN)")
     p.add_argument("--out", required=True, help="write the curve to this netCDF file (.nc)")
     _add_plot_option(p, force=False)
-    p.add_argument("--json", action="store_true", help="print the curve as one JSON object")
+    _flags(p, json="print the curve as one JSON object")
     p.add_argument(
         "--parameter",
         choices=["frequency", "force"],
         default="frequency",
         help="what varies along the curve (default frequency)",
     )
-    p.add_argument("--frequency", help="fixed frequency with --parameter force, e.g. 400Hz")
+    _options(p, frequency="fixed frequency with --parameter force, e.g. 400Hz")
     p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
-    p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
+    _flags(p, force="overwrite --out / --plot if they exist")
     p.add_argument(
         "--method",
         choices=["shooting", "harmonic"],
         default="shooting",
         help="exact shooting (default) or harmonic balance (clearjoint.harmonic)",
     )
-    p.add_argument("--harmonics", type=int, help="H with --method harmonic (default 7)")
-    _add_samples_option(p)
+    _add_harmonic_options(p, "H with --method harmonic")
 
 
-def _add_samples_option(p: argparse.ArgumentParser) -> None:
+def _add_harmonic_options(p: argparse.ArgumentParser, harmonics: str) -> None:
+    # 7 is studies.rules.DEFAULT_HARMONICS, typed here: importing the study layer at
+    # parser build would import every solver
+    p.add_argument("--harmonics", type=int, help=f"{harmonics} (default 7)")
     p.add_argument(
         "--samples",
         type=int,
@@ -258,42 +292,17 @@ def _add_samples_option(p: argparse.ArgumentParser) -> None:
     )
 
 
-#: Figure formats ``--plot`` writes (matplotlib picks the format from the suffix).
-PLOT_SUFFIXES = (".png", ".pdf", ".svg")
-
-
 def _add_plot_option(p: argparse.ArgumentParser, *, force: bool) -> None:
     p.add_argument(
         "--plot", metavar="FILE.png", help="draw the result into this figure (.png, .pdf or .svg)"
     )
     if force:
-        p.add_argument("--force", action="store_true", help="overwrite --plot if it exists")
+        _flags(p, force="overwrite --plot if it exists")
 
 
 def _plot_target(args: argparse.Namespace) -> Path | None:
     """The --plot file, checked before any work: a figure suffix, not overwritten unasked."""
-    if args.plot is None:
-        return None
-    return _figure_target(args.plot, "--plot", force=args.force)
-
-
-def _figure_target(text: str, option: str, *, force: bool) -> Path:
-    """A figure file named by ``option``: a figure suffix, not a folder, not overwritten unasked."""
-    path = Path(text)
-    if path.suffix.lower() not in PLOT_SUFFIXES:
-        raise ParameterError(
-            f"{option} must end in {', '.join(PLOT_SUFFIXES)}, got {path.name!r}; "
-            f"e.g. {option} result.png"
-        )
-    if path.is_dir():
-        raise ParameterError(
-            f"{option} {path} is a folder; give a file name such as {path}/plot.png"
-        )
-    if path.exists() and not force:
-        raise OutputExistsError(
-            f"will not overwrite {path}; choose another {option} file or pass --force"
-        )
-    return path
+    return None if args.plot is None else figure_target(args.plot, "--plot", force=args.force)
 
 
 def _save_plot(result: Any, path: Path | None, *, quiet: bool) -> None:
@@ -317,16 +326,7 @@ def _save_figure(fig: Any, path: Path, *, quiet: bool) -> None:
 
 def _netcdf_target(args: argparse.Namespace) -> Path:
     """The --out netCDF file, checked before any work: a .nc suffix, not overwritten unasked."""
-    from clearjoint.checks import refuse_to_overwrite
-
-    path = Path(args.out)
-    if path.suffix.lower() != ".nc":
-        raise ParameterError(
-            f"--out {args.out}: {args.command} writes netCDF; name the file .nc, "
-            f"e.g. {args.command}.nc"
-        )
-    refuse_to_overwrite([path], force=args.force)
-    return path
+    return netcdf_target(args.out, args.command, force=args.force)
 
 
 def _sweep_parser(sub: Any) -> None:
@@ -341,12 +341,18 @@ def _sweep_parser(sub: Any) -> None:
         ),
     )
     p.add_argument("sweep", nargs="?", help="sweep file (TOML)")
-    p.add_argument("--out", help="zarr store to write (.zarr); with --plot, the PNG")
-    p.add_argument("--scheduler", help="a running Dask scheduler, e.g. tcp://host:8786")
+    _options(
+        p,
+        out="zarr store to write (.zarr); with --plot, the PNG",
+        scheduler="a running Dask scheduler, e.g. tcp://host:8786",
+    )
     p.add_argument("--workers", type=int, help="local cluster's worker processes (default: cores)")
-    p.add_argument("--resume", action="store_true", help="finish an interrupted --out store")
-    p.add_argument("--force", action="store_true", help="replace an existing --out")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _flags(
+        p,
+        resume="finish an interrupted --out store",
+        force="replace an existing --out",
+        quiet="no progress bar",
+    )
     p.add_argument("--plot", nargs=2, metavar=("STORE", "VAR"), help="draw VAR of a store")
 
 
@@ -368,12 +374,14 @@ def _modes_parser(sub: Any) -> None:
         "--amplitude", required=True, help="modal amplitude range, e.g. 1um..1mm (or one value)"
     )
     p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
-    p.add_argument("--harmonics", type=int, help="H (default 7)")
-    _add_samples_option(p)
+    _add_harmonic_options(p, "H")
     p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
     _add_plot_option(p, force=False)
-    p.add_argument("--json", action="store_true", help="print the mode as one JSON object")
-    p.add_argument("--force", action="store_true", help="overwrite --out / --plot if they exist")
+    _flags(
+        p,
+        json="print the mode as one JSON object",
+        force="overwrite --out / --plot if they exist",
+    )
 
 
 def _structure_parser(sub: Any) -> None:
@@ -390,8 +398,7 @@ def _structure_parser(sub: Any) -> None:
     p.add_argument("task", choices=("modes", "respond", "decay"), help="what to compute")
     p.add_argument("--out", required=True, help="netCDF results file (.nc)")
     _add_plot_option(p, force=False)
-    p.add_argument("--json", action="store_true", help="print a JSON summary")
-    p.add_argument("--force", action="store_true", help="overwrite existing output")
+    _flags(p, json="print a JSON summary", force="overwrite existing output")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -399,17 +406,20 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
     parser.add_argument("--version", action="version", version=f"clearjoint {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    _stiffness_parser(sub)
-    _simulate_parser(sub)
-    _dissipation_parser(sub)
-    _rig_parser(sub)
-    _identify_parser(sub)
-    _reproduce_parser(sub)
-    _report_parser(sub)
-    _frf_parser(sub)
-    _sweep_parser(sub)
-    _modes_parser(sub)
-    _structure_parser(sub)
+    for add in (
+        _stiffness_parser,
+        _simulate_parser,
+        _dissipation_parser,
+        _rig_parser,
+        _identify_parser,
+        _reproduce_parser,
+        _report_parser,
+        _frf_parser,
+        _sweep_parser,
+        _modes_parser,
+        _structure_parser,
+    ):
+        add(sub)
     return parser
 
 
@@ -502,15 +512,9 @@ def _run_simulate(args: argparse.Namespace) -> int:
     from clearjoint.studies.text import simulation_lines
 
     study = load_study(args.study)
-    if args.out:
-        from clearjoint.checks import refuse_to_overwrite
-
-        if Path(args.out).suffix.lower() != ".nc":
-            raise ParameterError(
-                f"--out {args.out}: simulate writes netCDF; name the file .nc, e.g. result.nc"
-            )
-        refuse_to_overwrite([Path(args.out)], force=args.force)  # before the run, not after
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    if args.out:  # before the run, not after
+        out = netcdf_target(args.out, "simulate", force=args.force, example="result.nc")
+        out.parent.mkdir(parents=True, exist_ok=True)
     plot = _plot_target(args)
     motion = run_study(study)
     _save_plot(motion, plot, quiet=args.json)
@@ -539,7 +543,7 @@ def _run_rig(args: argparse.Namespace) -> int:
     from clearjoint.rig import load_campaign, run_campaign
 
     campaign = load_campaign(args.campaign)
-    _refuse_file_as_folder(args.out, "--out")
+    refuse_file_as_folder(args.out, "--out")
     jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
@@ -577,7 +581,7 @@ def _run_identify(args: argparse.Namespace) -> int:
     options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
 
     if args.figures:
-        _refuse_file_as_folder(args.figures, "--figures")
+        refuse_file_as_folder(args.figures, "--figures")
     if args.quiet:
         results, failures = identify_files(args.files, **options)
     else:
@@ -611,26 +615,18 @@ def _run_identify(args: argparse.Namespace) -> int:
 
 
 def _run_reproduce(args: argparse.Namespace) -> int:
-    import contextlib
     import time
 
-    from clearjoint.parallel import dask_client
+    from clearjoint.parallel import optional_client
     from clearjoint.reproduction import reproduce
 
-    if args.scheduler and args.workers is not None:
-        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
     if args.jobs is not None and (args.scheduler or args.workers is not None):
         raise ParameterError(
             "--jobs sizes a process pool; leave it out with --scheduler or --workers"
         )
-    _refuse_file_as_folder(args.out, "--out")
+    refuse_file_as_folder(args.out, "--out")
     start = time.perf_counter()
-    with contextlib.ExitStack() as stack:
-        client = None  # the process pool of --jobs
-        if args.scheduler:  # an unreachable scheduler is said first, within seconds
-            client = stack.enter_context(dask_client(args.scheduler))
-        elif args.workers is not None:
-            client = stack.enter_context(dask_client(workers=args.workers))
+    with optional_client(args.scheduler, args.workers) as client:  # None: the --jobs pool
         written = reproduce(
             Path(args.out),
             force=args.force,
@@ -668,7 +664,7 @@ def _run_report(args: argparse.Namespace) -> int:
         raise RecordError(f"{folder}: no such folder; give --records a folder of record files")
     if not folder.is_dir():
         raise RecordError(f"{folder}: not a folder; give --records a folder of record files")
-    _refuse_file_as_folder(args.out, "--out")
+    refuse_file_as_folder(args.out, "--out")
     written = report_records(
         Path(args.records),
         Path(args.out),
@@ -718,56 +714,36 @@ def _warning_printer(command: str) -> Callable[..., None]:
 
 
 def _run_sweep(args: argparse.Namespace) -> int:
-    import contextlib
     import time
 
     if args.plot:
         return _plot_sweep(args)
-    from clearjoint.parallel import dask_client
-    from clearjoint.sweep import Sweep, run_sweep
+    from clearjoint.sweep.run import run_sweep_file
 
     if args.sweep is None or args.out is None:
         raise ParameterError("give a sweep file and --out results.zarr (or --plot STORE VAR)")
-    if Path(args.out).suffix != ".zarr":
-        raise ParameterError(f"--out must end in .zarr, got {args.out!r}")
-    if args.scheduler and args.workers is not None:
-        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
-    if Path(args.out).exists() and not (args.resume or args.force):
-        raise OutputExistsError(
-            f"will not overwrite {args.out}; pass --resume to finish it, --force to start "
-            "again, or choose another --out"
-        )
     start = time.perf_counter()
     with contextlib.ExitStack() as stack:
-        if args.scheduler:  # an unreachable scheduler is said first, within seconds
-            client = stack.enter_context(dask_client(args.scheduler))
-        sweep = Sweep.from_toml(args.sweep)
-        if not args.scheduler:  # a bad sweep file is said before a cluster starts
-            client = stack.enter_context(dask_client(workers=args.workers))
-        already: list[int] = []  # points found in the store on --resume
-        bar: Any = None
-        if not args.quiet and sys.stderr.isatty():
+
+        def bar(sweep: Any) -> Callable[[int, int], None] | None:
+            if args.quiet or not sys.stderr.isatty():
+                return None
             from rich.progress import Progress, TimeRemainingColumn
 
-            bar = stack.enter_context(
-                _progress_bar(*Progress.get_default_columns()[:-1], TimeRemainingColumn())
-            )
-            task = bar.add_task(f"{sweep.n_points} points", total=sweep.n_points)
-
-        def progress(done: int, _total: int) -> None:
-            if not already:
-                already.append(done)
-            if bar is not None:
-                bar.update(task, completed=done)
+            columns = (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
+            shown = stack.enter_context(_progress_bar(*columns))
+            task = shown.add_task(f"{sweep.n_points} points", total=sweep.n_points)
+            return lambda done, _total: shown.update(task, completed=done)
 
         try:
-            results = run_sweep(
-                sweep,
-                client=client,
-                out=args.out,
+            results, kept = run_sweep_file(
+                args.sweep,
+                args.out,
+                scheduler=args.scheduler,
+                workers=args.workers,
                 resume=args.resume,
                 force=args.force,
-                progress=progress,
+                progress=bar,
             )
         except KeyboardInterrupt:
             print(
@@ -777,9 +753,9 @@ def _run_sweep(args: argparse.Namespace) -> int:
             )
             return 130
     failed = results.attrs["points_failed"]
-    kept = f", {already[0]} of them kept from the store" if already and already[0] else ""
+    kept_text = f", {kept} of them kept from the store" if kept else ""
     print(
-        f"wrote {results.attrs['points']} points{kept} ({failed} failed: see `status`) "
+        f"wrote {results.attrs['points']} points{kept_text} ({failed} failed: see `status`) "
         f"to {args.out} in {time.perf_counter() - start:.1f} s"
     )
     return 0
@@ -793,49 +769,11 @@ def _plot_sweep(args: argparse.Namespace) -> int:
     if args.sweep is not None:
         raise ParameterError("--plot STORE VAR takes no sweep file")
     default = Path(store).with_name(f"{Path(store).stem}_{variable}.png")
-    out = _figure_target(args.out or str(default), "--out", force=args.force)  # the picture
+    out = figure_target(args.out or str(default), "--out", force=args.force)  # the picture
     ax = plot_sweep(open_sweep(store), variable)
     ax.figure.savefig(out, dpi=110)
     print(f"wrote {out}")
     return 0
-
-
-def _refuse_file_as_folder(path: str, option: str) -> None:
-    """Refuse an output folder that is (or lies under) a file, before the work, not after it."""
-    for folder in (Path(path), *Path(path).parents):
-        if folder.exists():
-            if not folder.is_dir():
-                raise ParameterError(f"{option} {path}: {folder} is a file; give a folder")
-            return
-
-
-def _amplitude_range(text: str, points: int) -> Any:
-    """'1um..1mm' -> ``points`` values spaced logarithmically (m); one value -> itself."""
-    import numpy as np
-
-    from clearjoint.units import parse_quantity
-
-    if points < 1:
-        raise ParameterError(f"--points must be >= 1, got {points}")
-    parts = text.split("..")
-    if len(parts) > 2:
-        raise ParameterError(f"--amplitude: write a range like 1um..1mm, got {text!r}")
-    values = [parse_quantity(part, "length", name="--amplitude") for part in parts]
-    if any(not value > 0.0 for value in values):
-        raise ParameterError(
-            f"--amplitude must start above zero (a mode has no amplitude 0), got {text!r}; "
-            "write it like 1um..1mm"
-        )
-    if len(values) == 1:
-        return np.array(values)
-    if values[0] == values[1]:
-        raise ParameterError(f"--amplitude range {text!r} has zero width; give two values")
-    if values[0] > values[1]:
-        raise ParameterError(
-            f"--amplitude range {text!r} runs downwards; write it from the smaller amplitude "
-            f"to the larger, {parts[1].strip()}..{parts[0].strip()}"
-        )
-    return np.geomspace(values[0], values[1], points)
 
 
 def _run_frf(args: argparse.Namespace) -> int:
@@ -906,11 +844,12 @@ def _run_frf(args: argparse.Namespace) -> int:
 
 def _run_modes(args: argparse.Namespace) -> int:
     from clearjoint.studies import load_any_study, mode_summary, nonlinear_modes_of, write_curve
+    from clearjoint.units import parse_amplitude_range
 
     study = load_any_study(args.study)
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
-    amplitudes = _amplitude_range(args.amplitude, args.points)
+    amplitudes = parse_amplitude_range(args.amplitude, args.points)
     mode = nonlinear_modes_of(
         study, args.mode, amplitudes, harmonics=args.harmonics, samples=args.samples, names=_NAMES
     )

@@ -313,6 +313,28 @@ def dask_client(
         yield client
 
 
+@contextlib.contextmanager
+def optional_client(
+    scheduler: str | None = None, workers: int | None = None
+) -> Iterator[Client | None]:
+    """Yield a Dask client to ``scheduler``, or to a LocalCluster of ``workers``, or None.
+
+    None (neither given) leaves the work to the caller's own process pool. Both given is
+    refused: ``workers`` sizes a local cluster only. An unreachable scheduler is said
+    within seconds (see :func:`dask_client`).
+    """
+    if scheduler and workers is not None:
+        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    if scheduler:
+        with dask_client(scheduler) as client:
+            yield client
+    elif workers is not None:
+        with dask_client(workers=workers) as client:
+            yield client
+    else:
+        yield None
+
+
 # ---- the result store ------------------------------------------------------------------------
 
 _FINGERPRINT = "clearjoint_sweep_fingerprint"

@@ -268,3 +268,32 @@ def to_si(value: Any, unit: str, *, name: str) -> Any:
             magnitude = _convert(value, kind, name, raw)
         return float(magnitude) if np.ndim(magnitude) == 0 else np.asarray(magnitude, float)
     return value
+
+
+def parse_amplitude_range(text: str, points: int, *, name: str = "--amplitude") -> Any:
+    """Return ``points`` lengths (m) spaced logarithmically over a range like ``1um..1mm``.
+
+    One value (``20um``) gives itself. The range must start above zero (a mode has no
+    amplitude 0), have a width and run upwards; ``points`` must be >= 1 (``--points``).
+    """
+    if points < 1:
+        raise ParameterError(f"--points must be >= 1, got {points}")
+    parts = text.split("..")
+    if len(parts) > 2:
+        raise ParameterError(f"{name}: write a range like 1um..1mm, got {text!r}")
+    values = [parse_quantity(part, "length", name=name) for part in parts]
+    if any(not value > 0.0 for value in values):
+        raise ParameterError(
+            f"{name} must start above zero (a mode has no amplitude 0), got {text!r}; "
+            "write it like 1um..1mm"
+        )
+    if len(values) == 1:
+        return np.array(values)
+    if values[0] == values[1]:
+        raise ParameterError(f"{name} range {text!r} has zero width; give two values")
+    if values[0] > values[1]:
+        raise ParameterError(
+            f"{name} range {text!r} runs downwards; write it from the smaller amplitude "
+            f"to the larger, {parts[1].strip()}..{parts[0].strip()}"
+        )
+    return np.geomspace(values[0], values[1], points)

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from clearjoint.errors import OutputExistsError, ParameterError
 from clearjoint.parallel import (
     ChunkFailedError,
     ResultStore,
@@ -38,6 +39,7 @@ __all__ = [
     "SERIAL",
     "open_sweep",
     "run_sweep",
+    "run_sweep_file",
 ]
 
 #: Pass as ``client`` to run every chunk in this process, one after the other.
@@ -279,6 +281,78 @@ def run_sweep(
             array = np.concatenate([in_memory[i][var.name] for i in range(len(bounds))])
         flat[var.name] = (array, dict(var.attrs))
     return _dataset(flat, {**_attrs(sweep), "clearjoint_sweep_fingerprint": sweep.fingerprint})
+
+
+def run_sweep_file(
+    path: str | Path,
+    out: str | Path,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    resume: bool = False,
+    force: bool = False,
+    progress: Callable[[Sweep], Callable[[int, int], None] | None] | None = None,
+) -> tuple[Any, int]:
+    """Return the results of the sweep file ``path`` run into the zarr store ``out``.
+
+    The command line's run (``clearjoint sweep``): on the running Dask ``scheduler``,
+    probed before the sweep file is read so an unreachable one is said first, or on a
+    LocalCluster of ``workers`` started after it is read so a bad file is said before
+    a cluster starts. See :func:`run_sweep` for ``resume`` and ``force``.
+
+    Parameters
+    ----------
+    path : path
+        Sweep file (TOML).
+    out : path
+        Zarr store to write, ending in ``.zarr``.
+    scheduler : str, optional
+        Address of a running scheduler, e.g. ``tcp://host:8786``.
+    workers : int, optional
+        Worker processes of the local cluster (default: one per core); not with
+        ``scheduler``.
+    resume, force : bool
+        As for :func:`run_sweep`.
+    progress : callable, optional
+        Called with the loaded Sweep; returns the ``progress(done, total)`` callback
+        of :func:`run_sweep` (or None).
+
+    Returns
+    -------
+    results : xarray.Dataset
+        As :func:`run_sweep` returns them.
+    kept : int
+        Points found already done in the store (with ``resume``).
+    """
+    if Path(out).suffix != ".zarr":
+        raise ParameterError(f"--out must end in .zarr, got {str(out)!r}")
+    if scheduler and workers is not None:
+        raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    if Path(out).exists() and not (resume or force):
+        raise OutputExistsError(
+            f"will not overwrite {out}; pass --resume to finish it, --force to start "
+            "again, or choose another --out"
+        )
+    already: list[int] = []  # points found in the store on resume
+
+    with contextlib.ExitStack() as stack:
+        if scheduler:  # an unreachable scheduler is said first, within seconds
+            client = stack.enter_context(dask_client(scheduler))
+        sweep = Sweep.from_toml(path)
+        if not scheduler:  # a bad sweep file is said before a cluster starts
+            client = stack.enter_context(dask_client(workers=workers))
+        report = progress(sweep) if progress is not None else None
+
+        def on_progress(done: int, total: int) -> None:
+            if not already:
+                already.append(done)
+            if report is not None:
+                report(done, total)
+
+        results = run_sweep(
+            sweep, client=client, out=out, resume=resume, force=force, progress=on_progress
+        )
+    return results, already[0] if already else 0
 
 
 def _dataset(
