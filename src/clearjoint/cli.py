@@ -57,6 +57,7 @@ def _options(p: argparse.ArgumentParser, **helps: str) -> None:
 def _default(owner: type, name: str, scale: float = 1.0, unit: str = "") -> str:
     """The default of dataclass field ``owner.name`` in ``--help``, e.g. ``(default 206GPa)``."""
     value = next(f.default for f in dataclasses.fields(owner) if f.name == name)
+    assert isinstance(value, int | float), f"{owner.__name__}.{name} has no number default"
     return f"(default {value / scale:g}{unit})"
 
 
