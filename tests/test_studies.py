@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -157,3 +159,17 @@ def test_too_few_samples_alias_and_are_refused() -> None:
     assert checked_samples(30, 7) == 30
     with pytest.raises(ParameterError, match="at least 2 \\(2H \\+ 1\\) = 30"):
         checked_samples(29, 7, {"samples": "--samples", "harmonics": "--harmonics"})
+
+
+def test_the_identify_command_loads_no_solver() -> None:
+    # the study layer's package imports each name on first use: identify's start-up stays
+    # free of numba, scipy and the solvers behind the other studies
+    script = (
+        "import sys, clearjoint.cli, clearjoint.studies.identify\n"
+        "print(sorted(m for m in ('numba', 'scipy', 'clearjoint.structure', "
+        "'clearjoint.periodic') if m in sys.modules))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    assert done.stdout.strip() == "[]"

@@ -19,32 +19,43 @@ written once:
 
 from __future__ import annotations
 
-from clearjoint.studies.curves import (
-    curve_summary,
-    frequency_response_of,
-    load_any_study,
-    mode_summary,
-    name_dofs,
-    nonlinear_modes_of,
-    write_curve,
-)
-from clearjoint.studies.harmonic import (
-    checked_samples,
-    refuse_harmonic_losses,
-    refuse_harmonic_structure,
-)
-from clearjoint.studies.joint_study import (
-    DEFAULT_STUDY,
-    Study,
-    StudyError,
-    load_study,
-    run_study,
-    summary,
-    write_netcdf,
-)
-from clearjoint.studies.overrides import joint_at, losses_at, pin_at, structure_at, study_at
-from clearjoint.studies.rules import DEFAULT_HARMONICS, hole_radius, tension_follows
-from clearjoint.studies.structure import STRUCTURE_TASKS, StructureTaskResult, run_structure_task
+import importlib
+from typing import Any
+
+# Each name is imported from its module on first use (PEP 562), so that importing one
+# module of the layer (say studies.identify, for the identify command) does not load every
+# solver behind the others.
+_HOMES = {
+    "DEFAULT_HARMONICS": "rules",
+    "DEFAULT_STUDY": "joint_study",
+    "STRUCTURE_TASKS": "structure",
+    "StructureTaskResult": "structure",
+    "Study": "joint_study",
+    "StudyError": "joint_study",
+    "checked_samples": "harmonic",
+    "curve_summary": "curves",
+    "frequency_response_of": "curves",
+    "hole_radius": "rules",
+    "joint_at": "overrides",
+    "load_any_study": "curves",
+    "load_study": "joint_study",
+    "losses_at": "overrides",
+    "mode_summary": "curves",
+    "name_dofs": "curves",
+    "nonlinear_modes_of": "curves",
+    "pin_at": "overrides",
+    "refuse_harmonic_losses": "harmonic",
+    "refuse_harmonic_structure": "harmonic",
+    "run_structure_task": "structure",
+    "run_study": "joint_study",
+    "structure_at": "overrides",
+    "study_at": "overrides",
+    "summary": "joint_study",
+    "tension_follows": "rules",
+    "write_curve": "curves",
+    "write_netcdf": "joint_study",
+}
+
 
 __all__ = [
     "DEFAULT_HARMONICS",
@@ -76,3 +87,16 @@ __all__ = [
     "write_curve",
     "write_netcdf",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Import ``name`` from the module of the study layer that defines it."""
+    if name not in _HOMES:
+        raise AttributeError(f"module 'clearjoint.studies' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"clearjoint.studies.{_HOMES[name]}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
