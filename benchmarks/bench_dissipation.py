@@ -16,7 +16,7 @@ import warnings
 
 import numpy as np
 
-from clearjoint import Friction, Joint, Pin
+from clearjoint import Friction, Joint, Losses, Pin
 from clearjoint import dissipation as ds
 from clearjoint.contact import HertzValidityWarning
 from clearjoint.simulate import SimulationError
@@ -35,7 +35,7 @@ LOSSES = {
 def main(n: int = 10_000) -> None:
     warnings.simplefilter("ignore", HertzValidityWarning)
     omega = 2 * math.pi * 400.0
-    ds.compare(JOINT, 1000.0, omega, **LOSSES)  # type: ignore[arg-type]  # compile first
+    ds.compare(JOINT, 1000.0, omega, losses=Losses(**LOSSES))  # type: ignore[arg-type]  # compile first
     amplitudes = []
     initial = None
     start = time.perf_counter()
@@ -48,7 +48,7 @@ def main(n: int = 10_000) -> None:
                 initial=initial,
                 samples_per_period=64,
                 max_periods=4000,
-                **LOSSES,
+                losses=Losses(**LOSSES),
             )  # type: ignore[arg-type]
         except SimulationError:
             continue
@@ -59,7 +59,7 @@ def main(n: int = 10_000) -> None:
     best = math.inf
     for _ in range(5):
         start = time.perf_counter()
-        ds.energies(JOINT, a, **LOSSES)  # type: ignore[arg-type]
+        ds.energies(JOINT, a, losses=Losses(**LOSSES))  # type: ignore[arg-type]
         best = min(best, time.perf_counter() - start)
     print(
         f"{a.size} amplitudes ({n - a.size} forces gave no periodic orbit), "

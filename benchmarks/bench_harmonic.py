@@ -63,7 +63,7 @@ from typing import Any
 
 import numpy as np
 
-from clearjoint import ClearjointError, Joint
+from clearjoint import ClearjointError, Joint, Losses
 from clearjoint.harmonic import frequency_response
 
 JOINT = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_stiffness=1.0)
@@ -134,7 +134,7 @@ def ours(harmonics: int, samples: int | None, max_step: float) -> tuple[float, f
             1.8,
             harmonics=harmonics,
             samples=samples,
-            damping_ratio=ZETA,
+            losses=Losses(damping_ratio=ZETA),
             max_step=max_step,
         )
         times.append(time.perf_counter() - start)
@@ -565,7 +565,7 @@ def mast_orders(force_n: float, freqs: list[float]) -> None:
     from clearjoint.harmonic.system import build
 
     s, force, dof = _example_at(force_n)
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     n, k_ref = s.n_dof, model.reference_stiffness
     for f in freqs:
         w = 2 * math.pi * f
@@ -627,7 +627,7 @@ def mast_shoot(force_n: float, f: float, iterations: int) -> None:
     from clearjoint.structure import time_response
 
     s, force, dof = _example_at(force_n)
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     n, w = s.n_dof, 2 * math.pi * f
     basis = aft.Basis.make(7, 512)
     coef = _start(model, basis, w, force, model.reference_stiffness).reshape(15, n)
@@ -673,7 +673,7 @@ def hill_sorting() -> None:
     j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
     s = chain([1.0] * 3, [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
     force = np.array([0.0, 0.0, 40.0])
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     n = s.n_dof
     print("3-link chain, largest multiplier: monodromy / strip / centred eigenvector")
     for h in (7, 15):
@@ -717,7 +717,7 @@ def samples_error() -> None:
     from clearjoint.harmonic import aft, solve, system
     from clearjoint.periodic import periodic_orbit
 
-    model = system.from_joint(JOINT, ZETA, None, 1.0)
+    model = system.from_joint(JOINT, Losses(damping_ratio=ZETA))
     omega, force = 1.3, np.array([0.03])
     print(f"x_max error / X against the exact orbit, omega = {omega} rad/s (upper branch):")
     for h in (7, 12):
@@ -738,7 +738,9 @@ def samples_error() -> None:
             if exact is None:
                 x0 = q[0] + q[1::2].sum()
                 v0 = omega * float(np.arange(1, h + 1) @ q[2::2])
-                exact = periodic_orbit(JOINT, 0.03, omega, damping_ratio=ZETA, initial=(x0, v0))
+                exact = periodic_orbit(
+                    JOINT, 0.03, omega, losses=Losses(damping_ratio=ZETA), initial=(x0, v0)
+                )
             top, _ = basis.extremes(q[:, None])
             row.append(f"N_t = {n_t}: {abs(top[0] - exact.x_max) / exact.amplitude:.1e}")
         print(f"  H = {h}: " + ", ".join(row))

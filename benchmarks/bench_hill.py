@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import os
 
+from clearjoint import Losses
+
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
@@ -73,7 +75,7 @@ def _mast_agreement(m: Any, tip: np.ndarray, f0: float, f1: float, max_step: flo
     from clearjoint.harmonic import aft, monodromy
     from clearjoint.harmonic.system import build
 
-    mm = build(m, 0.0, None, 1.0)
+    mm = build(m, None)
     for h in (3, 7, 15):
         fr = frequency_response(
             m,
@@ -127,7 +129,7 @@ def hill_agreement() -> None:
     j = ClearanceJoint(clearance=1e-4, compression_stiffness=1e7, gap_stiffness=1e5)
     s = chain([1.0] * 3, [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
     force = np.array([0.0, 0.0, 40.0])
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     print("3-link chain (tests/test_harmonic_hill.py), 40 N, against the exact monodromy")
     print(f"  H    w rad/s  {head}")
     for h in (3, 7, 15):
@@ -144,7 +146,7 @@ def hill_agreement() -> None:
             )
 
     m = mast(2, joints=ClearanceJoint(1e-4, 1e8, gap_stiffness=1e6), rayleigh=(0, 2e-6))
-    mm = build(m, 0.0, None, 1.0)
+    mm = build(m, None)
     tip = np.zeros(m.n_dof)
     tip[m.dof_names.index("n5x")] = 5.0
     print("2-bay mast (joints 1e-4 m, 1e8 N/m), 5 N at the tip, 40 Hz up, 150 points,")
@@ -169,12 +171,12 @@ def hill_agreement() -> None:
                 f"{_line(ref, i)} | both sortings {took:.1f} s (size {2 * m.n_dof * (2 * hp + 1)})"
             )
 
-    joint_model = build(JOINT, ZETA, None, 1.0)
+    joint_model = build(JOINT, Losses(damping_ratio=ZETA))
     print("one joint (pyHarm's case, 0.03 N, the curve 1.0 to 1.7 rad/s), every 3rd contact")
     print("point against the exact orbit's multipliers (shooting), abs(mu) - 1 > 0.03 there")
     for h in (3, 7, 15, 31):
         curve = frequency_response(
-            JOINT, 0.03, 1.0, 1.7, harmonics=h, damping_ratio=ZETA, max_step=0.1
+            JOINT, 0.03, 1.0, 1.7, harmonics=h, losses=Losses(damping_ratio=ZETA), max_step=0.1
         )
         for name in ("centroid", "imaginary"):
             wrong = 0
@@ -186,7 +188,11 @@ def hill_agreement() -> None:
                 w = float(curve.omega[k])
                 try:
                     exact = periodic_orbit(
-                        JOINT, 0.03, w, damping_ratio=ZETA, initial=curve.initial_state[k]
+                        JOINT,
+                        0.03,
+                        w,
+                        losses=Losses(damping_ratio=ZETA),
+                        initial=curve.initial_state[k],
                     )
                 except Exception:  # no exact orbit near this HB one (low H): skip it
                     continue
@@ -217,15 +223,19 @@ def hill_agreement() -> None:
                 w,
                 1.0001 * w,
                 harmonics=h,
-                damping_ratio=ZETA,
-                friction=rub,
+                losses=Losses(damping_ratio=ZETA, friction=rub),
                 max_points=2,
             )
             exact = periodic_orbit(
-                JOINT, 0.03, w, damping_ratio=ZETA, friction=rub, initial=fr.initial_state[0]
+                JOINT,
+                0.03,
+                w,
+                losses=Losses(damping_ratio=ZETA, friction=rub),
+                initial=fr.initial_state[0],
             )
             ref = np.asarray(exact.multipliers)
-            fm = build(JOINT, ZETA, rub, 1.0, friction_speed(JOINT, w, None))
+            losses = Losses(damping_ratio=ZETA, friction=rub)
+            fm = build(JOINT, losses, friction_speed(JOINT, w, None))
             c, i = _hill_pair(fm, fr.coefficients[0][:, None], w)
             print(
                 f"  {h:2d} {w:8.2f}    {np.max(np.abs(ref)):8.4f} | "

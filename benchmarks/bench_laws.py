@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from clearjoint import fit
+from clearjoint import Losses, fit
 from clearjoint.analysis import analyse
 from clearjoint.identify import identify_files
 from clearjoint.rig import load_campaign, run_campaign, structure_under_test
@@ -51,9 +51,11 @@ def main() -> None:
             joint,
             spec.force_amplitude,
             2 * math.pi * spec.frequency_hz,
-            damping_ratio=rig.damping_ratio,
-            friction=rig.bearing_friction,
-            restitution=rig.restitution,
+            losses=Losses(
+                damping_ratio=rig.damping_ratio,
+                friction=rig.bearing_friction,
+                restitution=rig.restitution,
+            ),
             samples_per_period=16,
         )
         integrated.append(cycle.energy.input / cycle.period_multiple)

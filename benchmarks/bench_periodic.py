@@ -53,7 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
-from clearjoint import Joint
+from clearjoint import Joint, Losses
 from clearjoint.periodic import frequency_response
 from clearjoint.simulate import frequency_sweep, time_response
 
@@ -126,17 +126,23 @@ def best_of(fn, repeat: int = 3, clock=time.perf_counter) -> tuple[float, object
 
 CURVE_CPU_SCRIPT = textwrap.dedent(
     """
-    import math, sys, time
+    import inspect, math, sys, time
+    import clearjoint
     from clearjoint import Joint
     from clearjoint.periodic import frequency_response
     joint = Joint(mass=1.0, clearance=2 * 0.1745, gap_stiffness=1.0,
                   compression_stiffness=3.0, tension_stiffness=3.0)
     zeta = 0.05 / (2.0 * math.sqrt(3.0))
-    frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)  # compile
+    # one Losses value since issue 23; the loose keyword in older trees
+    if "losses" in inspect.signature(frequency_response).parameters:
+        kw = {"losses": clearjoint.Losses(damping_ratio=zeta)}
+    else:
+        kw = {"damping_ratio": zeta}
+    frequency_response(joint, 0.03, 0.05, 1.8, **kw)  # compile
     best = math.inf
     for _ in range(int(sys.argv[1])):
         start = time.process_time()
-        curve = frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)
+        curve = frequency_response(joint, 0.03, 0.05, 1.8, **kw)
         best = min(best, time.process_time() - start)
     print(best, curve.omega.size)
     """
@@ -193,7 +199,7 @@ def count_map_evaluations() -> int:
 
     periodic._map_residual = counting  # type: ignore[assignment]
     try:
-        frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, damping_ratio=ZETA)
+        frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, losses=Losses(damping_ratio=ZETA))
     finally:
         periodic._map_residual = build
     return sum(int(r.evaluations) for r in made)  # type: ignore[attr-defined]
@@ -488,8 +494,12 @@ def stiff_contact() -> None:
         f"stiff contact, k_contact/k0 = 1e8, e = 0.8, F0 = 1, {periods} forcing periods "
         f"(accuracy after {horizon}):"
     )
-    base = time_response(stiff, 1.0, omega, periods * period, restitution=0.8)  # compiles
-    kicked = time_response(stiff, 1.0, omega, periods * period, restitution=0.8, initial=(0, 1e-14))
+    base = time_response(
+        stiff, 1.0, omega, periods * period, losses=Losses(restitution=0.8)
+    )  # compiles
+    kicked = time_response(
+        stiff, 1.0, omega, periods * period, losses=Losses(restitution=0.8), initial=(0, 1e-14)
+    )
     growth = float(np.max(np.abs(np.subtract(base.final_state, kicked.final_state)))) / 1e-14
     print(
         f"  chaotic: a kick of 1e-14 m/s grows {growth:.1e}-fold over {periods} periods, so the "
@@ -497,11 +507,11 @@ def stiff_contact() -> None:
     )
     truth = closed_form_reference(stiff, 1.0, omega, horizon * period, 0.8)
     t_ed, motion = best_of(
-        lambda: time_response(stiff, 1.0, omega, periods * period, restitution=0.8),
+        lambda: time_response(stiff, 1.0, omega, periods * period, losses=Losses(restitution=0.8)),
         repeat=5,
         clock=time.process_time,
     )
-    near = time_response(stiff, 1.0, omega, horizon * period, restitution=0.8)
+    near = time_response(stiff, 1.0, omega, horizon * period, losses=Losses(restitution=0.8))
     err_ed = max(
         abs(near.final_state[0] - truth[0]) / 0.1, abs(near.final_state[1] - truth[1]) / 0.1
     )
@@ -584,12 +594,18 @@ def main() -> None:
         return
 
     print("case: pyHarm SDOF clearance, F0 = 0.03, omega 0.05 -> 1.8 rad/s, c_v = 0.05")
-    frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, damping_ratio=ZETA)  # compile
+    frequency_response(
+        PYHARM_JOINT, F0, W_START, W_STOP, losses=Losses(damping_ratio=ZETA)
+    )  # compile
     t_curve, curve = best_of(
-        lambda: frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, damping_ratio=ZETA)
+        lambda: frequency_response(
+            PYHARM_JOINT, F0, W_START, W_STOP, losses=Losses(damping_ratio=ZETA)
+        )
     )
     cpu_curve = best_cpu(
-        lambda: frequency_response(PYHARM_JOINT, F0, W_START, W_STOP, damping_ratio=ZETA)
+        lambda: frequency_response(
+            PYHARM_JOINT, F0, W_START, W_STOP, losses=Losses(damping_ratio=ZETA)
+        )
     )
     evaluations = count_map_evaluations()
     fr = curve  # type: ignore[assignment]
@@ -603,9 +619,11 @@ def main() -> None:
     print("  " + curve_summary(fr.omega, fr.amplitude))  # type: ignore[attr-defined]
 
     grid = np.sort(fr.omega)  # type: ignore[attr-defined]
-    frequency_sweep(PYHARM_JOINT, F0, grid[:3], direction="up", damping_ratio=ZETA)  # compile
+    frequency_sweep(
+        PYHARM_JOINT, F0, grid[:3], direction="up", losses=Losses(damping_ratio=ZETA)
+    )  # compile
     start = time.perf_counter()
-    up = frequency_sweep(PYHARM_JOINT, F0, grid, direction="up", damping_ratio=ZETA)
+    up = frequency_sweep(PYHARM_JOINT, F0, grid, direction="up", losses=Losses(damping_ratio=ZETA))
     t_up = time.perf_counter() - start
     print(
         f"frequency_sweep up on the same {grid.size} frequencies: {t_up:.3f} s "
@@ -614,7 +632,7 @@ def main() -> None:
     )
     if not args.skip_sweep_both:
         start = time.perf_counter()
-        frequency_sweep(PYHARM_JOINT, F0, grid, direction="both", damping_ratio=ZETA)
+        frequency_sweep(PYHARM_JOINT, F0, grid, direction="both", losses=Losses(damping_ratio=ZETA))
         t_both = time.perf_counter() - start
         print(f"frequency_sweep both ways: {t_both:.3f} s (ratio {t_both / t_curve:.1f}x)")
 

@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from clearjoint import Joint
+from clearjoint import Joint, Losses
 from clearjoint.exact import kernel as kn
 from clearjoint.exact import single
 from clearjoint.simulate.reference import reference_time_response
@@ -51,7 +51,7 @@ def event_driven() -> tuple[np.ndarray, int, float]:
 def reference(rtol: float) -> tuple[np.ndarray, int, float]:
     start = time.perf_counter()
     ref = reference_time_response(
-        JOINT, CASE["force_amplitude"], CASE["omega"], PERIODS, rtol=rtol, **LOSSES
+        JOINT, CASE["force_amplitude"], CASE["omega"], PERIODS, rtol=rtol, losses=Losses(**LOSSES)
     )
     return ref.strobe, ref.events, time.perf_counter() - start
 

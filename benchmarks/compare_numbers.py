@@ -114,6 +114,18 @@ RECORD_SAMPLES = (0.0, 0.25, 0.5, 0.75, 1.0)
 # ----------------------------------------------------------------------------- entries
 
 
+def losses_for(func: Callable[..., Any], **values: Any) -> dict[str, Any]:
+    """The losses as ``func`` takes them: one ``Losses`` (``losses=``, since issue 23), or
+    the loose keywords of older checkouts, so both trees compute the same case."""
+    import inspect
+
+    import clearjoint
+
+    if "losses" in inspect.signature(func).parameters:
+        return {"losses": clearjoint.Losses(**values)}
+    return values
+
+
 def _float_or_nan(value: Any) -> float:
     return math.nan if value is None else float(value)
 
@@ -575,9 +587,12 @@ def write_api(w: Writer) -> None:
             joint(),
             1000.0,
             omega,
-            damping_ratio=0.01,
-            restitution=0.8,
-            friction=clearjoint.Friction(0.2, 300.0),
+            **losses_for(
+                steady_state,
+                damping_ratio=0.01,
+                restitution=0.8,
+                friction=clearjoint.Friction(0.2, 300.0),
+            ),
         )
         return {
             "amplitude": c.amplitude,
@@ -606,11 +621,14 @@ def write_api(w: Writer) -> None:
         result = dissipation.energies(
             j,
             np.array([5e-6, 20e-6, 40e-6]),
-            friction=clearjoint.Friction(0.2, 300.0),
-            pin=pin,
-            contact_friction_coefficient=0.15,
-            restitution=0.8,
-            damping_ratio=0.01,
+            **losses_for(
+                dissipation.energies,
+                friction=clearjoint.Friction(0.2, 300.0),
+                pin=pin,
+                contact_friction_coefficient=0.15,
+                restitution=0.8,
+                damping_ratio=0.01,
+            ),
         )
         return {k: result[k] for k in result}
 
@@ -625,7 +643,7 @@ def write_api(w: Writer) -> None:
     def orbit() -> Any:
         from clearjoint.periodic import periodic_orbit
 
-        o = periodic_orbit(joint(), 1000.0, omega, damping_ratio=0.01)
+        o = periodic_orbit(joint(), 1000.0, omega, **losses_for(periodic_orbit, damping_ratio=0.01))
         return {
             "initial_state": o.initial_state,
             "monodromy": o.monodromy,

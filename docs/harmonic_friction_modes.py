@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from clearjoint import Friction, Joint, dissipation
+from clearjoint import Friction, Joint, Losses, dissipation
 from clearjoint.harmonic import nonlinear_modes
 
 HEAVY = Friction(coefficient=0.5, lateral_load=2000.0)
@@ -41,11 +41,16 @@ def errors(j: Joint, harmonics: int, sharper: float) -> tuple[float, float, int]
     """(zeta error, E error, converged count) at H and v_eps = sharper x the default."""
     v_eps = 1e-3 * math.sqrt(j.compression_stiffness / j.mass) * j.clearance * sharper
     nm = nonlinear_modes(
-        j, 1, AMPLITUDES, harmonics=harmonics, friction=HEAVY, friction_regularization=v_eps
+        j,
+        1,
+        AMPLITUDES,
+        harmonics=harmonics,
+        losses=Losses(friction=HEAVY),
+        friction_regularization=v_eps,
     )
     ok = nm.converged
     a = nm.x_max[ok] - j.compression_gap
-    exact = dissipation.energies(j, a, friction=HEAVY).loss_factor / 2.0
+    exact = dissipation.energies(j, a, losses=Losses(friction=HEAVY)).loss_factor / 2.0
     closed = 2.0 * HEAVY.force * (nm.x_max[ok] - nm.x_min[ok])
     return (
         float(np.max(np.abs(nm.damping_ratio[ok] / exact - 1.0))),
@@ -65,8 +70,10 @@ def main() -> None:
                     f"{name:11s} {sharper:13g} {h:3d} {z:12.2e} {e:9.2e} {n:5d}/{AMPLITUDES.size}"
                 )
     j = JOINTS["off-centre"]
-    nm = nonlinear_modes(j, 1, AMPLITUDES, harmonics=31, friction=HEAVY)
-    exact = dissipation.energies(j, nm.x_max - j.compression_gap, friction=HEAVY).loss_factor
+    nm = nonlinear_modes(j, 1, AMPLITUDES, harmonics=31, losses=Losses(friction=HEAVY))
+    exact = dissipation.energies(
+        j, nm.x_max - j.compression_gap, losses=Losses(friction=HEAVY)
+    ).loss_factor
     print("off-centre, H = 31: zeta       ", " ".join(f"{z:9.3g}" for z in nm.damping_ratio))
     error = nm.damping_ratio / (exact / 2.0) - 1.0
     print("                    zeta error ", " ".join(f"{e:9.2e}" for e in error))

@@ -104,7 +104,7 @@ def main() -> None:
     args = parser.parse_args()
     j = ClearanceJoint(clearance=5e-5, compression_stiffness=5e7, gap_stiffness=1e5)
     s = mast(args.bays, joints=j, rayleigh=(0.0, 2e-5))
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     closed = s.modes("closed")
     phi = closed.shapes[:, 0]
     ref = int(np.argmax(np.abs(phi)))

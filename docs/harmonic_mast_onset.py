@@ -36,7 +36,7 @@ class Epmc:
     """R(y) = 0 of EPMC at y = (Q / a, w / w_lin, xi / w_lin, log a), scaled as modes.py."""
 
     def __init__(self, structure: object) -> None:
-        self.model = build(structure, 0.0, None, 1.0)
+        self.model = build(structure, None)
         w2, shapes = scipy.linalg.eigh(self.model.closed_stiffness(), self.model.mass)
         self.ref = int(np.argmax(np.abs(shapes[:, 0])))
         self.w_lin = math.sqrt(float(w2[0]))

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from clearjoint import Joint, dissipation, stiffness
+from clearjoint import Joint, Losses, dissipation, stiffness
 from clearjoint.harmonic import aft, nonlinear_modes, solve, system
 from clearjoint.periodic import periodic_orbit
 
@@ -22,7 +22,7 @@ HARMONICS = (3, 7, 15, 31, 63)
 
 
 def _hb_point(h: int, omega: float, guess: np.ndarray) -> tuple[np.ndarray, aft.Basis]:
-    model = system.from_joint(PYHARM, ZETA, None, 1.0)
+    model = system.from_joint(PYHARM, Losses(damping_ratio=ZETA))
     hh, n_t = aft.check_harmonics(h, None)
     basis = aft.Basis.make(hh, n_t)
     q0 = np.zeros(2 * hh + 1)
@@ -51,7 +51,9 @@ def convergence_table() -> None:
             if exact is None:
                 x0 = q[0] + q[1::2].sum()
                 v0 = omega * float(np.arange(1, h + 1) @ q[2::2])
-                exact = periodic_orbit(PYHARM, 0.03, omega, damping_ratio=ZETA, initial=(x0, v0))
+                exact = periodic_orbit(
+                    PYHARM, 0.03, omega, losses=Losses(damping_ratio=ZETA), initial=(x0, v0)
+                )
             top, _ = basis.extremes(q[:, None])
             cells.append(f"{abs(top[0] - exact.x_max) / exact.amplitude:.1e}")
         assert exact is not None
@@ -68,10 +70,10 @@ def backbone_table() -> None:
         exact = 2 * math.pi / stiffness.period(PAPER, nm.x_max - PAPER.compression_gap)
         print(f"| {h} | {np.max(np.abs(nm.frequency / exact - 1)):.1e} |")
     zeta = 0.02
-    nm = nonlinear_modes(PAPER, 1, amplitudes, harmonics=15, damping_ratio=zeta)
+    nm = nonlinear_modes(PAPER, 1, amplitudes, harmonics=15, losses=Losses(damping_ratio=zeta))
     a = nm.x_max - PAPER.compression_gap
     e = dissipation.viscous(PAPER, a, zeta)
-    exact = dissipation.energies(PAPER, a, damping_ratio=zeta).loss_factor / 2
+    exact = dissipation.energies(PAPER, a, losses=Losses(damping_ratio=zeta)).loss_factor / 2
     print(
         "\n| A (um) | damping_ratio | E_diss / (4 pi E_max), dissipation | epmc_damping_ratio "
         "| E per cycle / dissipation.viscous |"
@@ -82,6 +84,7 @@ def backbone_table() -> None:
             f"| {a[i] * 1e6:.4g} | {nm.damping_ratio[i]:.5f} | {exact[i]:.5f} | "
             f"{nm.epmc_damping_ratio[i]:.5f} | {nm.energy_per_cycle[i] / e[i]:.5f} |"
         )
+
 
 if __name__ == "__main__":
     convergence_table()

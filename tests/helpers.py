@@ -8,6 +8,8 @@ turning points. Nothing from clearjoint.stiffness is used.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 from scipy.integrate import simpson, solve_ivp
@@ -224,3 +226,17 @@ frequency = "300Hz"
 [losses]
 damping_ratio = 0.05
 """
+
+
+def with_losses(keywords: Mapping[str, Any]) -> dict[str, Any]:
+    """``keywords`` with the loss keywords among them moved into one ``losses=Losses(...)``.
+
+    For tests that build one set of keywords for several solvers (since issue 23 the
+    solvers take the losses as one value).
+    """
+    from clearjoint import Losses
+    from clearjoint.joint import LOSS_KEYWORDS
+
+    rest = {k: v for k, v in keywords.items() if k not in LOSS_KEYWORDS}
+    losses = {k: v for k, v in keywords.items() if k in LOSS_KEYWORDS}
+    return {**rest, "losses": Losses(**losses)} if losses else rest

@@ -13,7 +13,7 @@ from types import ModuleType
 
 import pytest
 
-from clearjoint import Joint
+from clearjoint import Joint, Losses
 from clearjoint.simulate import time_response
 
 STIFF = Joint(
@@ -48,7 +48,7 @@ def test_inside_the_gap_it_is_the_linear_closed_form(bench: ModuleType) -> None:
 def test_stiff_impacting_case_agrees_with_time_response(bench: ModuleType) -> None:
     duration = 2.0 * math.pi
     x, v = bench.per_state_reference(STIFF, 1.0, 1.0, duration, 0.8, rtol=1e-12)
-    motion = time_response(STIFF, 1.0, 1.0, duration, restitution=0.8)
+    motion = time_response(STIFF, 1.0, 1.0, duration, losses=Losses(restitution=0.8))
     assert motion.impact_times.size > 3  # it does hit the edges, with the restitution jump
     assert abs(motion.final_state[0] - x) / 0.1 < 1e-9
     assert abs(motion.final_state[1] - v) / abs(v) < 1e-7
@@ -76,7 +76,7 @@ def test_longdouble_reference_with_impacts_agrees_with_both_solvers(bench: Modul
     x, v, impacts = bench.closed_form_reference(STIFF, 1.0, 1.0, duration, 0.8)
     assert impacts == 7
     ivp = bench.per_state_reference(STIFF, 1.0, 1.0, duration, 0.8, rtol=1e-12)
-    exact = time_response(STIFF, 1.0, 1.0, duration, restitution=0.8)
+    exact = time_response(STIFF, 1.0, 1.0, duration, losses=Losses(restitution=0.8))
     assert abs(ivp[0] - x) < 1e-9
     assert abs(ivp[1] - v) < 1e-9
     assert abs(exact.final_state[0] - x) < 1e-12

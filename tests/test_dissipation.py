@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from clearjoint import Friction, ParameterError, Pin
+from clearjoint import Friction, Losses, ParameterError, Pin
 from clearjoint import dissipation as ds
 from clearjoint.contact import hertz_coefficient
 from clearjoint.stiffness import free_orbit, natural_frequency
-from helpers import C1, CASES, joint, reference_cycle
+from helpers import C1, CASES, joint, reference_cycle, with_losses
 
 PIN = Pin.for_clearance(radius=5e-3, clearance=C1, length=10e-3)
 
@@ -106,11 +106,13 @@ def test_energies_add_up_and_give_the_loss_factor() -> None:
     values = ds.energies(
         j,
         a,
-        friction=Friction(0.2, 300.0),
-        pin=PIN,
-        contact_friction_coefficient=0.15,
-        restitution=0.8,
-        damping_ratio=0.01,
+        losses=Losses(
+            friction=Friction(0.2, 300.0),
+            pin=PIN,
+            contact_friction_coefficient=0.15,
+            restitution=0.8,
+            damping_ratio=0.01,
+        ),
     )
     assert set(values) == set(ds.ENERGY_KEYS)
     parts = (
@@ -135,11 +137,13 @@ def test_compare_closes_the_balance_and_reports_the_gap() -> None:
         j,
         1000.0,
         2 * math.pi * 400.0,
-        friction=Friction(0.2, 300.0),
-        pin=long_pin,
-        contact_friction_coefficient=0.15,
-        restitution=0.8,
-        damping_ratio=0.01,
+        losses=Losses(
+            friction=Friction(0.2, 300.0),
+            pin=long_pin,
+            contact_friction_coefficient=0.15,
+            restitution=0.8,
+            damping_ratio=0.01,
+        ),
     )
     ledger = result.cycle.energy
     carried = result.exact["total_j"] - result.exact["contact_friction_j"]
@@ -157,9 +161,13 @@ def test_closed_form_is_close_to_the_exact_cycle_on_the_resonant_branch() -> Non
     losses = {"restitution": 0.95, "damping_ratio": 0.003, "friction": Friction(0.1, 20.0)}
     orbit = free_orbit(j, a)
     x_amp = float(orbit.displacement_amplitude)
-    f0 = 1.5 * float(ds.total(j, a, **losses)) / (math.pi * x_amp)  # type: ignore[arg-type]
+    f0 = 1.5 * float(ds.total(j, a, **with_losses(losses))) / (math.pi * x_amp)  # type: ignore[arg-type]
     result = ds.compare(
-        j, f0, float(natural_frequency(j, a)), initial=(float(orbit.x_min), 0.0), **losses
+        j,
+        f0,
+        float(natural_frequency(j, a)),
+        initial=(float(orbit.x_min), 0.0),
+        **with_losses(losses),
     )  # type: ignore[arg-type]
     assert result.penetration == pytest.approx(a, rel=0.05)
     for key in ("sliding_friction_j", "impact_j", "viscous_j"):
@@ -170,7 +178,9 @@ def test_closed_form_is_close_to_the_exact_cycle_on_the_resonant_branch() -> Non
 def test_closed_form_is_far_from_a_quasi_static_cycle() -> None:
     # well below resonance the mass is pushed slowly through the gap: the free
     # cycle's edge speed A w_c overstates the impacts many times over
-    result = ds.compare(joint(), 20000.0, 2 * math.pi * 100.0, restitution=0.9, damping_ratio=0.01)
+    result = ds.compare(
+        joint(), 20000.0, 2 * math.pi * 100.0, losses=Losses(restitution=0.9, damping_ratio=0.01)
+    )
     assert result.gap["impact_j"] > 5.0
 
 
@@ -179,7 +189,11 @@ def test_excitation_work_of_the_sampled_cycle_matches_the_ledger() -> None:
 
     omega = 2 * math.pi * 400.0
     cycle = steady_state(
-        joint(tension_stiffness=5e7), 1000.0, omega, damping_ratio=0.05, samples_per_period=4096
+        joint(tension_stiffness=5e7),
+        1000.0,
+        omega,
+        losses=Losses(damping_ratio=0.05),
+        samples_per_period=4096,
     )
     work = ds.excitation_work(cycle.time, cycle.velocity, 1000.0, omega)
     assert work == pytest.approx(cycle.energy.input, rel=1e-4)
@@ -218,7 +232,7 @@ LOSSES = {
 
 
 def test_energies_result_is_still_the_mapping_it_was() -> None:
-    values = ds.energies(joint(), np.array([5e-6, 2e-5]), **LOSSES)  # type: ignore[arg-type]
+    values = ds.energies(joint(), np.array([5e-6, 2e-5]), **with_losses(LOSSES))  # type: ignore[arg-type]
     assert list(values) == list(ds.ENERGY_KEYS)
     assert dict(values).keys() == set(ds.ENERGY_KEYS)
     assert values["impact_j"] is values.impact_j
@@ -228,7 +242,7 @@ def test_energies_result_is_still_the_mapping_it_was() -> None:
 
 def test_energies_repr_stays_short_for_many_amplitudes() -> None:
     a = np.geomspace(1e-6, 2e-5, 10_000)
-    values = ds.energies(joint(), a, **LOSSES)  # type: ignore[arg-type]
+    values = ds.energies(joint(), a, **with_losses(LOSSES))  # type: ignore[arg-type]
     text = repr(values)
     assert len(text) < 200
     assert "10000 amplitudes" in text
@@ -239,7 +253,7 @@ def test_energies_repr_stays_short_for_many_amplitudes() -> None:
 
 def test_energies_to_xarray_and_pandas_round_trip_with_units() -> None:
     a = np.array([1e-6, 5e-6, 2e-5])
-    values = ds.energies(joint(), a, **LOSSES)  # type: ignore[arg-type]
+    values = ds.energies(joint(), a, **with_losses(LOSSES))  # type: ignore[arg-type]
     data = values.to_xarray()
     np.testing.assert_array_equal(data["amplitude"].values, a)
     assert data["amplitude"].attrs["units"] == "m"
@@ -259,7 +273,7 @@ def test_energies_plot_draws_the_total_in_mj_against_a_in_um() -> None:
     from matplotlib.figure import Figure
 
     a = np.geomspace(1e-6, 2e-5, 40)
-    values = ds.energies(joint(), a, **LOSSES)  # type: ignore[arg-type]
+    values = ds.energies(joint(), a, **with_losses(LOSSES))  # type: ignore[arg-type]
     ax = Figure().add_subplot()
     assert values.plot(ax) is ax
     lines = {line.get_label(): line for line in ax.lines}
@@ -274,7 +288,7 @@ def test_energies_plot_draws_the_total_in_mj_against_a_in_um() -> None:
 
 
 def test_energies_accept_a_losses_value_for_the_five_keywords() -> None:
-    from clearjoint import Joint, Losses
+    from clearjoint import Joint
 
     joint = Joint(2.0, 1.06e-4, 8e7)
     pin = Pin.for_clearance(5e-3, 1.06e-4, 1e-2)
@@ -286,13 +300,13 @@ def test_energies_accept_a_losses_value_for_the_five_keywords() -> None:
         damping_ratio=0.01,
     )
     amplitude = np.array([1e-6, 3e-6])
-    by_keywords = ds.energies(joint, amplitude, **keywords)  # type: ignore[arg-type]
-    by_value = ds.energies(joint, amplitude, losses=Losses(**keywords))  # type: ignore[arg-type]
+    by_keywords = ds.energies(joint, amplitude, **with_losses(keywords))  # type: ignore[arg-type]
+    by_value = ds.energies(joint, amplitude, **with_losses(keywords))  # type: ignore[arg-type]
     for key, value in by_keywords.items():
         np.testing.assert_array_equal(by_value[key], value)
     np.testing.assert_array_equal(
-        ds.total(joint, amplitude, losses=Losses(**keywords)),  # type: ignore[arg-type]
-        ds.total(joint, amplitude, **keywords),  # type: ignore[arg-type]
+        ds.total(joint, amplitude, **with_losses(keywords)),  # type: ignore[arg-type]
+        ds.total(joint, amplitude, **with_losses(keywords)),  # type: ignore[arg-type]
     )
 
 
@@ -302,7 +316,9 @@ def test_comparison_tables_and_plot_carry_both_routes() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    result = ds.compare(joint(), 20000.0, 2 * math.pi * 100.0, restitution=0.9, damping_ratio=0.01)
+    result = ds.compare(
+        joint(), 20000.0, 2 * math.pi * 100.0, losses=Losses(restitution=0.9, damping_ratio=0.01)
+    )
     data = result.to_xarray()
     for key in result.exact:
         assert float(data["exact"].sel(energy=key)) == result.exact[key]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from clearjoint import Friction, Joint
+from clearjoint import Friction, Joint, Losses
 from clearjoint.harmonic import HarmonicError, aft, solve, system
 from clearjoint.periodic import periodic_orbit
 
@@ -52,7 +52,7 @@ def test_jacobian_matches_finite_differences(offset: float, friction: Friction |
         gap_stiffness=0.5,
         gap_offset=offset,
     )
-    model = system.from_joint(joint, 0.02, friction, 1.0, 0.05)
+    model = system.from_joint(joint, Losses(damping_ratio=0.02, friction=friction), 0.05)
     basis = aft.Basis.make(6, 128)
     rng = np.random.default_rng(7)
     q = 0.1 * rng.normal(size=13)
@@ -80,13 +80,13 @@ def test_bad_harmonics_and_samples() -> None:
 
 def test_restitution_and_friction_are_refused_with_a_pointer() -> None:
     with pytest.raises(HarmonicError, match=r"clearjoint\.periodic"):
-        system.build(PYHARM, 0.0, None, 0.8)
+        system.build(PYHARM, Losses(restitution=0.8))
     with pytest.raises(HarmonicError, match=r"clearjoint\.periodic"):
-        system.build(PYHARM, 0.0, Friction(0.1, 1.0, "free-play"), 1.0, 1e-3)
+        system.build(PYHARM, Losses(friction=Friction(0.1, 1.0, "free-play")), 1e-3)
 
 
 def _hb_orbit(harmonics: int, omega: float, guess: np.ndarray) -> tuple[np.ndarray, aft.Basis]:
-    model = system.from_joint(PYHARM, PYHARM_ZETA, None, 1.0)
+    model = system.from_joint(PYHARM, Losses(damping_ratio=PYHARM_ZETA))
     h, n_t = aft.check_harmonics(harmonics, None)
     basis = aft.Basis.make(h, n_t)
     q0 = np.zeros(2 * h + 1)
@@ -113,7 +113,9 @@ def test_harmonic_balance_converges_to_the_exact_orbit() -> None:
         if exact is None:
             x0 = q[0] + q[1::2].sum()
             v0 = omega * float(np.arange(1, h + 1) @ q[2::2])
-            exact = periodic_orbit(PYHARM, 0.03, omega, damping_ratio=PYHARM_ZETA, initial=(x0, v0))
+            exact = periodic_orbit(
+                PYHARM, 0.03, omega, losses=Losses(damping_ratio=PYHARM_ZETA), initial=(x0, v0)
+            )
             assert exact.x_max > PYHARM.compression_gap  # a contacting orbit
         top, _ = basis.extremes(q[:, None])
         errors.append(abs(top[0] - exact.x_max) / exact.amplitude)
@@ -212,7 +214,7 @@ def test_hill_determinant_matches_the_integrated_monodromy(omega: float) -> None
 
 def test_hill_determinant_agrees_with_hills_eigenproblem() -> None:
     """On orbits in and out of contact the two Hill routes (same truncation) agree."""
-    model = system.from_joint(PYHARM, PYHARM_ZETA, None, 1.0)
+    model = system.from_joint(PYHARM, Losses(damping_ratio=PYHARM_ZETA))
     basis = aft.Basis.make(12, 512)
     for omega, guess in ((1.3, [0.0, -0.3, 0.1]), (0.6, [0.0, 0.05, 0.0])):
         q, _ = _hb_orbit(12, omega, np.array(guess))
@@ -236,7 +238,7 @@ def test_compiled_one_dof_path_equals_the_general_one() -> None:
         gap_stiffness=0.5,
         gap_offset=0.03,
     )
-    model = system.from_joint(joint, 0.02, None, 1.0)
+    model = system.from_joint(joint, Losses(damping_ratio=0.02))
     basis = aft.Basis.make(6, 128)
     general = dataclasses.replace(basis, assemble=None)  # forces the numpy path
     q = 0.1 * np.random.default_rng(3).normal(size=13)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from clearjoint import ClearanceJoint, Friction, Joint, ParameterError
+from clearjoint import ClearanceJoint, Friction, Joint, Losses, ParameterError
 from clearjoint.harmonic import HarmonicError, frequency_response, nonlinear_modes
 from clearjoint.harmonic.aft import Basis
 from clearjoint.harmonic.check import check_orbits
@@ -66,7 +66,9 @@ def test_one_joint_chain_is_the_joints_harmonic_balance() -> None:
     zeta = 0.02
     s = chain([1.0], [math.inf], [_law(LIGHT)], dampers=[viscous_coefficient(joint, zeta)])
     kw = {"harmonics": 7, "max_points": 12}
-    a = frequency_response(joint, 100.0, 600.0, 900.0, damping_ratio=zeta, friction=LIGHT, **kw)
+    a = frequency_response(
+        joint, 100.0, 600.0, 900.0, losses=Losses(damping_ratio=zeta, friction=LIGHT), **kw
+    )
     b = frequency_response(s, np.array([100.0]), 600.0, 900.0, **kw)
     assert a.omega.size == b.omega.size == 12
     assert b.coefficients is not None
@@ -91,7 +93,7 @@ def test_steady_states_agree_with_solve_ivp_of_the_regularised_ode(
     """
     fr = frequency_response(two_links, FORCE, omega, 1.001 * omega, harmonics=9, max_points=2)
     assert fr.stable[0]
-    model = build(two_links, 0.0, None, 1.0, 1e-3 * omega * GAP)  # the default v_eps
+    model = build(two_links, None, 1e-3 * omega * GAP)  # the default v_eps
     period = 2.0 * math.pi / omega
     times = np.linspace(29.0 * period, 30.0 * period, 1025)
     sol = solve_ivp(
@@ -117,7 +119,7 @@ def test_integrated_monodromy_is_the_exact_one_without_friction() -> None:
     s = chain([1.0, 1.0, 1.0], [1e6] * 3, [j] * 3, dampers=[150.0] * 3)
     force = np.array([0.0, 0.0, 40.0])
     fr = frequency_response(s, force, 400.0, 400.4, harmonics=7, max_points=2, check_points=0)
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     basis = Basis.make(7, int(fr.settings["samples"]))
     assert fr.coefficients is not None
     coef = fr.coefficients[0]
@@ -149,7 +151,7 @@ def test_multipliers_with_friction_match_a_finite_difference_monodromy(
         max_points=2,
         friction_regularization=v_eps,
     )
-    model = build(two_links, 0.0, None, 1.0, v_eps)
+    model = build(two_links, None, v_eps)
     rhs = _regularised_rhs(model, FORCE, omega)
     period = 2.0 * math.pi / omega
 
@@ -194,7 +196,7 @@ def test_regularisation_error_against_the_exact_stick_slip_orbit(
     fr = frequency_response(
         s, np.array([100.0]), omega, 1.001 * omega, harmonics=9, samples=128, max_points=2
     )
-    exact = periodic_orbit(joint, 100.0, omega, damping_ratio=zeta, friction=rub)
+    exact = periodic_orbit(joint, 100.0, omega, losses=Losses(damping_ratio=zeta, friction=rub))
     a_exact = 0.5 * (exact.cycle.x_max - exact.cycle.x_min)
     error = abs(fr.amplitude[0, 0] / a_exact - 1.0)
     assert error < bound

@@ -15,11 +15,12 @@ import pytest
 import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
-from clearjoint import ClearanceJoint, ParameterError
+from clearjoint import ClearanceJoint, Losses, ParameterError
 from clearjoint.harmonic import HarmonicError, aft, frequency_response, hill, monodromy
 from clearjoint.harmonic.system import build
 from clearjoint.periodic import periodic_orbit
 from clearjoint.structure import Structure, chain, mast
+from helpers import with_losses
 from test_harmonic_aft import PYHARM, PYHARM_ZETA
 
 FORCE = np.array([0.0, 0.0, 40.0])
@@ -64,7 +65,7 @@ def test_linear_orbit_gives_the_closed_form_exponents() -> None:
     each family; the smallest-abs(Im) sorting cannot (those families have no member in its
     strip) and gets other multipliers."""
     s = _stiff_mast()
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     force = _tip_x(s, 1.0)
     w = 2.0 * math.pi * 45.0
     fr = frequency_response(s, force, w, 1.0001 * w, harmonics=7, max_points=2, check_points=0)
@@ -100,7 +101,7 @@ def test_chain_agrees_with_the_exact_monodromy_of_the_same_orbit(
     six paired, within a tolerance that shrinks with H (measured: worst 0.041 at H = 7,
     9.3e-3 at H = 15; `benchmarks/bench_hill.py --agreement`), and the same verdict. At H = 7,
     400 rad/s the centroid alone kept a spurious family (largest 0.159 against 0.792)."""
-    model = build(three_links, 0.0, None, 1.0)
+    model = build(three_links, None)
     for w in (200.0, 300.0, 400.0, 600.0, 800.0):
         fr = frequency_response(
             three_links, FORCE, w, 1.001 * w, harmonics=harmonics, max_points=2, check_points=0
@@ -122,7 +123,7 @@ def test_stiff_contact_needs_many_more_harmonics_in_the_perturbation() -> None:
     reason structures keep the monodromy by default); carrying the perturbation with
     H' = 31 on the same orbit brings them within 0.15 (docs/harmonic.md, "Stability")."""
     s = _stiff_mast()
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     force = _tip_x(s, 5.0)
     w = 2.0 * math.pi * 51.92
     fr = frequency_response(s, force, w, 1.0001 * w, harmonics=7, max_points=2, check_points=0)
@@ -149,9 +150,9 @@ def test_one_joint_agrees_with_the_exact_orbits_floquet_multipliers() -> None:
     multipliers within 7.0e-3 (median), 4.8e-2 (worst, 1.53 rad/s beside the fold, where
     the HB orbit's own error matters most); 3.2e-4 from the determinant. Both shrink with
     H (`benchmarks/bench_hill.py --agreement`)."""
-    model = build(PYHARM, PYHARM_ZETA, None, 1.0)
+    model = build(PYHARM, Losses(damping_ratio=PYHARM_ZETA))
     curve = frequency_response(
-        PYHARM, 0.03, 1.0, 1.7, harmonics=12, damping_ratio=PYHARM_ZETA, max_step=0.1
+        PYHARM, 0.03, 1.0, 1.7, harmonics=12, losses=Losses(damping_ratio=PYHARM_ZETA), max_step=0.1
     )
     assert curve.coefficients is not None
     compared = unstable = 0
@@ -160,7 +161,11 @@ def test_one_joint_agrees_with_the_exact_orbits_floquet_multipliers() -> None:
             continue
         w = float(curve.omega[i])
         exact = periodic_orbit(
-            PYHARM, 0.03, w, damping_ratio=PYHARM_ZETA, initial=curve.initial_state[i]
+            PYHARM,
+            0.03,
+            w,
+            losses=Losses(damping_ratio=PYHARM_ZETA),
+            initial=curve.initial_state[i],
         )
         ref = np.asarray(exact.multipliers)
         if abs(float(np.max(np.abs(ref))) - 1.0) < 0.03:
@@ -192,8 +197,8 @@ def test_frequency_response_stability_option(three_links: Structure) -> None:
         assert _set_distance(a, b) < 0.05
     assert not [e for e in by_hill.events if e.kind == "untrusted"]
     joint = dict(harmonics=12, damping_ratio=PYHARM_ZETA, max_points=5)
-    det = frequency_response(PYHARM, 0.03, 1.2, 1.25, **joint)
-    mono = frequency_response(PYHARM, 0.03, 1.2, 1.25, stability="monodromy", **joint)
+    det = frequency_response(PYHARM, 0.03, 1.2, 1.25, **with_losses(joint))
+    mono = frequency_response(PYHARM, 0.03, 1.2, 1.25, stability="monodromy", **with_losses(joint))
     assert det.settings["stability"] == "hill"
     np.testing.assert_allclose(np.abs(det.multipliers), np.abs(mono.multipliers), atol=2e-3)
     with pytest.raises(ParameterError, match="stability must be 'hill' or 'monodromy'"):
@@ -282,7 +287,7 @@ def test_neimark_sacker_crossings_are_events_and_collisions_are_not() -> None:
     complex modulus drops from 1.2 to the inside pair's 0.5) give none."""
     from clearjoint.harmonic.response import _events
 
-    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), 0.0, None, 1.0)
+    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
     omega = np.array([1.0, 2.0, 3.0, 4.0])
     force = np.ones(4)
     amplitude = np.full(4, 1e-6)

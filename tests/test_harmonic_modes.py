@@ -8,13 +8,13 @@ import matplotlib
 import numpy as np
 import pytest
 
-from clearjoint import Friction, Joint, ParameterError, dissipation, stiffness
+from clearjoint import Friction, Joint, Losses, ParameterError, dissipation, stiffness
 from clearjoint.harmonic import HarmonicError, NonlinearMode, nonlinear_modes
 from clearjoint.harmonic.modes import MAX_HALVINGS
 
 matplotlib.use("Agg")
 
-from helpers import CASES, joint
+from helpers import CASES, joint, with_losses
 
 AMPLITUDES = np.geomspace(70e-6, 2e-3, 5)
 
@@ -40,7 +40,7 @@ def test_backbone_is_the_exact_free_period_and_converges_with_h(name: str) -> No
 def test_viscous_loss_and_epmc_damping_ratio() -> None:
     j = joint()
     zeta = 0.02
-    nm = nonlinear_modes(j, 1, AMPLITUDES, harmonics=15, damping_ratio=zeta)
+    nm = nonlinear_modes(j, 1, AMPLITUDES, harmonics=15, losses=Losses(damping_ratio=zeta))
     penetration = nm.x_max - j.compression_gap
     # E_diss per cycle: the closed form on the free cycle of clearjoint.dissipation
     e_diss = dissipation.viscous(j, penetration, zeta)
@@ -57,10 +57,12 @@ WIDE = np.geomspace(70e-6, 2e-3, 8)
 def _damping_ratio_error(j: Joint, harmonics: int) -> float:
     """Largest relative gap of damping_ratio to E_diss / (4 pi E_max) of the free orbit."""
     zeta = 0.02
-    nm = nonlinear_modes(j, 1, WIDE, harmonics=harmonics, damping_ratio=zeta)
+    nm = nonlinear_modes(j, 1, WIDE, harmonics=harmonics, losses=Losses(damping_ratio=zeta))
     assert nm.converged.all()
     penetration = nm.x_max - j.compression_gap
-    exact = dissipation.energies(j, penetration, damping_ratio=zeta).loss_factor / 2.0
+    exact = (
+        dissipation.energies(j, penetration, losses=Losses(damping_ratio=zeta)).loss_factor / 2.0
+    )
     return float(np.max(np.abs(nm.damping_ratio / exact - 1.0)))
 
 
@@ -82,7 +84,7 @@ def test_damping_ratio_is_the_loss_factor_over_the_whole_range(name: str) -> Non
 
 
 def test_the_two_damping_ratios_meet_for_near_harmonic_motion() -> None:
-    nm = nonlinear_modes(joint(), 1, WIDE, harmonics=15, damping_ratio=0.02)
+    nm = nonlinear_modes(joint(), 1, WIDE, harmonics=15, losses=Losses(damping_ratio=0.02))
     ratio = nm.epmc_damping_ratio / nm.damping_ratio
     assert ratio[-1] == pytest.approx(1.0, abs=0.02)  # A = 20 clearances: near-sinusoidal
     assert ratio[0] < 0.7  # A = 0.2 clearances: near-triangular
@@ -98,7 +100,7 @@ def test_no_mode_inside_the_gap_is_flagged() -> None:
 
 
 def test_result_object() -> None:
-    nm = nonlinear_modes(joint(), 1, AMPLITUDES, harmonics=5, damping_ratio=0.01)
+    nm = nonlinear_modes(joint(), 1, AMPLITUDES, harmonics=5, losses=Losses(damping_ratio=0.01))
     assert isinstance(nm, NonlinearMode)
     assert nm.harmonic_shapes.shape == (5, 11)
     ds = nm.to_xarray()
@@ -130,7 +132,7 @@ def test_bad_input(kwargs: dict[str, object], error: type, match: str) -> None:
     args: dict[str, object] = {"mode": 1, "amplitudes": AMPLITUDES}
     args.update(kwargs)
     with pytest.raises(error, match=match):
-        nonlinear_modes(joint(), **args)  # type: ignore[arg-type]
+        nonlinear_modes(joint(), **with_losses(args))  # type: ignore[arg-type]
 
 
 def _mast3() -> object:
@@ -172,7 +174,7 @@ def test_no_contact_over_the_range_is_noted_with_where_contact_begins() -> None:
     assert "no joint reaches a gap edge over 1e-06..1e-05 m" in nm.note
     reach = float(nm.note.rsplit("contact begins near ", 1)[1].split(" m")[0])
     # independently: the open-pattern linear frequency holds just below, not just above
-    model = build(_mast3(), 0.0, None, 1.0)
+    model = build(_mast3(), None)
     w_open = math.sqrt(scipy.linalg.eigh(model.open_stiffness(), model.mass)[0][0])
     # followed down from 1.1 x onset (alone, 1.01 x onset finds another HB solution, 11.8 Hz)
     near = nonlinear_modes(_mast3(), 1, np.array([0.99, 1.01, 1.1]) * reach, harmonics=3)
@@ -203,7 +205,7 @@ def test_points_below_onset_the_branch_from_above_misses_are_the_open_mode() -> 
 
     nm = nonlinear_modes(_mast2(), 1, np.geomspace(3e-5, 3e-3, 6), harmonics=7)
     assert nm.converged.all()
-    model = build(_mast2(), 0.0, None, 1.0)
+    model = build(_mast2(), None)
     w_open = math.sqrt(scipy.linalg.eigh(model.open_stiffness(), model.mass)[0][0])
     assert nm.frequency[0] == pytest.approx(w_open, rel=1e-9)
     assert nm.frequency[1] > w_open * 1.05  # above onset: contact stiffens it
@@ -271,7 +273,9 @@ def test_epmc_jacobian_with_friction_is_the_finite_difference_one(name: str) -> 
 
     j = CASES[name]
     h = 5
-    model = build(j, 0.01, HEAVY, 1.0, 0.05)  # v_eps 0.05 m/s: a slope finite differences see
+    model = build(
+        j, Losses(damping_ratio=0.01, friction=HEAVY), 0.05
+    )  # v_eps 0.05 m/s: a slope finite differences see
     basis = aft.Basis.make(h, 64)
     rng = np.random.default_rng(7)
     w_scale = math.sqrt(j.compression_stiffness / j.mass)
@@ -290,7 +294,7 @@ def test_epmc_jacobian_with_friction_is_the_finite_difference_one(name: str) -> 
         numeric[:, k] = (plus - minus) / 2e-7
     assert np.max(np.abs(jac - numeric)) < 1e-6 * np.max(np.abs(jac))
     # the friction is in it: the same point without friction has another residual
-    plain = epmc_residual(build(j, 0.01, None, 1.0), basis, z, a, w_scale, 0)[0]
+    plain = epmc_residual(build(j, Losses(damping_ratio=0.01)), basis, z, a, w_scale, 0)[0]
     assert np.max(np.abs(r - plain)) > 1e-3
 
 
@@ -303,7 +307,12 @@ def _sliding(
     w = math.sqrt(j.compression_stiffness / j.mass)
     v_eps = 1e-3 * w * j.clearance * sharper  # sharper = 1: the default
     nm = nonlinear_modes(
-        j, 1, SLIDING, harmonics=harmonics, friction=friction, friction_regularization=v_eps
+        j,
+        1,
+        SLIDING,
+        harmonics=harmonics,
+        losses=Losses(friction=friction),
+        friction_regularization=v_eps,
     )
     assert nm.converged.all()
     assert nm.note == ""
@@ -311,7 +320,7 @@ def _sliding(
     # MODEL.md section 2: Coulomb's work per cycle is mu_s P times the distance slid,
     # 2 (x_max - x_min) for one maximum and one minimum; on the exact free orbit of the
     # same penetration A that is 4 mu_s P X, with E_max = V(x_max) (clearjoint.dissipation)
-    exact = dissipation.energies(j, a, friction=friction).loss_factor / 2.0
+    exact = dissipation.energies(j, a, losses=Losses(friction=friction)).loss_factor / 2.0
     closed = 2.0 * friction.force * (nm.x_max - nm.x_min)
     return nm.damping_ratio, nm.damping_ratio / exact - 1.0, nm.energy_per_cycle / closed - 1.0
 
@@ -367,14 +376,14 @@ def test_friction_that_holds_the_joint_fails_the_amplitude_with_the_reason() -> 
     stick = j.compression_gap + HEAVY.force / j.compression_stiffness  # x_max at the limit
     amps = np.array([4.62e-5, 1e-4, 1e-3])
     for h in (7, 15):
-        nm = nonlinear_modes(j, 1, amps, harmonics=h, friction=HEAVY)
+        nm = nonlinear_modes(j, 1, amps, harmonics=h, losses=Losses(friction=HEAVY))
         assert list(nm.converged) == [False, True, True]
         assert math.isnan(nm.damping_ratio[0])
         assert "no mode at 1 of 3 amplitudes (4.62e-05..4.62e-05 m): friction holds the joint" in (
             nm.note
         )
         assert np.all(nm.x_max[1:] > 1.5 * stick)
-    loose = nonlinear_modes(j, 1, amps, harmonics=7, friction=Friction(0.1, 100.0))
+    loose = nonlinear_modes(j, 1, amps, harmonics=7, losses=Losses(friction=Friction(0.1, 100.0)))
     assert loose.converged.all()  # 10 N: the same amplitudes slide
 
 
@@ -537,7 +546,7 @@ def test_holding_force_is_the_chains_spring_and_joint_force_by_hand() -> None:
     from clearjoint.harmonic.modes import holding_forces
     from clearjoint.harmonic.system import build
 
-    model = build(_rubbing_chain(), 0.0, None, 1.0, 1e-3)
+    model = build(_rubbing_chain(), None, 1e-3)
     basis = aft.Basis.make(3, 64)
     rng = np.random.default_rng(3)
     coef = 1e-4 * rng.standard_normal((7, 2))
@@ -557,7 +566,7 @@ def test_the_stick_check_names_orbits_made_by_hand() -> None:
     from clearjoint.harmonic.modes import _held
     from clearjoint.harmonic.system import build
 
-    model = build(_rubbing_chain(), 0.0, None, 1.0, 1e-3)
+    model = build(_rubbing_chain(), None, 1e-3)
     basis = aft.Basis.make(3, 64)
     omega = 2.0 * math.pi * 159.0
     orbits = {}
@@ -578,7 +587,7 @@ def test_the_stick_check_on_a_joint_is_the_restoring_force_at_the_turning_points
     from clearjoint.harmonic.system import build
 
     j = joint()
-    model = build(j, 0.0, HEAVY, 1.0, 1e-3)
+    model = build(j, Losses(friction=HEAVY), 1e-3)
     basis = aft.Basis.make(3, 64)
     orbits = {i: np.array([0.0, 1.0, 0, 0, 0, 0, 0, 1.0, 0.0]) for i in range(2)}
     amps = np.array([55e-6, 2e-4])

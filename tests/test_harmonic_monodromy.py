@@ -33,7 +33,7 @@ def test_open_orbit_has_the_linear_systems_multipliers(three_links: Structure) -
     small = FORCE * 1e-3
     omega = 150.0
     fr = frequency_response(three_links, small, omega, 1.001 * omega, harmonics=5, max_points=2)
-    model = build(three_links, 0.0, None, 1.0)
+    model = build(three_links, None)
     n = model.n_dof
     k_open = model.open_stiffness()
     inv_m = np.linalg.inv(model.mass)
@@ -101,7 +101,7 @@ def test_monodromy_equals_a_product_over_the_contact_patterns(three_links: Struc
 
     omega = 600.0
     fr = frequency_response(three_links, FORCE, omega, 1.001 * omega, harmonics=7, max_points=2)
-    model = build(three_links, 0.0, None, 1.0)
+    model = build(three_links, None)
     basis = aft.Basis.make(7, fr.settings["samples"])
     coef = fr.coefficients[0]
     phi = monodromy.monodromy(model, basis, coef, omega)
@@ -140,7 +140,7 @@ def _chain_orbit(three_links: Structure, omega: float) -> tuple[object, aft.Basi
     fr = frequency_response(three_links, FORCE, omega, 1.001 * omega, harmonics=7, max_points=2)
     assert fr.coefficients is not None
     basis = aft.Basis.make(7, fr.settings["samples"])
-    return build(three_links, 0.0, None, 1.0), basis, fr.coefficients[0]
+    return build(three_links, None), basis, fr.coefficients[0]
 
 
 def _no_expm(*args: object, **kwargs: object) -> np.ndarray:
@@ -233,7 +233,7 @@ def _free_end_chain() -> tuple[object, aft.Basis, np.ndarray]:
     while that joint is open the outer mass is free, A has a Jordan block at 0 (defective)."""
     loose = ClearanceJoint(clearance=1e-4, compression_stiffness=1e6)
     s = chain([1.0, 1.0], [1e6, math.inf], [None, loose], dampers=[10.0, 0.0])
-    model = build(s, 0.0, None, 1.0)
+    model = build(s, None)
     basis = aft.Basis.make(3, 64)
     coef = np.zeros((7, 2))
     coef[1] = [0.0, 3e-4]  # the outer mass swings 0.3 mm: the joint opens and closes
@@ -301,9 +301,7 @@ def test_the_cache_tells_systems_apart(three_links: Structure) -> None:
             [ClearanceJoint(clearance=1e-4, compression_stiffness=2e7, gap_stiffness=1e5)] * 3,
             dampers=[150.0] * 3,
         ),
-        0.0,
         None,
-        1.0,
     )
     for system in (model, stiffer, model):
         phi = monodromy.monodromy(system, basis, coef, 600.0)

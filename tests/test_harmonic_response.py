@@ -8,10 +8,11 @@ import matplotlib
 import numpy as np
 import pytest
 
-from clearjoint import Friction, ParameterError
+from clearjoint import Friction, Losses, ParameterError
 from clearjoint.harmonic import HarmonicError, frequency_response
 from clearjoint.periodic import FrequencyResponse, periodic_orbit
 from clearjoint.simulate import SimulationError
+from helpers import with_losses
 
 matplotlib.use("Agg")
 
@@ -22,7 +23,7 @@ from test_harmonic_aft import PYHARM, PYHARM_ZETA
 def curve() -> FrequencyResponse:
     """The pyHarm case around its resonance: both folds, three branches (H = 12)."""
     return frequency_response(
-        PYHARM, 0.03, 1.0, 1.7, harmonics=12, damping_ratio=PYHARM_ZETA, max_step=0.1
+        PYHARM, 0.03, 1.0, 1.7, harmonics=12, losses=Losses(damping_ratio=PYHARM_ZETA), max_step=0.1
     )
 
 
@@ -51,7 +52,7 @@ def test_hill_stability_agrees_with_floquet_away_from_bifurcations(
                 PYHARM,
                 0.03,
                 float(curve.omega[i]),
-                damping_ratio=PYHARM_ZETA,
+                losses=Losses(damping_ratio=PYHARM_ZETA),
                 initial=curve.initial_state[i],
             )
         except SimulationError:
@@ -87,14 +88,14 @@ def test_force_continuation_reaches_the_exact_orbit() -> None:
         0.9,
         None,
         harmonics=15,
-        damping_ratio=PYHARM_ZETA,
+        losses=Losses(damping_ratio=PYHARM_ZETA),
         parameter="force",
         force_stop=0.05,
         max_step=0.2,
     )
     assert fr.force_amplitude[-1] == pytest.approx(0.05)
     exact = periodic_orbit(
-        PYHARM, 0.05, 0.9, damping_ratio=PYHARM_ZETA, initial=fr.initial_state[-1]
+        PYHARM, 0.05, 0.9, losses=Losses(damping_ratio=PYHARM_ZETA), initial=fr.initial_state[-1]
     )
     assert exact.x_max > PYHARM.compression_gap
     assert fr.x_max[-1] == pytest.approx(exact.x_max, rel=1e-4)
@@ -123,7 +124,7 @@ def test_bad_input_one_clear_message(kwargs: dict[str, object], error: type, mat
             args.pop("force"),  # type: ignore[arg-type]
             args.pop("omega_start"),  # type: ignore[arg-type]
             args.pop("omega_stop"),  # type: ignore[arg-type]
-            **args,  # type: ignore[arg-type]
+            **with_losses(args),  # type: ignore[arg-type]
         )
 
 
@@ -137,16 +138,14 @@ def test_regularised_friction_against_exact_stick_slip_orbits(omega: float) -> N
         omega,
         1.001 * omega,
         harmonics=15,
-        damping_ratio=PYHARM_ZETA,
-        friction=friction,
+        losses=Losses(damping_ratio=PYHARM_ZETA, friction=friction),
         max_points=2,
     )
     exact = periodic_orbit(
         PYHARM,
         0.03,
         omega,
-        damping_ratio=PYHARM_ZETA,
-        friction=friction,
+        losses=Losses(damping_ratio=PYHARM_ZETA, friction=friction),
         initial=fr.initial_state[0],
     )
     assert abs(fr.x_max[0] - exact.x_max) < 2e-3 * exact.amplitude
@@ -164,7 +163,9 @@ def test_stability_is_recomputed_where_the_continuation_kept_no_evaluation(
     import clearjoint.harmonic.response as response
 
     def run() -> FrequencyResponse:
-        return frequency_response(PYHARM, 0.03, 1.0, 1.2, harmonics=7, damping_ratio=PYHARM_ZETA)
+        return frequency_response(
+            PYHARM, 0.03, 1.0, 1.2, harmonics=7, losses=Losses(damping_ratio=PYHARM_ZETA)
+        )
 
     kept = run()
     real = response.continue_branch
@@ -193,10 +194,14 @@ def test_compiled_one_dof_corrector_follows_the_same_curve(
         return original(self, *args)  # type: ignore[arg-type]
 
     monkeypatch.setattr(aft.OneDofResidual, "corrector", counted)
-    fast = frequency_response(PYHARM, 0.03, 0.6, 1.8, harmonics=7, damping_ratio=PYHARM_ZETA)
+    fast = frequency_response(
+        PYHARM, 0.03, 0.6, 1.8, harmonics=7, losses=Losses(damping_ratio=PYHARM_ZETA)
+    )
     assert len(calls) >= fast.omega.size
     monkeypatch.delattr(aft.OneDofResidual, "corrector")
-    plain = frequency_response(PYHARM, 0.03, 0.6, 1.8, harmonics=7, damping_ratio=PYHARM_ZETA)
+    plain = frequency_response(
+        PYHARM, 0.03, 0.6, 1.8, harmonics=7, losses=Losses(damping_ratio=PYHARM_ZETA)
+    )
     # the same Newton steps from the same start (continuation's own corrector, asked for
     # the compiled one's, keeps dR/dw as a chord; step sizes then differ a little)
     np.testing.assert_allclose(fast.omega[:4], plain.omega[:4], rtol=1e-9)

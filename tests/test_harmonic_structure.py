@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from clearjoint import ClearanceJoint, ParameterError
+from clearjoint import ClearanceJoint, Losses, ParameterError
 from clearjoint.harmonic import HarmonicError, frequency_response, nonlinear_modes
 from clearjoint.structure import Structure, chain, time_response
 
@@ -104,7 +104,7 @@ def test_bad_structure_input(three_links: Structure) -> None:
     with pytest.raises(ParameterError, match="the structure has modes 1 to 3"):
         nonlinear_modes(three_links, 4, [1e-3])
     with pytest.raises(ParameterError, match="apply to a Joint"):
-        frequency_response(three_links, FORCE, 100.0, 200.0, damping_ratio=0.1)
+        frequency_response(three_links, FORCE, 100.0, 200.0, losses=Losses(damping_ratio=0.1))
 
 
 def test_first_nonlinear_mode_is_the_free_decay_backbone() -> None:

@@ -107,7 +107,6 @@ def test_large_amplitude_stiffness_is_the_bilinear_oscillators() -> None:
 # ---- the massless element and the Losses value ------------------------------------------
 
 from clearjoint import ClearanceJoint, Friction, Losses  # noqa: E402
-from clearjoint.joint import unpack_losses  # noqa: E402
 from helpers import check_tangent_stiffness  # noqa: E402
 
 
@@ -200,18 +199,18 @@ def test_element_is_built_once_and_is_not_part_of_the_value() -> None:
         joint.element = _element()  # type: ignore[misc]
 
 
-def test_losses_replace_the_five_keywords_and_refuse_both() -> None:
+def test_losses_are_the_one_carrier_and_the_old_keywords_name_the_fix() -> None:
     from clearjoint.simulate import time_response
 
     joint = Joint(2.0, 1e-4, 8e7)
-    friction = Friction(0.1, 50.0)
-    by_keywords = time_response(
-        joint, 300.0, 5000.0, 0.01, damping_ratio=0.02, friction=friction, restitution=0.8
-    )
-    losses = Losses(damping_ratio=0.02, friction=friction, restitution=0.8)
-    by_value = time_response(joint, 300.0, 5000.0, 0.01, losses=losses)
-    np.testing.assert_array_equal(by_value.displacement, by_keywords.displacement)
-    with pytest.raises(ParameterError, match="losses given both"):
-        unpack_losses(losses, 0.01, None, 1.0, None, 0.0)
+    losses = Losses(damping_ratio=0.02, friction=Friction(0.1, 50.0), restitution=0.8)
+    moved = time_response(joint, 300.0, 5000.0, 0.01, losses=losses)
+    assert moved.energy.impact > 0.0
+    assert moved.energy.sliding_friction > 0.0
+    assert moved.energy.viscous > 0.0
+    with pytest.raises(ParameterTypeError, match=r"write losses=Losses\(damping_ratio=0.02\)"):
+        time_response(joint, 300.0, 5000.0, 0.01, damping_ratio=0.02)  # type: ignore[call-arg]
+    with pytest.raises(ParameterTypeError, match=r"losses must be a clearjoint\.Losses"):
+        time_response(joint, 300.0, 5000.0, 0.01, losses=0.02)  # type: ignore[arg-type]
     with pytest.raises(ParameterError, match="damping_ratio must be >= 0"):
         Losses(damping_ratio=-1.0)

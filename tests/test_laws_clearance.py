@@ -203,7 +203,7 @@ def joint(law: ClearanceJoint) -> Place:
 def _linear_system(law: ClearanceJoint, structure: bool) -> system.LinearSystem:
     if structure:
         return system.from_structure(chain([2.0], [math.inf], [law]))
-    return system.from_joint(_joint(law), 0.0, None, 1.0)
+    return system.from_joint(_joint(law), None)
 
 
 def _harmonic(law: ClearanceJoint, structure: bool) -> Place:

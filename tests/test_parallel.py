@@ -24,6 +24,7 @@ from clearjoint.parallel import (
     run_ordered,
     run_unordered,
 )
+from helpers import with_losses
 
 
 def _noisy_chunk(bounds: tuple[int, int]) -> list[float]:
@@ -255,12 +256,14 @@ def test_the_agreement_map_is_the_same_row_by_row_on_an_executor() -> None:
     joint = Joint(mass=2.0, clearance=1e-4, compression_stiffness=8e7)
     omegas, forces = [2 * np.pi * 300, 2 * np.pi * 500], [300.0, 800.0]
     kwargs = {"restitution": 0.8, "damping_ratio": 0.02}
-    serial = agreement_map(joint, omegas, forces, **kwargs)
+    serial = agreement_map(joint, omegas, forces, **with_losses(kwargs))
     with ThreadPoolExecutor(2) as pool:
-        pooled = agreement_map(joint, omegas, forces, executor=pool, **kwargs)
+        pooled = agreement_map(joint, omegas, forces, executor=pool, **with_losses(kwargs))
     np.testing.assert_array_equal(serial.penetration, pooled.penetration)
     for key, gap in serial.gap.items():
         np.testing.assert_array_equal(gap, pooled.gap[key])
     # each row starts from rest at the lowest force: compare() there directly
-    first = compare(joint, 300.0, omegas[1], samples_per_period=128, max_periods=2000, **kwargs)
+    first = compare(
+        joint, 300.0, omegas[1], samples_per_period=128, max_periods=2000, **with_losses(kwargs)
+    )
     assert serial.penetration[1, 0] == first.penetration

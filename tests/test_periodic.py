@@ -13,10 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from clearjoint import Friction, Joint, ParameterError
+from clearjoint import Friction, Joint, Losses, ParameterError
 from clearjoint.periodic import FrequencyResponse, frequency_response, periodic_orbit
 from clearjoint.simulate import SimulationError, frequency_sweep, steady_state, time_response
 from clearjoint.stiffness import equivalent_linear_response
+from helpers import with_losses
 
 #: pyHarm's SDOF clearance case: m = 1, c_v = 0.05, k0 = 1, edges at +-0.1745, contact adds 3.
 PYHARM = Joint(
@@ -41,7 +42,7 @@ ONE_SIDED = Joint(
 
 @pytest.fixture(scope="module")
 def curve() -> FrequencyResponse:
-    return frequency_response(PYHARM, F0, 0.05, 1.8, damping_ratio=ZETA)
+    return frequency_response(PYHARM, F0, 0.05, 1.8, losses=Losses(damping_ratio=ZETA))
 
 
 def _relative(a: np.ndarray, b: np.ndarray) -> float:
@@ -57,9 +58,9 @@ def _relative(a: np.ndarray, b: np.ndarray) -> float:
     ],
 )
 def test_stable_orbit_agrees_with_steady_state(omega: float, losses: dict[str, object]) -> None:
-    orbit = periodic_orbit(PYHARM, F0, omega, **losses)  # type: ignore[arg-type]
+    orbit = periodic_orbit(PYHARM, F0, omega, **with_losses(losses))  # type: ignore[arg-type]
     assert orbit.stable
-    ss = steady_state(PYHARM, F0, omega, initial=orbit.initial_state, **losses)  # type: ignore[arg-type]
+    ss = steady_state(PYHARM, F0, omega, initial=orbit.initial_state, **with_losses(losses))  # type: ignore[arg-type]
     assert ss.period_multiple == 1
     scale = np.array([orbit.amplitude, orbit.amplitude * omega])
     assert np.max(np.abs(np.subtract(ss.initial_state[:2], orbit.initial_state)) / scale) < 1e-9
@@ -72,15 +73,22 @@ def test_stable_orbit_agrees_with_steady_state(omega: float, losses: dict[str, o
 
 def test_period_2_orbit_is_found_and_matches_steady_state() -> None:
     omega = 2.786
-    ss = steady_state(ONE_SIDED, 1.0, omega, damping_ratio=0.05)
+    ss = steady_state(ONE_SIDED, 1.0, omega, losses=Losses(damping_ratio=0.05))
     assert ss.period_multiple == 2
-    orbit = periodic_orbit(ONE_SIDED, 1.0, omega, damping_ratio=0.05, period_multiple=2)
+    orbit = periodic_orbit(
+        ONE_SIDED, 1.0, omega, losses=Losses(damping_ratio=0.05), period_multiple=2
+    )
     assert orbit.stable
     assert orbit.cycle.period_multiple == 2
     # the same orbit, possibly started one forcing period later
     starts = [np.array(ss.initial_state[:2])]
     back = time_response(
-        ONE_SIDED, 1.0, omega, 2 * math.pi / omega, initial=ss.initial_state[:2], damping_ratio=0.05
+        ONE_SIDED,
+        1.0,
+        omega,
+        2 * math.pi / omega,
+        initial=ss.initial_state[:2],
+        losses=Losses(damping_ratio=0.05),
     )
     starts.append(np.array(back.final_state))
     scale = np.array([orbit.amplitude, orbit.amplitude * omega])
@@ -91,7 +99,12 @@ def _distance_after(orbit_state: tuple[float, float], omega: float, periods: int
     """Relative distance from the orbit's start after ``periods`` periods from a 1e-6 offset."""
     start = np.array(orbit_state) + np.array([1e-6, 0.0])
     motion = time_response(
-        PYHARM, F0, omega, periods * 2 * math.pi / omega, initial=start, damping_ratio=ZETA
+        PYHARM,
+        F0,
+        omega,
+        periods * 2 * math.pi / omega,
+        initial=start,
+        losses=Losses(damping_ratio=ZETA),
     )
     return float(abs(motion.final_state[0] - orbit_state[0]))
 
@@ -108,14 +121,18 @@ def test_unstable_orbit_leaves_and_stable_orbit_returns(curve: FrequencyResponse
     assert len(unstable) == 1
     assert len(stable) == 2
     orbit_u = periodic_orbit(
-        PYHARM, F0, omega, damping_ratio=ZETA, initial=curve.initial_state[unstable[0]]
+        PYHARM,
+        F0,
+        omega,
+        losses=Losses(damping_ratio=ZETA),
+        initial=curve.initial_state[unstable[0]],
     )
     assert not orbit_u.stable
     assert np.max(np.abs(orbit_u.multipliers)) > 1.0
     assert _distance_after(orbit_u.initial_state, omega, 60) > 1e-3  # left: 1000x the offset
     for i in stable:
         orbit_s = periodic_orbit(
-            PYHARM, F0, omega, damping_ratio=ZETA, initial=curve.initial_state[i]
+            PYHARM, F0, omega, losses=Losses(damping_ratio=ZETA), initial=curve.initial_state[i]
         )
         assert orbit_s.stable
         assert _distance_after(orbit_s.initial_state, omega, 60) < 1e-7  # came back
@@ -174,7 +191,7 @@ def test_stable_points_agree_with_steady_state(curve: FrequencyResponse) -> None
     for i in stable[:: max(1, stable.size // 8)]:
         omega = float(curve.omega[i])
         start = curve.initial_state[i] * (1.0 + 1e-4)  # off the orbit: steady_state must converge
-        ss = steady_state(PYHARM, F0, omega, damping_ratio=ZETA, initial=start)
+        ss = steady_state(PYHARM, F0, omega, losses=Losses(damping_ratio=ZETA), initial=start)
         scale = curve.amplitude[i]
         assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
         assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
@@ -190,9 +207,9 @@ def test_energy_ledger_closes_on_every_point(curve: FrequencyResponse) -> None:
 
 def test_period_doubling_where_a_sweep_finds_period_2_orbits() -> None:
     grid = np.array([2.0, 2.6, 3.0, 3.6])
-    sweep = frequency_sweep(ONE_SIDED, 1.0, grid, direction="up", damping_ratio=0.05)
+    sweep = frequency_sweep(ONE_SIDED, 1.0, grid, direction="up", losses=Losses(damping_ratio=0.05))
     assert list(sweep.multiple_up) == [1, 2, 2, 1]
-    fr = frequency_response(ONE_SIDED, 1.0, 1.8, 3.8, damping_ratio=0.05)
+    fr = frequency_response(ONE_SIDED, 1.0, 1.8, 3.8, losses=Losses(damping_ratio=0.05))
     doublings = sorted(e.omega for e in fr.events if e.kind == "period_doubling")
     assert len(doublings) == 2
     assert 2.0 < doublings[0] < 2.6
@@ -206,7 +223,13 @@ def test_period_doubling_where_a_sweep_finds_period_2_orbits() -> None:
 def test_force_continuation_is_linear_inside_the_gap_and_meets_steady_state() -> None:
     omega = 0.6
     fr = frequency_response(
-        PYHARM, 0.01, omega, None, damping_ratio=ZETA, parameter="force", force_stop=0.2
+        PYHARM,
+        0.01,
+        omega,
+        None,
+        losses=Losses(damping_ratio=ZETA),
+        parameter="force",
+        force_stop=0.2,
     )
     assert fr.stop_reason == "reached"
     assert np.all(fr.omega == omega)
@@ -215,7 +238,7 @@ def test_force_continuation_is_linear_inside_the_gap_and_meets_steady_state() ->
     gain = 1.0 / math.hypot(1.0 - omega**2, 0.05 * omega)
     assert _relative(fr.amplitude[inside], fr.force_amplitude[inside] * gain) < 1e-9
     assert any(e.kind == "grazing" for e in fr.events)
-    ss = steady_state(PYHARM, 0.2, omega, damping_ratio=ZETA)
+    ss = steady_state(PYHARM, 0.2, omega, losses=Losses(damping_ratio=ZETA))
     assert fr.amplitude[-1] == pytest.approx(ss.amplitude, rel=1e-9)
 
 
@@ -258,7 +281,7 @@ def test_eq7_shortcut_holds_off_the_peak_and_misses_the_fold(curve: FrequencyRes
 )
 def test_bad_input_is_one_clear_error(kwargs: dict[str, object], match: str) -> None:
     with pytest.raises(ParameterError, match=match):
-        frequency_response(PYHARM, F0, **kwargs)  # type: ignore[arg-type]
+        frequency_response(PYHARM, F0, **with_losses(kwargs))  # type: ignore[arg-type]
 
 
 def test_result_repr_plot_and_xarray(curve: FrequencyResponse) -> None:
@@ -326,7 +349,7 @@ def test_study_curve_crosses_the_grazing_with_impacts_near_69_hz() -> None:
     joint, kw = _study_losses()
     force = float(kw.pop("force"))  # type: ignore[arg-type]
     hz = 2.0 * math.pi
-    curve = frequency_response(joint, force, 20.0 * hz, 72.0 * hz, **kw)  # type: ignore[arg-type]
+    curve = frequency_response(joint, force, 20.0 * hz, 72.0 * hz, **with_losses(kw))  # type: ignore[arg-type]
     assert curve.stop_reason == "reached"
     assert curve.omega[-1] == pytest.approx(72.0 * hz)
     kinks = [e for e in curve.events if e.kind == "grazing" and 69.0 < e.omega / hz < 70.0]
@@ -341,7 +364,7 @@ def test_study_curve_crosses_the_grazing_with_impacts_near_69_hz() -> None:
     assert past.size > 5
     for i in past[:: max(1, past.size // 4)]:
         start = curve.initial_state[i] * (1.0 + 1e-6)
-        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **with_losses(kw))  # type: ignore[arg-type]
         assert ss.period_multiple == 1
         scale = curve.amplitude[i]
         assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
@@ -357,7 +380,7 @@ def test_study_curve_turns_back_where_sticking_begins_near_74_hz() -> None:
     joint, kw = _study_losses()
     force = float(kw.pop("force"))  # type: ignore[arg-type]
     hz = 2.0 * math.pi
-    curve = frequency_response(joint, force, 72.0 * hz, 78.0 * hz, **kw)  # type: ignore[arg-type]
+    curve = frequency_response(joint, force, 72.0 * hz, 78.0 * hz, **with_losses(kw))  # type: ignore[arg-type]
     assert curve.stop_reason == "reached"
     corner = [e for e in curve.events if "sticking begins" in e.note and "turns back" in e.note]
     assert len(corner) == 1
@@ -377,7 +400,7 @@ def test_study_curve_turns_back_where_sticking_begins_near_74_hz() -> None:
     assert past.size > 5
     for i in past[:: max(1, past.size // 3)]:
         start = curve.initial_state[i] * (1.0 + 1e-6)
-        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **with_losses(kw))  # type: ignore[arg-type]
         assert ss.period_multiple == 1
         assert ss.stick_time > 0.0
         scale = curve.amplitude[i]
@@ -388,7 +411,9 @@ def test_study_curve_turns_back_where_sticking_begins_near_74_hz() -> None:
 def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
     # e = 0.8: the impacts make the map square-root singular where the orbit first touches
     # the edges (omega ~ 0.913) and where the unstable branch meets the lower one (~1.0785)
-    curve = frequency_response(PYHARM, F0, 0.05, 1.8, damping_ratio=ZETA, restitution=0.8)
+    curve = frequency_response(
+        PYHARM, F0, 0.05, 1.8, losses=Losses(damping_ratio=ZETA, restitution=0.8)
+    )
     assert curve.stop_reason == "reached"
     assert curve.omega[-1] == pytest.approx(1.8)
     grazing = sorted(e.omega for e in curve.events if e.kind == "grazing")
@@ -409,7 +434,11 @@ def test_restitution_curve_of_the_pyharm_case_passes_both_grazings() -> None:
     for i in stable[:: max(1, stable.size // 6)]:
         start = curve.initial_state[i] * (1.0 + 1e-6)
         ss = steady_state(
-            PYHARM, F0, float(curve.omega[i]), damping_ratio=ZETA, restitution=0.8, initial=start
+            PYHARM,
+            F0,
+            float(curve.omega[i]),
+            losses=Losses(damping_ratio=ZETA, restitution=0.8),
+            initial=start,
         )
         scale = curve.amplitude[i]
         assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
@@ -423,7 +452,7 @@ def test_compiled_corrector_matches_the_generic_one() -> None:
     from clearjoint.exact.single import parameters as _parameters
     from clearjoint.periodic import _map_residual
 
-    orbit = periodic_orbit(PYHARM, F0, 1.3, damping_ratio=ZETA)
+    orbit = periodic_orbit(PYHARM, F0, 1.3, losses=Losses(damping_ratio=ZETA))
     p = _parameters(PYHARM, F0, 1.3, ZETA, None, 1.0)
     residual = _map_residual(p, "omega")
     scale = np.array([0.2, 0.26, 1.75])
@@ -447,7 +476,7 @@ def test_compiled_corrector_matches_the_generic_one() -> None:
 
 
 def test_branch_switching_at_each_period_doubling_finds_the_period_2_orbit() -> None:
-    fr = frequency_response(ONE_SIDED, 1.0, 1.8, 3.8, damping_ratio=0.05)
+    fr = frequency_response(ONE_SIDED, 1.0, 1.8, 3.8, losses=Losses(damping_ratio=0.05))
     doublings = [e for e in fr.events if e.kind == "period_doubling"]
     assert len(doublings) == 2
     for event in doublings:
@@ -459,12 +488,18 @@ def test_branch_switching_at_each_period_doubling_finds_the_period_2_orbit() -> 
         z = np.array(orbit.initial_state)
         scale = np.array([orbit.amplitude, orbit.amplitude * omega])
         # by time marching (no Newton): back after two forcing periods, not after one
-        one = time_response(ONE_SIDED, 1.0, omega, period, initial=z, damping_ratio=0.05)
-        two = time_response(ONE_SIDED, 1.0, omega, 2 * period, initial=z, damping_ratio=0.05)
+        one = time_response(
+            ONE_SIDED, 1.0, omega, period, initial=z, losses=Losses(damping_ratio=0.05)
+        )
+        two = time_response(
+            ONE_SIDED, 1.0, omega, 2 * period, initial=z, losses=Losses(damping_ratio=0.05)
+        )
         assert np.max(np.abs(np.array(two.final_state) - z) / scale) < 1e-9
         assert np.max(np.abs(np.array(one.final_state) - z) / scale) > 1e-3
         if orbit.stable:  # and steady_state from off the orbit settles on it
-            ss = steady_state(ONE_SIDED, 1.0, omega, damping_ratio=0.05, initial=z * (1.0 + 1e-6))
+            ss = steady_state(
+                ONE_SIDED, 1.0, omega, losses=Losses(damping_ratio=0.05), initial=z * (1.0 + 1e-6)
+            )
             assert ss.period_multiple == 2
             assert abs(ss.x_max - orbit.x_max) / orbit.amplitude < 1e-9
             assert abs(ss.x_min - orbit.x_min) / orbit.amplitude < 1e-9
@@ -488,11 +523,11 @@ def test_study_curve_goes_on_past_the_grazing_fold_near_104_hz_from_an_orbit_fur
     force = float(kw.pop("force"))  # type: ignore[arg-type]
     hz = 2.0 * math.pi
     monkeypatch.setattr(periodic, "_REJOINS", 0)
-    stuck = frequency_response(joint, force, 100.0 * hz, 115.0 * hz, **kw)  # type: ignore[arg-type]
+    stuck = frequency_response(joint, force, 100.0 * hz, 115.0 * hz, **with_losses(kw))  # type: ignore[arg-type]
     assert stuck.stop_reason.startswith(("ran back", "step too small"))
     assert stuck.omega.max() / hz < 106.7
     monkeypatch.undo()
-    curve = frequency_response(joint, force, 100.0 * hz, 115.0 * hz, **kw)  # type: ignore[arg-type]
+    curve = frequency_response(joint, force, 100.0 * hz, 115.0 * hz, **with_losses(kw))  # type: ignore[arg-type]
     assert curve.stop_reason == "reached"
     assert curve.omega[-1] / hz == pytest.approx(115.0)
     # the part past the old stop: each sampled stable orbit by time marching from off it
@@ -504,13 +539,13 @@ def test_study_curve_goes_on_past_the_grazing_fold_near_104_hz_from_an_orbit_fur
     assert past.size >= 3
     for i in past:
         start = curve.initial_state[i] * (1.0 + 1e-6)
-        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **with_losses(kw))  # type: ignore[arg-type]
         assert ss.period_multiple == 1
         scale = curve.amplitude[i]
         assert abs(ss.x_max - curve.x_max[i]) / scale < 1e-9
         assert abs(ss.x_min - curve.x_min[i]) / scale < 1e-9
     # and the stable orbit a long transient from rest settles on at 105 Hz is on the curve
-    rest = steady_state(joint, force, 105.0 * hz, **kw)  # type: ignore[arg-type]
+    rest = steady_state(joint, force, 105.0 * hz, **with_losses(kw))  # type: ignore[arg-type]
     assert rest.period_multiple == 1
     on = np.nonzero(np.abs(curve.omega / hz - 105.0) < 0.05)[0]
     assert np.min(np.abs(curve.amplitude[on] - rest.amplitude)) < 1e-3 * rest.amplitude
@@ -524,7 +559,7 @@ def test_compiled_ordinary_step_follows_the_same_branch_as_the_python_one() -> N
     from clearjoint.exact.single import parameters as _parameters
     from clearjoint.periodic import _map_residual
 
-    orbit = periodic_orbit(PYHARM, F0, 1.0, damping_ratio=ZETA)
+    orbit = periodic_orbit(PYHARM, F0, 1.0, losses=Losses(damping_ratio=ZETA))
     p = _parameters(PYHARM, F0, 1.0, ZETA, None, 1.0)
     residual = _map_residual(p, "omega")
 
@@ -556,7 +591,7 @@ def test_study_unstable_branch_passes_where_the_section_sits_on_an_impact_near_6
     joint, kw = _study_losses()
     force = float(kw.pop("force"))  # type: ignore[arg-type]
     hz = 2.0 * math.pi
-    curve = frequency_response(joint, force, 500.0 * hz, 720.0 * hz, **kw)  # type: ignore[arg-type]
+    curve = frequency_response(joint, force, 500.0 * hz, 720.0 * hz, **with_losses(kw))  # type: ignore[arg-type]
     assert curve.stop_reason == "reached"
     f = curve.omega / hz
     assert f.min() < 490.0  # on down past 636.04 Hz, the way it was going
@@ -584,7 +619,7 @@ def test_study_unstable_branch_passes_where_the_section_sits_on_an_impact_near_6
         w = float(curve.omega[i])
         z = curve.initial_state[i]
         size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
-        one = time_response(joint, force, w, 2.0 * math.pi / w, initial=z, **kw)  # type: ignore[arg-type]
+        one = time_response(joint, force, w, 2.0 * math.pi / w, initial=z, **with_losses(kw))  # type: ignore[arg-type]
         assert np.max(np.abs(np.array(one.final_state) - z) / size) < 1e-8
         kicked = time_response(
             joint,
@@ -592,7 +627,7 @@ def test_study_unstable_branch_passes_where_the_section_sits_on_an_impact_near_6
             w,
             60 * 2.0 * math.pi / w,
             initial=z + 1e-6 * size,
-            **kw,  # type: ignore[arg-type]
+            **with_losses(kw),  # type: ignore[arg-type]
         )
         assert np.max(np.abs(np.array(kicked.final_state) - z) / size) > 1e-3
 
@@ -607,7 +642,13 @@ def test_reached_means_the_curve_ends_at_the_end_of_the_range() -> None:
     joint, kw = _study_losses()
     kw.pop("force")
     fr = frequency_response(
-        joint, 2000.0, 2 * math.pi * 400.0, None, parameter="force", force_stop=100.0, **kw
+        joint,
+        2000.0,
+        2 * math.pi * 400.0,
+        None,
+        parameter="force",
+        force_stop=100.0,
+        **with_losses(kw),
     )  # type: ignore[arg-type]
     if fr.stop_reason == "reached":
         assert fr.force_amplitude[-1] == pytest.approx(100.0, rel=1e-12)
@@ -623,7 +664,9 @@ def test_a_period_doubling_at_a_kink_is_not_said_to_pass_minus_1() -> None:
     # Only where the multipliers on both sides are near -1 does one pass -1 smoothly.
     joint, kw = _study_losses()
     force = kw.pop("force")
-    fr = frequency_response(joint, force, 2 * math.pi * 400.0, 2 * math.pi * 300.0, **kw)  # type: ignore[arg-type]
+    fr = frequency_response(
+        joint, force, 2 * math.pi * 400.0, 2 * math.pi * 300.0, **with_losses(kw)
+    )  # type: ignore[arg-type]
     doublings = [e for e in fr.events if e.kind == "period_doubling"]
     assert len(doublings) == 3
     f = fr.omega / (2 * math.pi)

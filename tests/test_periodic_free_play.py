@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from clearjoint import Joint
+from clearjoint import Joint, Losses
 from clearjoint.periodic import FrequencyResponse, frequency_response
 from clearjoint.simulate import SimulationError, steady_state, time_response
+from helpers import with_losses
 
 #: k0 = 0, symmetric contact 100 N/m, edges at +-0.1; forced past the contact resonance.
 FREE = Joint(mass=1.0, clearance=0.2, compression_stiffness=100.0, tension_stiffness=100.0)
@@ -27,7 +28,9 @@ C_V = 2.0
 
 @pytest.fixture(scope="module")
 def curve() -> FrequencyResponse:
-    return frequency_response(FREE, 1.0, 2.0, 12.0, damping_ratio=ZETA, restitution=0.8)
+    return frequency_response(
+        FREE, 1.0, 2.0, 12.0, losses=Losses(damping_ratio=ZETA, restitution=0.8)
+    )
 
 
 def _free_mass_amplitude(w: np.ndarray | float) -> np.ndarray | float:
@@ -83,7 +86,12 @@ def test_free_play_orbit_closes_from_any_mean_position(curve: FrequencyResponse)
     for shift in (0.0, 0.5 * room, -0.9 * room):
         start = curve.initial_state[i] + np.array([shift, 0.0])
         motion = time_response(
-            FREE, 1.0, w, 3 * 2.0 * math.pi / w, initial=start, damping_ratio=ZETA, restitution=0.8
+            FREE,
+            1.0,
+            w,
+            3 * 2.0 * math.pi / w,
+            initial=start,
+            losses=Losses(damping_ratio=ZETA, restitution=0.8),
         )
         end = np.array(motion.final_state)
         assert np.max(np.abs(end - start) / np.array([0.1, 0.1 * w])) < 1e-9
@@ -108,7 +116,9 @@ def study_curve() -> tuple[FrequencyResponse, Joint, dict[str, object], float]:
         "restitution": study.restitution,
     }
     hz = 2.0 * math.pi
-    curve = frequency_response(study.joint, study.force_amplitude, 20 * hz, 900 * hz, **kw)  # type: ignore[arg-type]
+    curve = frequency_response(
+        study.joint, study.force_amplitude, 20 * hz, 900 * hz, **with_losses(kw)
+    )  # type: ignore[arg-type]
     return curve, study.joint, kw, study.force_amplitude
 
 
@@ -136,7 +146,7 @@ def test_study_curve_is_whole_from_20_to_900_hz_with_the_default_options(
     assert upper.size > 10
     for i in upper[:: max(1, upper.size // 3)]:
         start = curve.initial_state[i] * (1.0 + 1e-6)
-        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **kw)  # type: ignore[arg-type]
+        ss = steady_state(joint, force, float(curve.omega[i]), initial=start, **with_losses(kw))  # type: ignore[arg-type]
         assert ss.period_multiple == 1
         assert abs(ss.x_max - curve.x_max[i]) / curve.amplitude[i] < 1e-9
 
@@ -153,14 +163,16 @@ def test_above_the_resonance_every_start_settles_inside_the_gap(
     w = float(curve.omega[i])
     means = []
     for start in ((0.0, 0.0), (4e-5, 0.0), (-6e-5, -0.5), (1e-4, 0.5)):
-        motion = time_response(joint, force, w, 150 * 2 * math.pi / w, initial=start, **kw)  # type: ignore[arg-type]
+        motion = time_response(
+            joint, force, w, 150 * 2 * math.pi / w, initial=start, **with_losses(kw)
+        )  # type: ignore[arg-type]
         last = time_response(
             joint,
             force,
             w,
             2 * math.pi / w,
             initial=motion.final_state,
-            **kw,  # type: ignore[arg-type]
+            **with_losses(kw),  # type: ignore[arg-type]
         )
         assert last.x_max < joint.compression_gap
         assert last.x_min > -joint.tension_gap
@@ -172,7 +184,9 @@ def test_above_the_resonance_every_start_settles_inside_the_gap(
 def test_a_curve_started_on_a_free_play_orbit_is_followed_from_the_other_end(
     curve: FrequencyResponse,
 ) -> None:
-    down = frequency_response(FREE, 1.0, 12.0, 2.0, damping_ratio=ZETA, restitution=0.8)
+    down = frequency_response(
+        FREE, 1.0, 12.0, 2.0, losses=Losses(damping_ratio=ZETA, restitution=0.8)
+    )
     assert down.stop_reason == "reached"
     assert down.omega[0] == pytest.approx(12.0)
     assert down.omega[-1] == pytest.approx(2.0)
@@ -184,7 +198,9 @@ def test_a_curve_started_on_a_free_play_orbit_is_followed_from_the_other_end(
     assert np.array_equal(down.omega, curve.omega[::-1])
     # both ends on free-play orbits: no single curve, said so
     with pytest.raises(SimulationError, match="multiplier of exactly 1"):
-        frequency_response(FREE, 1.0, 10.0, 12.0, damping_ratio=ZETA, restitution=0.8)
+        frequency_response(
+            FREE, 1.0, 10.0, 12.0, losses=Losses(damping_ratio=ZETA, restitution=0.8)
+        )
 
 
 #: the fixed frequency of the force curves (rad/s), below the contact resonance sqrt(100/1)
@@ -194,7 +210,13 @@ W_F = 4.0
 @pytest.fixture(scope="module")
 def force_curve() -> FrequencyResponse:
     return frequency_response(
-        FREE, 0.5, W_F, None, parameter="force", force_stop=5.0, damping_ratio=ZETA, restitution=0.8
+        FREE,
+        0.5,
+        W_F,
+        None,
+        parameter="force",
+        force_stop=5.0,
+        losses=Losses(damping_ratio=ZETA, restitution=0.8),
     )
 
 
@@ -257,12 +279,12 @@ def test_force_curve_contact_orbits_by_time_marching(force_curve: FrequencyRespo
     for i in (*stable[:: stable.size // 3], *unstable[:: unstable.size // 3]):
         f, z = float(curve.force_amplitude[i]), curve.initial_state[i]
         size = np.array([curve.amplitude[i], curve.amplitude[i] * W_F])
-        one = time_response(FREE, f, W_F, 2.0 * math.pi / W_F, initial=z, **kw)  # type: ignore[arg-type]
+        one = time_response(FREE, f, W_F, 2.0 * math.pi / W_F, initial=z, **with_losses(kw))  # type: ignore[arg-type]
         assert np.max(np.abs(np.array(one.final_state) - z) / size) < 1e-8
         assert one.x_max == pytest.approx(curve.x_max[i], abs=1e-8 * size[0])
         assert one.x_max > 0.1 or one.x_min < -0.1  # it does reach an edge
         if curve.stable[i]:
-            ss = steady_state(FREE, f, W_F, initial=z * (1.0 + 1e-6), **kw)  # type: ignore[arg-type]
+            ss = steady_state(FREE, f, W_F, initial=z * (1.0 + 1e-6), **with_losses(kw))  # type: ignore[arg-type]
             assert ss.period_multiple == 1
             assert abs(ss.x_max - curve.x_max[i]) / curve.amplitude[i] < 1e-9
 
@@ -271,7 +293,13 @@ def test_force_curve_followed_down_ends_on_the_free_play_orbits(
     force_curve: FrequencyResponse,
 ) -> None:
     down = frequency_response(
-        FREE, 5.0, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA, restitution=0.8
+        FREE,
+        5.0,
+        W_F,
+        None,
+        parameter="force",
+        force_stop=0.5,
+        losses=Losses(damping_ratio=ZETA, restitution=0.8),
     )
     assert down.stop_reason == "reached"
     assert down.free_play is not None
@@ -292,8 +320,7 @@ def test_force_curve_followed_down_ends_on_the_free_play_orbits(
             None,
             parameter="force",
             force_stop=1.0,
-            damping_ratio=ZETA,
-            restitution=0.8,
+            losses=Losses(damping_ratio=ZETA, restitution=0.8),
         )
 
 
@@ -318,7 +345,7 @@ def test_study_force_curve_from_inside_the_gap_by_time_marching() -> None:
         None,
         parameter="force",
         force_stop=2000.0,
-        **kw,  # type: ignore[arg-type]
+        **with_losses(kw),  # type: ignore[arg-type]
     )
     assert curve.stop_reason == "reached"
     assert curve.free_play is not None
@@ -333,7 +360,9 @@ def test_study_force_curve_from_inside_the_gap_by_time_marching() -> None:
         room = gap - float(curve.x_max[i])
         for shift in (0.0, 0.8 * room):
             start = curve.initial_state[i] + np.array([shift, 0.0])
-            one = time_response(study.joint, f, w, 2.0 * math.pi / w, initial=start, **kw)  # type: ignore[arg-type]
+            one = time_response(
+                study.joint, f, w, 2.0 * math.pi / w, initial=start, **with_losses(kw)
+            )  # type: ignore[arg-type]
             size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
             assert np.max(np.abs(np.array(one.final_state) - start) / size) < 1e-8
             assert one.amplitude == pytest.approx(curve.amplitude[i], rel=1e-8)
@@ -349,12 +378,16 @@ def test_study_force_curve_from_inside_the_gap_by_time_marching() -> None:
     for i, start, inside in ((j, curve.initial_state[j] * np.array([1.0, 1.01]), True),
                              (k, np.zeros(2), False)):  # fmt: skip
         f = float(curve.force_amplitude[i])
-        motion = time_response(study.joint, f, w, 100 * period, initial=start, **kw)  # type: ignore[arg-type]
-        last = time_response(study.joint, f, w, period, initial=motion.final_state, **kw)  # type: ignore[arg-type]
+        motion = time_response(study.joint, f, w, 100 * period, initial=start, **with_losses(kw))  # type: ignore[arg-type]
+        last = time_response(
+            study.joint, f, w, period, initial=motion.final_state, **with_losses(kw)
+        )  # type: ignore[arg-type]
         assert (last.x_max < gap) == inside
         if inside:
             assert last.amplitude == pytest.approx(curve.amplitude[i], rel=1e-8)
-    ss = steady_state(study.joint, f, w, initial=curve.initial_state[k] * (1.0 + 1e-6), **kw)  # type: ignore[arg-type]
+    ss = steady_state(
+        study.joint, f, w, initial=curve.initial_state[k] * (1.0 + 1e-6), **with_losses(kw)
+    )  # type: ignore[arg-type]
     assert ss.period_multiple == 1
     assert abs(ss.x_max - curve.x_max[k]) / curve.amplitude[k] < 1e-9
     assert last.amplitude == pytest.approx(curve.amplitude[k], rel=1e-6)
@@ -365,7 +398,13 @@ def test_force_curve_from_the_coexistence_region_goes_round_the_fold_to_the_free
     # stable contact orbit; followed down, the curve goes round the fold, up the unstable
     # branch past the start to the junction (2 X = clearance), then down the free play
     curve = frequency_response(
-        FREE, 1.5, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA, restitution=0.8
+        FREE,
+        1.5,
+        W_F,
+        None,
+        parameter="force",
+        force_stop=0.5,
+        losses=Losses(damping_ratio=ZETA, restitution=0.8),
     )
     assert curve.stop_reason == "reached"
     assert curve.free_play is not None
@@ -387,9 +426,9 @@ def test_without_impact_loss_the_curve_goes_on_along_the_free_play_too() -> None
     f_g = 0.1 * W_F * math.sqrt(W_F**2 + C_V**2)
     w_g = brentq(lambda w: 2.0 * _free_mass_amplitude(w) - 0.2, 1.0, 10.0)
     by_force = frequency_response(
-        FREE, 5.0, W_F, None, parameter="force", force_stop=0.5, damping_ratio=ZETA
+        FREE, 5.0, W_F, None, parameter="force", force_stop=0.5, losses=Losses(damping_ratio=ZETA)
     )
-    by_omega = frequency_response(FREE, 1.0, 2.0, 12.0, damping_ratio=ZETA)
+    by_omega = frequency_response(FREE, 1.0, 2.0, 12.0, losses=Losses(damping_ratio=ZETA))
     for curve, junction in ((by_force, f_g), (by_omega, w_g)):
         assert curve.stop_reason == "reached"
         fp = curve.free_play
@@ -404,6 +443,8 @@ def test_without_impact_loss_the_curve_goes_on_along_the_free_play_too() -> None
         # the last contact orbit closes under one period of time marching
         i = first - 1
         f, w, z = float(curve.force_amplitude[i]), float(curve.omega[i]), curve.initial_state[i]
-        one = time_response(FREE, f, w, 2.0 * math.pi / w, initial=z, damping_ratio=ZETA)
+        one = time_response(
+            FREE, f, w, 2.0 * math.pi / w, initial=z, losses=Losses(damping_ratio=ZETA)
+        )
         size = np.array([curve.amplitude[i], curve.amplitude[i] * w])
         assert np.max(np.abs(np.array(one.final_state) - z) / size) < 1e-8

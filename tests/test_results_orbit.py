@@ -8,6 +8,8 @@ import matplotlib
 import numpy as np
 import pytest
 
+from clearjoint import Losses
+
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
@@ -19,7 +21,7 @@ from helpers import joint
 
 @pytest.fixture(scope="module")
 def orbit() -> PeriodicOrbit:
-    return periodic_orbit(joint(), 20000.0, 2 * math.pi * 100.0, damping_ratio=0.01)
+    return periodic_orbit(joint(), 20000.0, 2 * math.pi * 100.0, losses=Losses(damping_ratio=0.01))
 
 
 def test_orbit_to_xarray_carries_the_cycle_multipliers_and_monodromy(orbit: PeriodicOrbit) -> None:

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from clearjoint import Friction, Joint, ParameterError, Pin
+from clearjoint import Friction, Joint, Losses, ParameterError, ParameterTypeError, Pin
 from clearjoint.contact import hertz_coefficient
 from clearjoint.simulate import (
     SimulationError,
@@ -19,6 +19,7 @@ from clearjoint.simulate import (
     time_response,
 )
 from clearjoint.simulate.reference import reference_time_response
+from helpers import with_losses
 
 JOINT = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7, tension_stiffness=5e7)
 TWO_PI = 2.0 * math.pi
@@ -27,7 +28,7 @@ TWO_PI = 2.0 * math.pi
 def test_linear_limit_matches_the_textbook_amplitude() -> None:
     linear = Joint(mass=2.0, clearance=0.0, compression_stiffness=8e7)
     omega, zeta, f0 = TWO_PI * 300.0, 0.02, 500.0
-    ss = steady_state(linear, f0, omega, damping_ratio=zeta)
+    ss = steady_state(linear, f0, omega, losses=Losses(damping_ratio=zeta))
     c_v = 2 * zeta * math.sqrt(2.0 * 8e7)
     expected = f0 / math.hypot(8e7 - 2.0 * omega**2, c_v * omega)
     assert ss.period_multiple == 1
@@ -39,7 +40,7 @@ def test_linear_limit_matches_the_textbook_amplitude() -> None:
 def test_orbit_inside_the_gap_is_the_linear_gap_oscillator() -> None:
     joint = dataclasses.replace(JOINT, gap_stiffness=2e6)
     omega, zeta, f0 = TWO_PI * 100.0, 0.05, 50.0
-    ss = steady_state(joint, f0, omega, damping_ratio=zeta)
+    ss = steady_state(joint, f0, omega, losses=Losses(damping_ratio=zeta))
     c_v = 2 * zeta * math.sqrt(2.0 * 8e7)
     expected = f0 / math.hypot(2e6 - 2.0 * omega**2, c_v * omega)
     assert expected < joint.compression_gap
@@ -60,7 +61,7 @@ def test_orbit_inside_the_gap_is_the_linear_gap_oscillator() -> None:
     ids=["viscous", "sliding", "sliding in free-play", "impact", "all together"],
 )
 def test_steady_cycle_balances_input_and_losses(losses: dict[str, object]) -> None:
-    ss = steady_state(JOINT, 1000.0, TWO_PI * 400.0, **losses)  # type: ignore[arg-type]
+    ss = steady_state(JOINT, 1000.0, TWO_PI * 400.0, **with_losses(losses))  # type: ignore[arg-type]
     ledger = ss.energy
     assert ledger.input > 0.0
     assert abs(ledger.input - ledger.losses) / ledger.input < 1e-9
@@ -72,7 +73,9 @@ def test_steady_cycle_balances_input_and_losses(losses: dict[str, object]) -> No
 
 def test_each_impact_removes_beta_m_v_squared() -> None:
     e = 0.7
-    ss = steady_state(JOINT, 1000.0, TWO_PI * 400.0, restitution=e, damping_ratio=0.01)
+    ss = steady_state(
+        JOINT, 1000.0, TWO_PI * 400.0, losses=Losses(restitution=e, damping_ratio=0.01)
+    )
     assert ss.impact_velocities.size >= 2
     beta = (1 - e**2) / 2
     assert ss.energy.impact == pytest.approx(
@@ -85,7 +88,9 @@ def test_each_impact_removes_beta_m_v_squared() -> None:
 
 def test_sliding_friction_over_the_whole_path_is_mu_p_times_the_total_travel() -> None:
     friction = Friction(0.25, 400.0)
-    ss = steady_state(JOINT, 1000.0, TWO_PI * 400.0, friction=friction, samples_per_period=8192)
+    ss = steady_state(
+        JOINT, 1000.0, TWO_PI * 400.0, losses=Losses(friction=friction), samples_per_period=8192
+    )
     closed = np.append(ss.displacement, ss.displacement[0])  # the cycle closes on itself
     travel = float(np.sum(np.abs(np.diff(closed))))
     assert ss.energy.sliding_friction == pytest.approx(friction.force * travel, rel=1e-5)
@@ -112,14 +117,14 @@ def test_steady_orbit_agrees_with_the_solve_ivp_reference(losses: dict[str, obje
         gap_offset=2e-5,
     )
     omega = TWO_PI * 350.0
-    ss = steady_state(joint, 1000.0, omega, **losses)  # type: ignore[arg-type]
+    ss = steady_state(joint, 1000.0, omega, **with_losses(losses))  # type: ignore[arg-type]
     ref = reference_time_response(
         joint,
         1000.0,
         omega,
         ss.period_multiple,
         initial=ss.initial_state[:2],
-        **losses,  # type: ignore[arg-type]
+        **with_losses(losses),  # type: ignore[arg-type]
     )
     assert ref.x_max == pytest.approx(ss.x_max, rel=1e-6)
     assert ref.x_min == pytest.approx(ss.x_min, rel=1e-6)
@@ -133,7 +138,7 @@ def test_sticking_case_holds_still_and_agrees_with_the_reference() -> None:
     wide = Joint(mass=2.0, clearance=2e-3, compression_stiffness=8e7)
     friction = Friction(0.3, 700.0)
     omega = TWO_PI * 20.0
-    ss = steady_state(wide, 300.0, omega, friction=friction)
+    ss = steady_state(wide, 300.0, omega, losses=Losses(friction=friction))
     assert ss.stick_time > 0.2 * ss.period
     still = np.abs(ss.velocity) == 0.0
     assert still.any()
@@ -142,7 +147,7 @@ def test_sticking_case_holds_still_and_agrees_with_the_reference() -> None:
     assert np.all(np.abs(net[still]) <= friction.force * (1 + 1e-9))
     assert abs(ss.energy.input - ss.energy.losses) / ss.energy.input < 1e-9
     ref = reference_time_response(
-        wide, 300.0, omega, 1, initial=ss.initial_state[:2], friction=friction
+        wide, 300.0, omega, 1, initial=ss.initial_state[:2], losses=Losses(friction=friction)
     )
     assert ref.x_max == pytest.approx(ss.x_max, rel=1e-6)
     assert ref.x_min == pytest.approx(ss.x_min, rel=1e-6)
@@ -157,7 +162,7 @@ def test_grazing_contact_is_neither_missed_nor_invented(excess: float) -> None:
     c_v = 2 * zeta * math.sqrt(2.0 * 8e7)
     gain = 1.0 / math.hypot(4e6 - 2.0 * omega**2, c_v * omega)
     f0 = joint.compression_gap * (1 + excess) / gain
-    ss = steady_state(joint, f0, omega, damping_ratio=zeta)
+    ss = steady_state(joint, f0, omega, losses=Losses(damping_ratio=zeta))
     assert ss.x_max == pytest.approx(f0 * gain, rel=1e-9)
     if excess > 0:
         assert ss.impact_velocities.size == 2  # touches both edges, tiny speed
@@ -169,10 +174,12 @@ def test_grazing_contact_is_neither_missed_nor_invented(excess: float) -> None:
 def test_period_two_orbit_is_detected_not_assumed() -> None:
     omega = TWO_PI * 300.0
     kwargs = {"damping_ratio": 0.02, "restitution": 0.8}
-    ss = steady_state(JOINT, 2000.0, omega, **kwargs)  # type: ignore[arg-type]
+    ss = steady_state(JOINT, 2000.0, omega, **with_losses(kwargs))  # type: ignore[arg-type]
     assert ss.period_multiple == 2
     assert ss.period == pytest.approx(2 * TWO_PI / omega)
-    ref = reference_time_response(JOINT, 2000.0, omega, 2, initial=ss.initial_state[:2], **kwargs)  # type: ignore[arg-type]
+    ref = reference_time_response(
+        JOINT, 2000.0, omega, 2, initial=ss.initial_state[:2], **with_losses(kwargs)
+    )  # type: ignore[arg-type]
     x0 = ss.initial_state[0]
     assert abs(ref.strobe[0, 0] - x0) > 1e-3 * ss.amplitude  # not back after one period
     assert ref.strobe[1, 0] == pytest.approx(x0, abs=1e-6 * ss.amplitude)  # back after two
@@ -185,9 +192,7 @@ def test_contact_friction_along_the_orbit_matches_the_closed_form_per_excursion(
         JOINT,
         1000.0,
         TWO_PI * 400.0,
-        damping_ratio=0.02,
-        pin=pin,
-        contact_friction_coefficient=mu_c,
+        losses=Losses(damping_ratio=0.02, pin=pin, contact_friction_coefficient=mu_c),
     )
     beta_h = hertz_coefficient(pin)
     # one excursion 0 -> A -> 0 of F_n = k A: integral of F^1.5 |v| dt = (4/5) k^1.5 A^2.5
@@ -210,7 +215,9 @@ def test_lossless_system_says_why_it_never_settles() -> None:
 
 def test_frequency_sweep_shows_the_jump_and_the_hysteresis() -> None:
     omegas = TWO_PI * np.linspace(600.0, 850.0, 11)
-    sweep = frequency_sweep(JOINT, 2000.0, omegas, damping_ratio=0.02, restitution=0.8)
+    sweep = frequency_sweep(
+        JOINT, 2000.0, omegas, losses=Losses(damping_ratio=0.02, restitution=0.8)
+    )
     gap = sweep.amplitude_up - sweep.amplitude_down
     assert np.nanmax(gap) > 2.0 * np.nanmin(sweep.amplitude_down)  # two branches coexist
     jumps_up = np.abs(np.diff(sweep.amplitude_up)) / sweep.amplitude_up[:-1]
@@ -224,9 +231,7 @@ def test_time_response_balances_over_a_transient() -> None:
         TWO_PI * 250.0,
         0.05,
         initial=(1e-5, 0.0),
-        damping_ratio=0.01,
-        friction=Friction(0.1, 300.0),
-        restitution=0.9,
+        losses=Losses(damping_ratio=0.01, friction=Friction(0.1, 300.0), restitution=0.9),
     )
     assert motion.energy.balance_error < 1e-9
     assert motion.time[-1] < 0.05
@@ -269,11 +274,13 @@ def test_generated_joints_agree_with_the_reference_and_balance(
         "friction": Friction(0.2, friction_load) if friction_load else None,
     }
     periods = 3
-    motion = time_response(joint, force, omega, periods * TWO_PI / omega, **kwargs)  # type: ignore[arg-type]
+    motion = time_response(joint, force, omega, periods * TWO_PI / omega, **with_losses(kwargs))  # type: ignore[arg-type]
     assert motion.energy.balance_error < 1e-9
     # the reference needs short steps to see brief excursions out of a contact
     # (test_brief_exit_from_contact_that_coarse_solve_ivp_steps_miss)
-    ref = reference_time_response(joint, force, omega, periods, steps_per_period=200, **kwargs)  # type: ignore[arg-type]
+    ref = reference_time_response(
+        joint, force, omega, periods, steps_per_period=200, **with_losses(kwargs)
+    )  # type: ignore[arg-type]
     scale = max(motion.x_max - motion.x_min, joint.clearance)
     x_end, v_end = motion.final_state
     assert x_end == pytest.approx(ref.strobe[-1, 0], abs=1e-6 * scale)
@@ -290,9 +297,13 @@ def test_brief_exit_from_contact_that_coarse_solve_ivp_steps_miss() -> None:
     )
     omega = TWO_PI * 242.5
     kwargs = {"damping_ratio": 0.03, "restitution": 0.515625, "friction": Friction(0.2, 12.0)}
-    motion = time_response(joint, 998.0, omega, 3 * TWO_PI / omega, **kwargs)  # type: ignore[arg-type]
-    fine = reference_time_response(joint, 998.0, omega, 3, steps_per_period=2000, **kwargs)  # type: ignore[arg-type]
-    coarse = reference_time_response(joint, 998.0, omega, 3, steps_per_period=20, **kwargs)  # type: ignore[arg-type]
+    motion = time_response(joint, 998.0, omega, 3 * TWO_PI / omega, **with_losses(kwargs))  # type: ignore[arg-type]
+    fine = reference_time_response(
+        joint, 998.0, omega, 3, steps_per_period=2000, **with_losses(kwargs)
+    )  # type: ignore[arg-type]
+    coarse = reference_time_response(
+        joint, 998.0, omega, 3, steps_per_period=20, **with_losses(kwargs)
+    )  # type: ignore[arg-type]
     assert motion.final_state[0] == pytest.approx(fine.strobe[-1, 0], rel=1e-6)
     assert motion.events == fine.events
     assert abs(coarse.strobe[-1, 0] / fine.strobe[-1, 0] - 1) > 1e-2  # the blind spot
@@ -310,12 +321,13 @@ def test_brief_exit_from_contact_that_coarse_solve_ivp_steps_miss() -> None:
     ],
 )
 def test_bad_input_is_refused_with_a_message(kwargs: dict[str, object], words: str) -> None:
-    with pytest.raises(ParameterError, match=words):
-        steady_state(JOINT, 1000.0, 1000.0, **kwargs)  # type: ignore[arg-type]
+    # a loss of the wrong type is refused by Losses, as a ParameterTypeError
+    with pytest.raises((ParameterError, ParameterTypeError), match=words):
+        steady_state(JOINT, 1000.0, 1000.0, **with_losses(kwargs))  # type: ignore[arg-type]
 
 
 def test_bad_frequency_and_force() -> None:
     with pytest.raises(ParameterError, match="omega must be > 0"):
-        steady_state(JOINT, 1000.0, 0.0, damping_ratio=0.1)
+        steady_state(JOINT, 1000.0, 0.0, losses=Losses(damping_ratio=0.1))
     with pytest.raises(ParameterError, match="force_amplitude must be finite"):
-        steady_state(JOINT, math.nan, 10.0, damping_ratio=0.1)
+        steady_state(JOINT, math.nan, 10.0, losses=Losses(damping_ratio=0.1))

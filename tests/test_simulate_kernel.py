@@ -13,7 +13,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from clearjoint import Friction, Joint
+from clearjoint import Friction, Joint, Losses
 from clearjoint.exact import kernel as kn
 from clearjoint.exact import single
 from clearjoint.simulate import time_response
@@ -32,14 +32,14 @@ def test_a_march_that_runs_out_of_steps_raises_instead_of_jumping() -> None:
     # with the JIT off the step limit is read at run time, so one step is enough to hit it
     script = textwrap.dedent(
         """
-        from clearjoint import Friction, Joint
+        from clearjoint import Friction, Joint, Losses
         from clearjoint.exact import kernel as kn
         from clearjoint.simulate import time_response, SimulationError
         kn.MAX_MARCH_STEPS = 1
         joint = Joint(mass=1.0, clearance=0.2, gap_stiffness=1.0, compression_stiffness=4.0)
-        for kwargs in ({}, {"friction": Friction(0.5, 1.0)}):  # moving state, sticking state
+        for losses in (None, Losses(friction=Friction(0.5, 1.0))):  # moving, sticking state
             try:
-                time_response(joint, 1.0, 1.0, 6.0, **kwargs)
+                time_response(joint, 1.0, 1.0, 6.0, losses=losses)
             except SimulationError as error:
                 assert "certified steps" in str(error), error
                 print("raised")
@@ -96,7 +96,9 @@ def test_stiff_contact_runs_and_closes_its_ledger() -> None:
     # free flights were cut into pieces of the contact period / 8 (seconds per call), and a
     # velocity zero below the resolution of the time stalled the march
     omega = 1.0
-    motion = time_response(STIFF, 1.0, omega, 100 * 2 * math.pi / omega, restitution=0.8)
+    motion = time_response(
+        STIFF, 1.0, omega, 100 * 2 * math.pi / omega, losses=Losses(restitution=0.8)
+    )
     assert motion.impact_times.size > 100
     assert motion.energy.balance_error < 1e-9
 
@@ -163,7 +165,9 @@ def test_a_start_at_rest_just_off_zero_follows_the_closed_form(x0: float) -> Non
     # took the tiny acceleration for round-off, zeroed it, and so met the velocity zero at
     # once, again and again ("more than 100000 events ... (chattering)")
     omega = 1.0
-    motion = time_response(STIFF, 1.0, omega, 3 * 2 * math.pi, restitution=0.8, initial=(x0, 0))
+    motion = time_response(
+        STIFF, 1.0, omega, 3 * 2 * math.pi, losses=Losses(restitution=0.8), initial=(x0, 0)
+    )
     # free play with k0 = m w^2 (resonant): x = x0 cos t + (sin t - t cos t) / 2 until x = 0.1
     t = motion.time
     free = t < 0.9 * motion.impact_times[0]
@@ -182,7 +186,12 @@ def test_a_start_just_past_the_friction_limit_sticks_instead_of_looping(ulps: in
     joint = Joint(mass=1.0, clearance=2.0, gap_stiffness=1.0, compression_stiffness=3.0)
     x0 = 0.5 + ulps * float(np.spacing(0.5))
     motion = time_response(
-        joint, 1.0, 1.0, 2 * 2 * math.pi, friction=Friction(0.5, 1.0), initial=(x0, 0.0)
+        joint,
+        1.0,
+        1.0,
+        2 * 2 * math.pi,
+        losses=Losses(friction=Friction(0.5, 1.0)),
+        initial=(x0, 0.0),
     )
     stuck = motion.time < math.pi - 1e-6
     np.testing.assert_allclose(motion.displacement[stuck], x0, rtol=0, atol=1e-12)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from clearjoint import Friction, Joint
+from clearjoint import Friction, Joint, Losses
 from clearjoint.exact.single import STAGE_NAMES, _stages
 from clearjoint.results import Stage
 from clearjoint.simulate import Motion, SteadyState, steady_state, time_response
@@ -22,19 +22,19 @@ TWO_PI = 2.0 * math.pi
 @pytest.fixture(scope="module")
 def cycle() -> SteadyState:
     return steady_state(
-        JOINT, 1000.0, TWO_PI * 400.0, damping_ratio=0.01, restitution=0.8,
-        friction=Friction(0.2, 300.0),
+        JOINT, 1000.0, TWO_PI * 400.0,
+        losses=Losses(damping_ratio=0.01, restitution=0.8, friction=Friction(0.2, 300.0)),
     )  # fmt: skip
 
 
 @pytest.fixture(scope="module")
 def transient() -> Motion:
-    return time_response(JOINT, 500.0, TWO_PI * 300.0, 0.05, damping_ratio=0.02)
+    return time_response(JOINT, 500.0, TWO_PI * 300.0, 0.05, losses=Losses(damping_ratio=0.02))
 
 
 def test_steady_state_repr_is_short_and_gives_the_textbook_amplitude() -> None:
     omega, zeta, f0 = TWO_PI * 300.0, 0.02, 500.0
-    ss = steady_state(LINEAR, f0, omega, damping_ratio=zeta, samples_per_period=4096)
+    ss = steady_state(LINEAR, f0, omega, losses=Losses(damping_ratio=zeta), samples_per_period=4096)
     text = repr(ss)
     assert len(text) < 400
     assert "array" not in text

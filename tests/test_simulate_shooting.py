@@ -7,12 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from clearjoint import Friction, Joint
+from clearjoint import Friction, Joint, Losses
 from clearjoint.exact import shooting as sh
 from clearjoint.exact import single
 from clearjoint.exact.shooting import shoot
 from clearjoint.simulate import steady_state, time_response
 from clearjoint.simulate.reference import reference_time_response
+from helpers import with_losses
 
 #: pyHarm's SDOF clearance case: m = 1, c_v = 0.05, k0 = 1, edges at +-0.1745, contact adds 3.
 PYHARM = Joint(
@@ -127,7 +128,9 @@ def test_parameter_sensitivity_matches_a_central_difference_of_the_map(
         losses.get("restitution", 1.0),  # type: ignore[arg-type]
     )
     z0 = np.array(z, dtype=float)
-    motion = time_response(PYHARM, force, omega, 2 * math.pi / omega, initial=z, **losses)  # type: ignore[arg-type]
+    motion = time_response(
+        PYHARM, force, omega, 2 * math.pi / omega, initial=z, **with_losses(losses)
+    )  # type: ignore[arg-type]
     if case.startswith("sticks"):
         assert motion.stick_time > 0.0
     if case == "free play":
@@ -175,13 +178,13 @@ def _closes_after(
     joint: Joint, force: float, omega: float, ss_state: tuple[float, ...], **kw: object
 ) -> float:
     """|x(T) - x(0)| + |v(T) - v(0)| / omega after one period, by solve_ivp (independent route)."""
-    ref = reference_time_response(joint, force, omega, 1, initial=ss_state[:2], **kw)  # type: ignore[arg-type]
+    ref = reference_time_response(joint, force, omega, 1, initial=ss_state[:2], **with_losses(kw))  # type: ignore[arg-type]
     return float(abs(ref.strobe[0, 0] - ss_state[0]) + abs(ref.strobe[0, 1] - ss_state[1]) / omega)
 
 
 def test_alternating_convergence_is_labelled_period_1() -> None:
     force, omega = 0.6074259728855343, 0.5913488835368865
-    ss = steady_state(ALTERNATING, force, omega, friction=ALTERNATING_FRICTION)
+    ss = steady_state(ALTERNATING, force, omega, losses=Losses(friction=ALTERNATING_FRICTION))
     assert ss.period_multiple == 1
     assert (
         _closes_after(ALTERNATING, force, omega, ss.initial_state, friction=ALTERNATING_FRICTION)
@@ -192,7 +195,9 @@ def test_alternating_convergence_is_labelled_period_1() -> None:
 
 def test_linear_orbit_inside_the_gap_is_labelled_period_1() -> None:
     force, omega = 0.03, 1.5
-    ss = steady_state(PYHARM, force, omega, damping_ratio=PYHARM_ZETA, initial=(0.4, 0.0))
+    ss = steady_state(
+        PYHARM, force, omega, losses=Losses(damping_ratio=PYHARM_ZETA), initial=(0.4, 0.0)
+    )
     assert ss.period_multiple == 1
     # closed form x = a sin(w t) + b cos(w t) of m x'' + c x' + k0 x = F0 sin(w t)
     k, c = 1.0 - omega**2, 0.05

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from clearjoint import Losses
 from clearjoint.cli import main
 from clearjoint.simulate import steady_state
 from clearjoint.simulate.study import StudyError, load_study
@@ -95,7 +96,7 @@ def test_cli_json_and_netcdf_match_the_library(
     assert main(["simulate", str(path), "--json", "--out", str(out)]) == 0
     result = json.loads(capsys.readouterr().out)
     study = load_study(path)
-    direct = steady_state(study.joint, 1000.0, study.omega, damping_ratio=0.02)
+    direct = steady_state(study.joint, 1000.0, study.omega, losses=Losses(damping_ratio=0.02))
     assert result["amplitude_m"] == pytest.approx(direct.amplitude, rel=1e-12)
     assert result["energy_j"]["input"] == pytest.approx(direct.energy.input, rel=1e-12)
     assert result["balance_error"] < 1e-9

@@ -4,12 +4,17 @@ and a system given only as matrices runs every structure solver (MODEL.md 5.2-5.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
 
-from clearjoint import ClearanceJoint
-from clearjoint.harmonic import frequency_response
+from clearjoint import ClearanceJoint, Friction, Joint, Losses, dissipation, periodic
+from clearjoint import simulate as sim
+from clearjoint.errors import ParameterError, ParameterTypeError
+from clearjoint.harmonic import frequency_response, nonlinear_modes
+from clearjoint.joint import LOSS_KEYWORDS
+from clearjoint.simulate.reference import reference_time_response
 from clearjoint.structure import Structure, chain, decay_backbone, free_decay, time_response
 from clearjoint.structure.model import system_modes
 from clearjoint.system import VibrationSystem, VibrationSystemError
@@ -127,3 +132,90 @@ def test_a_consistent_mass_is_refused_by_the_solvers_that_need_a_lumped_one() ->
     with pytest.raises(VibrationSystemError, match="lumped"):
         system_modes(system)
     assert math.isfinite(float(system.mass[0, 1]))
+
+
+# ---- a Joint is the one-DOF case: the single-joint solvers take its system -------------------
+
+
+def _joint_and_losses() -> tuple[Joint, Losses]:
+    joint = Joint(2.0, 1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6, gap_offset=2e-5)
+    return joint, Losses(damping_ratio=0.02, friction=Friction(0.1, 50.0), restitution=0.8)
+
+
+def test_a_joint_and_its_one_dof_system_round_trip() -> None:
+    joint, losses = _joint_and_losses()
+    back, back_losses = VibrationSystem.from_joint(joint, losses).to_joint()
+    assert back == joint
+    assert back_losses.friction == losses.friction
+    assert back_losses.restitution == losses.restitution
+    assert back_losses.damping_ratio == pytest.approx(losses.damping_ratio, rel=1e-15)
+
+
+def test_a_system_spring_in_parallel_is_the_joints_gap_stiffness() -> None:
+    # the same law written two ways: k0 in the joint, or K beside a k0 = 0 joint
+    law = ClearanceJoint(1e-4, 8e7, tension_stiffness=3e7)
+    one = np.ones((1, 1))
+    system = VibrationSystem(2.0 * one, 0.0 * one, 1e6 * one, one, (law,))
+    joint, losses = system.to_joint()
+    assert joint == Joint(2.0, 1e-4, 8e7, tension_stiffness=3e7, gap_stiffness=1e6)
+    assert losses == Losses()
+
+
+def test_the_single_joint_solvers_give_the_same_numbers_for_the_joint_and_its_system() -> None:
+    joint, losses = _joint_and_losses()
+    system = VibrationSystem.from_joint(joint, losses)
+    w = 2.0 * math.pi * 600.0
+    by_joint = sim.time_response(joint, 300.0, w, 0.01, losses=losses)
+    by_system = sim.time_response(system, 300.0, w, 0.01)
+    np.testing.assert_allclose(by_system.displacement, by_joint.displacement, rtol=1e-9, atol=1e-15)
+    orbit_j = periodic.periodic_orbit(joint, 300.0, w, losses=losses)
+    orbit_s = periodic.periodic_orbit(system, 300.0, w)
+    np.testing.assert_allclose(orbit_s.initial_state, orbit_j.initial_state, rtol=1e-9)
+    e_j = dissipation.total(joint, [5e-6, 2e-5], losses=losses)
+    e_s = dissipation.total(system, [5e-6, 2e-5])
+    np.testing.assert_allclose(e_s, e_j, rtol=1e-12)
+
+
+def test_a_system_that_is_not_one_joint_is_refused_by_the_single_joint_solvers(
+    links: Structure,
+) -> None:
+    with pytest.raises(VibrationSystemError, match="one DOF and one joint, got 3 DOFs"):
+        sim.time_response(links.to_system(), 1.0, 100.0, 0.01)
+    joint, losses = _joint_and_losses()
+    with pytest.raises(ParameterError, match="carries its own"):
+        sim.steady_state(VibrationSystem.from_joint(joint), 1.0, 100.0, losses=losses)
+    flipped = VibrationSystem.from_joint(joint)
+    flipped = VibrationSystem(
+        flipped.mass, flipped.damping, flipped.stiffness, -flipped.directions, flipped.laws
+    )
+    with pytest.raises(VibrationSystemError, match="direction b = \\+1"):
+        periodic.periodic_orbit(flipped, 1.0, 100.0)
+
+
+@pytest.mark.parametrize(
+    ("solver", "arguments"),
+    [
+        (sim.time_response, (1.0, 100.0, 0.01)),
+        (sim.steady_state, (1.0, 100.0)),
+        (sim.frequency_sweep, (1.0, [100.0, 200.0])),
+        (reference_time_response, (1.0, 100.0, 2)),
+        (periodic.periodic_orbit, (1.0, 100.0)),
+        (periodic.frequency_response, (1.0, 100.0, 200.0)),
+        (periodic.orbit_cycle, (1.0, 100.0, (0.0, 0.0))),
+        (periodic.orbit_monodromy, (1.0, 100.0, (0.0, 0.0))),
+        (dissipation.total, ([1e-5],)),
+        (dissipation.energies, ([1e-5],)),
+        (dissipation.compare, (1.0, 100.0)),
+        (dissipation.agreement_map, ([100.0], [1.0])),
+        (frequency_response, (1.0, 100.0, 200.0)),
+        (nonlinear_modes, ()),
+    ],
+    ids=lambda v: getattr(v, "__qualname__", ""),
+)
+@pytest.mark.parametrize("keyword", LOSS_KEYWORDS)
+def test_every_solver_refuses_a_loose_loss_keyword_with_the_fix(
+    solver: Any, arguments: tuple[Any, ...], keyword: str
+) -> None:
+    joint, _ = _joint_and_losses()
+    with pytest.raises(ParameterTypeError, match=rf"losses=Losses\({keyword}=0\.5\) instead"):
+        solver(joint, *arguments, **{keyword: 0.5})

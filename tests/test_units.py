@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from clearjoint import Friction, Joint, Pin, stiffness
+from clearjoint import Friction, Joint, Losses, Pin, stiffness
 from clearjoint.errors import ParameterError
 from clearjoint.simulate import steady_state
 from clearjoint.units import parse_quantity, parse_quantity_list, registry, to_si
@@ -112,8 +112,8 @@ def test_the_python_api_takes_units_wherever_it_takes_floats() -> None:
 
 def test_the_simulator_takes_a_frequency_in_hz_for_omega() -> None:
     joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
-    si = steady_state(joint, 1000.0, 2.0 * math.pi * 400.0, damping_ratio=0.02)
-    united = steady_state(joint, "1kN", "400Hz", damping_ratio=0.02)
+    si = steady_state(joint, 1000.0, 2.0 * math.pi * 400.0, losses=Losses(damping_ratio=0.02))
+    united = steady_state(joint, "1kN", "400Hz", losses=Losses(damping_ratio=0.02))
     assert united.amplitude == pytest.approx(si.amplitude, rel=1e-12)
 
 
@@ -123,9 +123,13 @@ def test_sweeps_and_records_take_units_too() -> None:
 
     joint = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
     hz = registry().Quantity(np.array([390.0, 400.0]), "Hz")
-    united = frequency_sweep(joint, "1kN", hz, damping_ratio=0.02, direction="up")
+    united = frequency_sweep(joint, "1kN", hz, losses=Losses(damping_ratio=0.02), direction="up")
     si = frequency_sweep(
-        joint, 1000.0, 2 * math.pi * np.array([390.0, 400.0]), damping_ratio=0.02, direction="up"
+        joint,
+        1000.0,
+        2 * math.pi * np.array([390.0, 400.0]),
+        losses=Losses(damping_ratio=0.02),
+        direction="up",
     )
     np.testing.assert_allclose(united.omega, si.omega, rtol=1e-12)
     np.testing.assert_allclose(united.amplitude_up, si.amplitude_up, rtol=1e-12)

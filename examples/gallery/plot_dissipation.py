@@ -17,7 +17,7 @@ import warnings
 import matplotlib.pyplot as plt
 import numpy as np
 
-from clearjoint import Friction, Joint, Pin
+from clearjoint import Friction, Joint, Losses, Pin
 from clearjoint import dissipation as ds
 from clearjoint.contact import HertzValidityWarning
 from clearjoint.figures import EnergyPanel, agreement_map_figure, dissipation_figure
@@ -44,7 +44,7 @@ for clearance in (0.106e-3, 0.196e-3):
     joint = joint_with(clearance)
     pin = Pin.for_clearance(radius=5e-3, clearance=clearance, length=25e-3)
     grid = np.geomspace(2e-6, 3e-4, 80)
-    closed = ds.energies(joint, grid, pin=pin, **LOSSES)
+    closed = ds.energies(joint, grid, losses=Losses(pin=pin, **LOSSES))
     exact_a, exact = [], {key: [] for key in ds.ENERGY_KEYS if key.endswith("_j")}
     initial = None
     for force in np.geomspace(300.0, 8000.0, 24):
@@ -53,11 +53,10 @@ for clearance in (0.106e-3, 0.196e-3):
                 joint,
                 float(force),
                 2 * math.pi * 400.0,
-                pin=pin,
+                losses=Losses(pin=pin, **LOSSES),
                 initial=initial,
                 samples_per_period=256,
                 max_periods=4000,
-                **LOSSES,
             )
         except SimulationError:
             continue
@@ -88,8 +87,7 @@ survey = ds.agreement_map(
     joint,
     2 * math.pi * np.linspace(100.0, 900.0, 17),
     np.linspace(200.0, 5000.0, 17),
-    pin=pin,
-    **LOSSES,
+    losses=Losses(pin=pin, **LOSSES),
 )
 DOCS_FIGURES["dissipation_agreement_map.png"] = agreement_map_figure(
     survey.omega,
@@ -110,7 +108,7 @@ print(
 # ``energies`` returns an ``Energies``: still a mapping by key, with a summary, a table and
 # its own log-log plot.
 
-values = ds.energies(joint, np.geomspace(2e-6, 1e-4, 40), pin=pin, **LOSSES)
+values = ds.energies(joint, np.geomspace(2e-6, 1e-4, 40), losses=Losses(pin=pin, **LOSSES))
 print(values)
 print(values.to_pandas()[["impact_j", "total_j", "loss_factor"]].iloc[::13])
 ax = values.plot()

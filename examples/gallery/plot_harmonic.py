@@ -16,7 +16,7 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
-from clearjoint import Joint, stiffness
+from clearjoint import Joint, Losses, stiffness
 from clearjoint.harmonic import frequency_response, nonlinear_modes
 from clearjoint.periodic import frequency_response as exact_response
 
@@ -26,7 +26,9 @@ PYHARM = Joint(mass=1.0, clearance=2 * 0.1745, compression_stiffness=3.0, gap_st
 ZETA = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 0.05 as a damping ratio of the contact state
 PAPER = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
 
-hb = frequency_response(PYHARM, 0.03, 0.5, 1.8, harmonics=12, damping_ratio=ZETA, max_step=0.05)
+hb = frequency_response(
+    PYHARM, 0.03, 0.5, 1.8, harmonics=12, losses=Losses(damping_ratio=ZETA), max_step=0.05
+)
 ex = exact_response(PYHARM, 0.03, 0.5, 1.8, damping_ratio=ZETA)
 print(hb)
 print(ex)
@@ -41,7 +43,7 @@ DOCS_FIGURES["harmonic_frf.png"] = fig
 # The nonlinear mode and the paper's dynamic stiffness as its backbone.
 
 amplitudes = np.geomspace(50e-6, 3e-3, 40)
-nm = nonlinear_modes(PAPER, 1, amplitudes, harmonics=15, damping_ratio=0.02)
+nm = nonlinear_modes(PAPER, 1, amplitudes, harmonics=15, losses=Losses(damping_ratio=0.02))
 print(nm)
 fig, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
 nm.plot(ax=ax)

@@ -15,7 +15,7 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
-from clearjoint import Joint
+from clearjoint import Joint, Losses
 from clearjoint.periodic import frequency_response
 from clearjoint.stiffness import equivalent_linear_response
 
@@ -29,7 +29,7 @@ joint = Joint(
     tension_stiffness=3.0,
 )
 zeta = 0.05 / (2.0 * math.sqrt(3.0))  # c_v = 2 zeta sqrt(m k_c) = 0.05
-curve = frequency_response(joint, 0.03, 0.05, 1.8, damping_ratio=zeta)
+curve = frequency_response(joint, 0.03, 0.05, 1.8, losses=Losses(damping_ratio=zeta))
 print(curve)
 
 fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2))
@@ -57,7 +57,7 @@ one_sided = Joint(
     compression_stiffness=20.0,
     tension_stiffness=1e-3,
 )
-doubling = frequency_response(one_sided, 1.0, 1.5, 4.5, damping_ratio=0.05)
+doubling = frequency_response(one_sided, 1.0, 1.5, 4.5, losses=Losses(damping_ratio=0.05))
 print(doubling)
 doubling.plot(axes[1])
 axes[1].set_title("One-sided contact (k_c = 20 k0, F0 = 1): period doubling")

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
+from clearjoint import Losses
 from clearjoint.periodic import frequency_response
 from clearjoint.simulate.study import load_study
 
@@ -34,9 +35,9 @@ curve = frequency_response(
     study.force_amplitude,
     20.0 * hz,
     900.0 * hz,
-    damping_ratio=study.damping_ratio,
-    friction=study.friction,
-    restitution=study.restitution,
+    losses=Losses(
+        damping_ratio=study.damping_ratio, friction=study.friction, restitution=study.restitution
+    ),
 )
 print(curve)
 print(f"{time.perf_counter() - start:.1f} s")

@@ -12,7 +12,7 @@ import math
 
 import matplotlib.pyplot as plt
 
-from clearjoint import Friction, Joint
+from clearjoint import Friction, Joint, Losses
 from clearjoint.figures import displacement_stages_figure, force_displacement_figure
 from clearjoint.simulate import steady_state
 
@@ -23,9 +23,7 @@ cycle = steady_state(
     joint,
     1000.0,  # F0, N
     2 * math.pi * 400.0,  # omega, rad/s
-    damping_ratio=0.01,
-    restitution=0.8,
-    friction=Friction(0.2, 300.0),
+    losses=Losses(damping_ratio=0.01, restitution=0.8, friction=Friction(0.2, 300.0)),
     samples_per_period=512,
 )
 print(cycle)  # a SteadyState: its short summary

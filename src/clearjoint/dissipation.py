@@ -33,9 +33,10 @@ from numpy.typing import ArrayLike, NDArray
 from clearjoint import checks as _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ParameterError
-from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
+from clearjoint.joint import Friction, Joint, Losses, Pin, takes_losses
 from clearjoint.simulate import SteadyState, steady_state
 from clearjoint.stiffness import FreeOrbit, free_orbit, viscous_coefficient
+from clearjoint.system import VibrationSystem, as_joint
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -156,29 +157,28 @@ def _viscous(orbit: FreeOrbit, c_v: float) -> FloatArray:
     return c_v * (orbit.contact_action + orbit.free_play_action)
 
 
+@takes_losses
 def total(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     amplitude: ArrayLike,
     *,
-    friction: Friction | None = None,
-    pin: Pin | None = None,
-    contact_friction_coefficient: float = 0.0,
-    restitution: float = 1.0,
-    damping_ratio: float = 0.0,
     form: Literal["exact", "paper"] = "exact",
     losses: Losses | None = None,
 ) -> FloatArray:
-    """Return E_Z = E_P + E_C + E_I (+ viscous) per free cycle at penetration A, J (eq 17)."""
-    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
-        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
-    )
-    result = impact(joint, amplitude, restitution)
-    if friction is not None:
-        result = result + sliding_friction(joint, amplitude, friction, form=form)
-    if pin is not None:
-        result = result + contact_friction(joint, amplitude, pin, contact_friction_coefficient)
-    if damping_ratio:
-        result = result + viscous(joint, amplitude, damping_ratio)
+    """Return E_Z = E_P + E_C + E_I (+ viscous) per free cycle at penetration A, J (eq 17).
+
+    The mechanisms are those of ``losses`` (:class:`~clearjoint.Losses`, default none),
+    or of the one-DOF VibrationSystem given as ``joint``.
+    """
+    joint, losses = as_joint(joint, losses)
+    result = impact(joint, amplitude, losses.restitution)
+    if losses.friction is not None:
+        result = result + sliding_friction(joint, amplitude, losses.friction, form=form)
+    if losses.pin is not None:
+        mu_c = losses.contact_friction_coefficient
+        result = result + contact_friction(joint, amplitude, losses.pin, mu_c)
+    if losses.damping_ratio:
+        result = result + viscous(joint, amplitude, losses.damping_ratio)
     return result
 
 
@@ -217,30 +217,23 @@ def _loss_factor(joint: Joint, orbit: FreeOrbit, energy: ArrayLike) -> FloatArra
         return np.where(u_max > 0.0, np.asarray(energy) / (2.0 * math.pi * u_max), np.nan)
 
 
+@takes_losses
 def energies(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     amplitude: ArrayLike,
     *,
-    friction: Friction | None = None,
-    pin: Pin | None = None,
-    contact_friction_coefficient: float = 0.0,
-    restitution: float = 1.0,
-    damping_ratio: float = 0.0,
     losses: Losses | None = None,
 ) -> Energies:
     """Return every energy per free cycle at penetration A, keyed as ``ENERGY_KEYS`` (SI).
 
     ``total_j`` uses the exact sliding-friction form; ``sliding_friction_paper_j``
     is the paper's equivalent-viscous form beside it. ``hertz_half_width_m`` is the
-    half-width at the largest contact force of the cycle (0 without a pin).
+    half-width at the largest contact force of the cycle (0 without a pin). The
+    mechanisms as for :func:`total`.
     """
-    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
-        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
-    )
-    if friction is not None and not isinstance(friction, Friction):
-        raise ParameterError(f"friction must be a clearjoint.Friction, got {friction!r}")
-    mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
-    e = _restitution(restitution)
+    joint, losses = as_joint(joint, losses)
+    friction, pin, mu_c = losses.friction, losses.pin, losses.contact_friction_coefficient
+    e, damping_ratio = losses.restitution, losses.damping_ratio
     c_v = viscous_coefficient(joint, damping_ratio)
     orbit = free_orbit(joint, amplitude)  # once, for every mechanism
     zero = np.zeros_like(orbit.period)
@@ -574,16 +567,12 @@ def _exact_energies(
     }
 
 
+@takes_losses
 def compare(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega: float,
     *,
-    friction: Friction | None = None,
-    pin: Pin | None = None,
-    contact_friction_coefficient: float = 0.0,
-    restitution: float = 1.0,
-    damping_ratio: float = 0.0,
     initial: ArrayLike | None = None,
     samples_per_period: int = 1024,
     max_periods: int = 20_000,
@@ -593,35 +582,21 @@ def compare(
 
     The forced steady cycle at F0 sin(omega t) (omega in rad/s) is simulated
     exactly; the closed forms are evaluated on the free cycle at that cycle's
-    compression penetration A = x_max - g_c.
+    compression penetration A = x_max - g_c. The losses as for :func:`total`.
     """
-    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
-        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
-    )
+    joint, losses = as_joint(joint, losses)
     cycle = steady_state(
         joint,
         force_amplitude,
         omega,
-        damping_ratio=damping_ratio,
-        friction=friction,
-        restitution=restitution,
-        pin=pin,
-        contact_friction_coefficient=contact_friction_coefficient,
+        losses=losses,
         initial=initial,
         samples_per_period=samples_per_period,
         max_periods=max_periods,
     )
     a = cycle.compression_penetration
-    closed_all = energies(
-        joint,
-        a,
-        friction=friction,
-        pin=pin,
-        contact_friction_coefficient=contact_friction_coefficient,
-        restitution=restitution,
-        damping_ratio=damping_ratio,
-    )
-    exact = _exact_energies(cycle, joint, friction, omega)
+    closed_all = energies(joint, a, losses=losses)
+    exact = _exact_energies(cycle, joint, losses.friction, omega)
     closed = {key: float(closed_all[key]) for key in exact}
     gap = {
         key: (closed[key] / exact[key] - 1.0)
@@ -731,7 +706,7 @@ class AgreementMap:
 
 
 def _agreement_row(
-    args: tuple[Joint, float, FloatArray, dict[str, Any], int],
+    args: tuple[Joint, float, FloatArray, Losses, int],
 ) -> tuple[FloatArray, dict[str, FloatArray]]:
     """One frequency of :func:`agreement_map`: the forces stepped upward from rest."""
     from clearjoint.simulate import SimulationError
@@ -746,7 +721,7 @@ def _agreement_row(
                 joint,
                 float(force),
                 omega,
-                **losses,
+                losses=losses,
                 initial=initial,
                 samples_per_period=128,
                 max_periods=max_periods,
@@ -760,16 +735,12 @@ def _agreement_row(
     return penetration, gaps
 
 
+@takes_losses
 def agreement_map(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     omegas: ArrayLike,
     forces: ArrayLike,
     *,
-    friction: Friction | None = None,
-    pin: Pin | None = None,
-    contact_friction_coefficient: float = 0.0,
-    restitution: float = 1.0,
-    damping_ratio: float = 0.0,
     max_periods: int = 2000,
     executor: Any = None,
     losses: Losses | None = None,
@@ -781,25 +752,16 @@ def agreement_map(
     cycle compared with the closed forms at its own penetration (:func:`compare`).
     Frequencies run one after the other here, or side by side on ``executor`` (a
     concurrent.futures Executor or a dask.distributed Client: clearjoint.parallel),
-    with the same result.
+    with the same result. The losses as for :func:`total`.
     """
-    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
-        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
-    )
+    joint, losses = as_joint(joint, losses)
     from clearjoint.parallel import run_ordered
 
     w = np.atleast_1d(np.asarray(omegas, dtype=np.float64))
     f = np.sort(np.atleast_1d(np.asarray(forces, dtype=np.float64)))
-    loss_keywords: dict[str, Any] = {
-        "friction": friction,
-        "pin": pin,
-        "contact_friction_coefficient": contact_friction_coefficient,
-        "restitution": restitution,
-        "damping_ratio": damping_ratio,
-    }
     rows = run_ordered(
         _agreement_row,
-        [(joint, float(omega), f, loss_keywords, max_periods) for omega in w],
+        [(joint, float(omega), f, losses, max_periods) for omega in w],
         executor,
     )
     penetration = np.full((w.size, f.size), np.nan)

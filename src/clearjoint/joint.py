@@ -13,14 +13,20 @@ centred gap).
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import ParamSpec, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
 from clearjoint.errors import ParameterError, ParameterTypeError
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
 
 
 @dataclass(frozen=True)
@@ -415,7 +421,7 @@ def _restitution(value: float) -> float:
 class Losses:
     """The losses of a joint's motion as one value (MODEL.md sec. 2).
 
-    Accepted as ``losses=`` by the functions that take these five keywords.
+    Every solver of one joint takes it as ``losses=`` (default: none of them).
 
     Parameters
     ----------
@@ -454,39 +460,43 @@ class Losses:
         )
 
 
-def unpack_losses(
-    losses: Losses | None,
-    damping_ratio: float,
-    friction: Friction | None,
-    restitution: float,
-    pin: Pin | None,
-    contact_friction_coefficient: float,
-) -> tuple[float, Friction | None, float, Pin | None, float]:
-    """Return the five loss values from ``losses`` or, when it is None, the keywords as given.
+LOSS_KEYWORDS = ("damping_ratio", "friction", "restitution", "pin", "contact_friction_coefficient")
+"""The five loss keywords that :class:`Losses` replaced (refused by :func:`takes_losses`)."""
 
-    A keyword that differs from its default while ``losses`` is given is an error,
-    so no value is silently dropped.
-    """
-    given = (damping_ratio, friction, restitution, pin, contact_friction_coefficient)
+
+def checked_losses(losses: Losses | None) -> Losses:
+    """Return ``losses``, or no losses (``Losses()``) for None; anything else is refused."""
     if losses is None:
-        return given
+        return Losses()
     if not isinstance(losses, Losses):
-        raise ParameterTypeError(f"losses must be a clearjoint.Losses, got {losses!r}")
-    names = ("damping_ratio", "friction", "restitution", "pin", "contact_friction_coefficient")
-    default = Losses()
-    clash = [n for n, v in zip(names, given, strict=True) if v != getattr(default, n)]
-    if clash:
-        raise ParameterError(
-            f"losses given both as losses= and as {', '.join(clash)}; "
-            f"move {clash[0]} into the Losses value"
+        raise ParameterTypeError(
+            f"losses must be a clearjoint.Losses or None, got {losses!r}; "
+            "e.g. losses=Losses(damping_ratio=0.02)"
         )
-    return (
-        losses.damping_ratio,
-        losses.friction,
-        losses.restitution,
-        losses.pin,
-        losses.contact_friction_coefficient,
-    )
+    return losses
+
+
+def takes_losses(func: Callable[_P, _R]) -> Callable[_P, _R]:
+    """Refuse the five loose loss keywords of the earlier API with a line that names the fix.
+
+    ``damping_ratio=``, ``friction=``, ``restitution=``, ``pin=`` and
+    ``contact_friction_coefficient=`` now travel in one :class:`Losses` value
+    (``losses=``); a call that still passes one gets a ParameterTypeError naming it
+    instead of Python's bare "unexpected keyword argument".
+    """
+
+    @functools.wraps(func)
+    def checked(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        old = [name for name in LOSS_KEYWORDS if name in kwargs]
+        if old:
+            given = ", ".join(f"{name}={kwargs[name]!r}" for name in old)
+            raise ParameterTypeError(
+                f"{func.__name__}() takes its losses as one value: write "
+                f"losses=Losses({given}) instead of {', '.join(n + '=' for n in old)}"
+            )
+        return func(*args, **kwargs)
+
+    return checked
 
 
 def positive_or_inf(name: str, value: float, *, unit: str = "") -> float:

@@ -63,8 +63,8 @@ from clearjoint.exact.shooting import (
     shoot,
     start_state,
 )
-from clearjoint.exact.single import initial_state, orbit_from, parameters, run_kernel
-from clearjoint.joint import Friction, Joint
+from clearjoint.exact.single import initial_state, orbit_from, run_kernel, setup
+from clearjoint.joint import Joint, Losses, takes_losses
 from clearjoint.results.motion import SteadyState
 
 # the results moved to clearjoint.results; imported "as" themselves so that the old path
@@ -72,6 +72,7 @@ from clearjoint.results.motion import SteadyState
 from clearjoint.results.orbit import PeriodicOrbit as PeriodicOrbit
 from clearjoint.results.response import FrequencyResponse as FrequencyResponse
 from clearjoint.results.response import ResponseEvent as ResponseEvent
+from clearjoint.system import VibrationSystem, as_joint
 
 __all__ = [
     "frequency_response",
@@ -106,14 +107,13 @@ def _scales(joint: Joint, p: FloatArray, z: FloatArray) -> FloatArray:
     return np.array([x_scale, v_scale])
 
 
+@takes_losses
 def periodic_orbit(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega: float,
     *,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
     period_multiple: int = 1,
     initial: ArrayLike | None = None,
 ) -> PeriodicOrbit:
@@ -126,8 +126,9 @@ def periodic_orbit(
         F0 > 0, N.
     omega : float
         Forcing circular frequency > 0, rad/s.
-    damping_ratio, friction, restitution
-        As for :func:`clearjoint.simulate.steady_state`.
+    losses : Losses, optional
+        As for :func:`clearjoint.simulate.steady_state` (a one-DOF VibrationSystem given
+        as ``joint`` carries its own).
     period_multiple : int
         p >= 1: the orbit closes after p forcing periods.
     initial : (2,) array_like, optional
@@ -143,7 +144,7 @@ def periodic_orbit(
     SimulationError
         Newton's method found no orbit.
     """
-    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    joint, losses, p = setup(joint, force_amplitude, omega, losses)
     if isinstance(period_multiple, bool) or not isinstance(period_multiple, int | np.integer):
         raise ParameterError(f"period_multiple must be an integer >= 1, got {period_multiple!r}")
     n = int(period_multiple)
@@ -157,7 +158,7 @@ def periodic_orbit(
         found = newton_orbit(p, state[:2], n, _scales(joint, p, state[:2]), tolerance=_TOLERANCE)
         if found is not None:
             z, shot, iterations = found
-            return _orbit(joint, p, z, shot, n, iterations)
+            return _orbit(joint, losses, p, z, shot, n, iterations)
     raise SimulationError(
         f"Newton's method found no period-{n} orbit at omega = {omega!r} rad/s; "
         "give initial=(x0, v0) near the orbit, or another period_multiple"
@@ -165,11 +166,11 @@ def periodic_orbit(
 
 
 def _orbit(
-    joint: Joint, p: FloatArray, z: FloatArray, shot: Shot, n: int, iterations: int
+    joint: Joint, losses: Losses, p: FloatArray, z: FloatArray, shot: Shot, n: int, iterations: int
 ) -> PeriodicOrbit:
     state = np.zeros(4)
     start_state(p, float(z[0]), float(z[1]), state)
-    cycle = orbit_from(p, joint, state, n, 0, None, 0.0, 256)
+    cycle = orbit_from(p, joint, state, n, 0, losses.pin, losses.contact_friction_coefficient, 256)
     mu = np.linalg.eigvals(shot.monodromy).astype(np.complex128)
     return PeriodicOrbit(
         initial_state=(float(z[0]), float(z[1])),
@@ -184,15 +185,14 @@ def _orbit(
     )
 
 
+@takes_losses
 def orbit_cycle(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega: float,
     initial_state: ArrayLike,
     *,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
 ) -> SteadyState:
     """Return the period-1 orbit from ``initial_state`` re-run exactly, as a SteadyState.
 
@@ -207,36 +207,36 @@ def orbit_cycle(
         F0 (N) and the forcing circular frequency (rad/s).
     initial_state : (2,) array_like
         (x0, x0') at forcing phase 0, m and m/s: a point of the orbit.
-    damping_ratio, friction, restitution
-        As for :func:`clearjoint.simulate.steady_state`.
+    losses : Losses, optional
+        As for :func:`clearjoint.simulate.steady_state` (a one-DOF VibrationSystem given
+        as ``joint`` carries its own).
 
     Returns
     -------
     SteadyState
     """
-    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    joint, losses, p = setup(joint, force_amplitude, omega, losses)
     z = np.asarray(initial_state, dtype=np.float64)
     state = np.zeros(4)
     start_state(p, float(z[0]), float(z[1]), state)
-    return orbit_from(p, joint, state, 1, 0, None, 0.0, 64)
+    return orbit_from(p, joint, state, 1, 0, losses.pin, losses.contact_friction_coefficient, 64)
 
 
+@takes_losses
 def orbit_monodromy(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega: float,
     initial_state: ArrayLike,
     *,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
 ) -> FloatArray:
     """Return the exact monodromy matrix dP/dz0 (2, 2) of one forcing period from ``initial_state``.
 
     MODEL.md sec. 5.1: the closed-form flows and saltation matrices of the period-1
     map from (x0, x0') at forcing phase 0; arguments as for :func:`orbit_cycle`.
     """
-    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    p = setup(joint, force_amplitude, omega, losses)[2]
     return shoot(p, np.asarray(initial_state, dtype=np.float64), 1).monodromy
 
 
@@ -283,10 +283,9 @@ def period_2_orbit(curve: FrequencyResponse, event: ResponseEvent) -> PeriodicOr
     beyond = np.nonzero(curve.multipliers.real.min(axis=1) < -0.5)[0]
     beyond = beyond[np.argsort(np.abs(lam[beyond] - at))][:16]
     for i in beyond:
-        kw = {k: s[k] for k in ("damping_ratio", "friction", "restitution")}
         w, f = float(curve.omega[i]), float(curve.force_amplitude[i])
         z = curve.initial_state[i]
-        mono = orbit_monodromy(s["joint"], f, w, z, **kw)
+        mono = orbit_monodromy(s["joint"], f, w, z, losses=s["losses"])
         mu, vectors = np.linalg.eig(mono)
         direction = np.real(vectors[:, int(np.argmin(mu.real))])
         size = np.array([max(curve.amplitude[i], 1e-300), max(curve.amplitude[i], 1e-300) * w])
@@ -300,7 +299,7 @@ def period_2_orbit(curve: FrequencyResponse, event: ResponseEvent) -> PeriodicOr
                         w,
                         period_multiple=2,
                         initial=z + sign * eps * direction,
-                        **kw,
+                        losses=s["losses"],
                     )
                 except SimulationError:
                     continue
@@ -501,15 +500,14 @@ def _free_play_orbit(p: FloatArray, omega: float, code: int = 0) -> FloatArray |
     return out
 
 
+@takes_losses
 def frequency_response(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega_start: float,
     omega_stop: float | None,
     *,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
     parameter: Literal["omega", "force"] = "omega",
     force_stop: float | None = None,
     max_points: int = 2000,
@@ -538,8 +536,9 @@ def frequency_response(
         F0 > 0, N (the start of the range with ``parameter="force"``).
     omega_start, omega_stop : float
         Forcing circular frequencies > 0, rad/s, either order.
-    damping_ratio, friction, restitution
-        As for :func:`clearjoint.simulate.steady_state`.
+    losses : Losses, optional
+        As for :func:`clearjoint.simulate.steady_state` (a one-DOF VibrationSystem given
+        as ``joint`` carries its own).
     parameter : {"omega", "force"}
     force_stop : float, optional
         End of the force range, N (required with ``parameter="force"``).
@@ -566,14 +565,8 @@ def frequency_response(
     start, stop = parameter_range(parameter, f0, w0, omega_stop, force_stop)
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
-    first = periodic_orbit(
-        joint,
-        f0,
-        w0,
-        damping_ratio=damping_ratio,
-        friction=friction,
-        restitution=restitution,
-    )
+    joint, losses = as_joint(joint, losses)
+    first = periodic_orbit(joint, f0, w0, losses=losses)
     if np.min(np.abs(first.multipliers - 1.0)) < 1e-9:
         refusal = SimulationError(
             f"the orbit at the start ({first!r}) has a multiplier of exactly 1: it is one of a "
@@ -581,7 +574,8 @@ def frequency_response(
             "no single curve exists; give gap_stiffness > 0 or start where the joint is in contact"
         )
         inside = joint.compression_gap > first.x_max and first.x_min > -joint.tension_gap
-        if inside and joint.gap_stiffness > 0.0 and damping_ratio == 0.0 and friction is None:
+        undamped = losses.damping_ratio == 0.0 and losses.friction is None
+        if inside and joint.gap_stiffness > 0.0 and undamped:
             # undamped inside the gap: the linear orbit's multipliers are exp(+-2 pi i w_g / w),
             # exactly 1 where omega divides w_g, and any free oscillation can be added to it
             w_g = math.sqrt(joint.gap_stiffness / joint.mass)
@@ -595,14 +589,13 @@ def frequency_response(
             raise refusal
         # a free-play orbit at the start: follow the curve from the other end, which ends on
         # the free-play orbits (if that end is not one too), and turn it round
-        kw = {"damping_ratio": damping_ratio, "friction": friction, "restitution": restitution}
         force_mode = parameter == "force"
         try:
             other = periodic_orbit(
                 joint,
                 stop if force_mode else f0,
                 w0 if force_mode else stop,
-                **kw,  # type: ignore[arg-type]
+                losses=losses,
             )
         except SimulationError:
             raise refusal from None
@@ -617,12 +610,12 @@ def frequency_response(
                 parameter="force",
                 force_stop=f0,
                 max_points=max_points,
-                **kw,  # type: ignore[arg-type]
+                losses=losses,
             )
         else:
-            turned = frequency_response(joint, f0, stop, w0, max_points=max_points, **kw)  # type: ignore[arg-type]
+            turned = frequency_response(joint, f0, stop, w0, max_points=max_points, losses=losses)
         return _turned_round(turned)
-    p = parameters(joint, f0, w0, damping_ratio, friction, restitution)
+    p = setup(joint, f0, w0, losses)[2]
     x_scale = max(joint.clearance / 2.0, first.amplitude)
     v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
     code = 0 if parameter == "omega" else 1
@@ -643,7 +636,7 @@ def frequency_response(
         return bool(last[R_EVENTS] != new[R_EVENTS])
 
     edges = (joint.compression_gap, -joint.tension_gap)
-    e = float(restitution)
+    e = losses.restitution
 
     def equivalents(u: FloatArray) -> list[FloatArray]:
         """At a gap edge the section may sit on an impact: the state before and after it."""
@@ -703,7 +696,7 @@ def frequency_response(
         joined = _rejoin(
             branch,
             follow,
-            lambda lam: _seed(joint, f0, w0, lam, parameter, damping_ratio, friction, restitution),
+            lambda lam: _seed(joint, f0, w0, lam, parameter, losses),
             start,
             stop,
             max_points,
@@ -796,9 +789,10 @@ def frequency_response(
         solver=__name__,
         settings={
             "joint": joint,
-            "damping_ratio": damping_ratio,
-            "friction": friction,
-            "restitution": restitution,
+            "damping_ratio": losses.damping_ratio,
+            "friction": losses.friction,
+            "restitution": losses.restitution,
+            "losses": losses,
         },
     )
 
@@ -878,9 +872,7 @@ def _seed(
     omega: float,
     lam: float,
     parameter: str,
-    damping_ratio: float,
-    friction: Friction | None,
-    restitution: float,
+    losses: Losses,
 ) -> FloatArray | None:
     """A period-1 orbit at parameter ``lam`` from a transient (``periodic_orbit``), or None.
 
@@ -888,9 +880,7 @@ def _seed(
     """
     w, f = (lam, force) if parameter == "omega" else (omega, lam)
     try:
-        orbit = periodic_orbit(
-            joint, f, w, damping_ratio=damping_ratio, friction=friction, restitution=restitution
-        )
+        orbit = periodic_orbit(joint, f, w, losses=losses)
     except SimulationError:
         return None
     if np.min(np.abs(orbit.multipliers - 1.0)) < 1e-9:

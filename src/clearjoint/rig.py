@@ -34,7 +34,7 @@ from scipy import signal
 from clearjoint.checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import quantity, read_toml
-from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.joint import Friction, Joint, Losses, Pin
 from clearjoint.parallel import process_pool, run_ordered
 from clearjoint.records import Record, record_suffixes, write_record
 from clearjoint.simulate import SimulationError, steady_state, time_response
@@ -130,6 +130,19 @@ class Rig:
     pin_length: float
     contact_friction_coefficient: float
     sensors: Sensors
+
+    def losses(self, pin: Pin | None = None) -> Losses:
+        """The rig's losses (MODEL.md sec. 2): damping, bearing friction, restitution, and
+        with ``pin`` its contact friction (evaluated along the cycle, no feedback)."""
+        return Losses(
+            damping_ratio=self.damping_ratio,
+            friction=self.bearing_friction,
+            restitution=self.restitution,
+            pin=pin,
+            contact_friction_coefficient=self.contact_friction_coefficient
+            if pin is not None
+            else 0.0,
+        )
 
     @property
     def beam_stiffness(self) -> float:
@@ -382,11 +395,7 @@ def simulate_test(
     """Simulate and measure one test; return the record and its truth (manifest row)."""
     joint, _, k_beam = structure_under_test(rig, spec)
     omega = 2.0 * math.pi * spec.frequency_hz
-    losses: dict[str, Any] = {
-        "damping_ratio": rig.damping_ratio,
-        "friction": rig.bearing_friction,
-        "restitution": rig.restitution,
-    }
+    losses = rig.losses()
     truth: dict[str, Any] = {
         "structure": spec.structure.name,
         "clearance_m": joint.clearance,
@@ -411,7 +420,12 @@ def simulate_test(
     }
     try:
         cycle = steady_state(
-            joint, spec.force_amplitude, omega, max_periods=5000, samples_per_period=16, **losses
+            joint,
+            spec.force_amplitude,
+            omega,
+            max_periods=5000,
+            samples_per_period=16,
+            losses=losses,
         )
         truth.update(
             energy_per_cycle_j=cycle.energy.input / cycle.period_multiple,
@@ -436,7 +450,7 @@ def simulate_test(
         omega,
         periods / spec.frequency_hz,
         sampling_rate=fast,
-        **losses,
+        losses=losses,
     )
     sos = signal.butter(
         sensors.filter_order, sensors.cutoff * sensors.sampling_rate, fs=fast, output="sos"

@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
-from clearjoint.joint import ClearanceJoint, Joint, Losses
+from clearjoint.joint import ClearanceJoint, Joint, Losses, checked_losses
 from clearjoint.laws.clearance import COMPRESSION, OPEN, TENSION, state_tables
 from clearjoint.laws.clearance import parameters as law_parameters
 
@@ -210,6 +210,45 @@ class VibrationSystem:
             source=joint,
         )
 
+    def to_joint(self) -> tuple[Joint, Losses]:
+        """This system of one DOF and one joint as a :class:`Joint` and its :class:`Losses`.
+
+        The inverse of :meth:`from_joint` (MODEL.md eq 7): m = M; the joint's law, with
+        the linear stiffness K (a spring in parallel, acting everywhere) added to its
+        free-play stiffness k0; ``damping_ratio`` = C / (2 sqrt(m k_c)) beside the joint's
+        own losses. This is how the single-joint solvers (``clearjoint.simulate``,
+        ``clearjoint.periodic``, ``clearjoint.dissipation``) take a system.
+
+        Raises
+        ------
+        VibrationSystemError
+            More than one DOF or joint, or a joint direction other than +1.
+        """
+        if self.n_dof != 1 or self.n_joints != 1:
+            raise VibrationSystemError(
+                f"a single-joint solver takes a system of one DOF and one joint, got "
+                f"{self.n_dof} DOFs and {self.n_joints} joints; use clearjoint.structure's "
+                "solvers or clearjoint.harmonic for this system"
+            )
+        if float(self.directions[0, 0]) != 1.0:
+            raise VibrationSystemError(
+                f"a single-joint solver needs the joint's direction b = +1 (x positive in "
+                f"compression), got {float(self.directions[0, 0])!r}; flip the law's sides "
+                "(swap k_c and k_t, negate gap_offset) instead"
+            )
+        law = self.laws[0]
+        mass = float(self.mass[0, 0])
+        joint = Joint(
+            mass,
+            law.clearance,
+            law.compression_stiffness,
+            law.tension_stiffness,
+            law.gap_stiffness + float(self.stiffness[0, 0]),
+            law.gap_offset,
+        )
+        zeta = float(self.damping[0, 0]) / (2.0 * math.sqrt(mass * law.compression_stiffness))
+        return joint, replace(self.losses[0], damping_ratio=zeta)
+
     # ---- sizes and views --------------------------------------------------------------------
 
     @property
@@ -378,6 +417,37 @@ def as_system(system: Any, losses: Losses | None = None) -> VibrationSystem:
     raise ParameterTypeError(
         "system must be a clearjoint.Joint, a clearjoint.structure.Structure or a "
         f"clearjoint.system.VibrationSystem, got {system!r}"
+    )
+
+
+def as_joint(system: Any, losses: Losses | None = None) -> tuple[Joint, Losses]:
+    """Return a single-joint solver's input as a :class:`Joint` and its :class:`Losses`.
+
+    A Joint comes with ``losses`` (None: no losses); a one-DOF
+    :class:`VibrationSystem` carries its own (:meth:`VibrationSystem.to_joint`), so
+    ``losses`` must then be None.
+
+    Raises
+    ------
+    ParameterTypeError
+        ``system`` is neither, or ``losses`` is not a Losses.
+    ParameterError
+        ``losses`` given with a system that carries its own.
+    VibrationSystemError
+        A system that is not one joint.
+    """
+    if isinstance(system, Joint):
+        return system, checked_losses(losses)
+    if isinstance(system, VibrationSystem):
+        if losses is not None:
+            raise ParameterError(
+                "losses apply to a Joint; a VibrationSystem carries its own (its damping "
+                "matrix C and its losses): give one or the other"
+            )
+        return system.to_joint()
+    raise ParameterTypeError(
+        "joint must be a clearjoint.Joint or a one-DOF clearjoint.system.VibrationSystem, "
+        f"got {system!r}"
     )
 
 

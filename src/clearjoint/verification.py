@@ -23,7 +23,7 @@ from clearjoint.analysis import Analysis
 from clearjoint.contact import HertzValidityWarning
 from clearjoint.dissipation import compare, energies
 from clearjoint.figures import Curve
-from clearjoint.joint import Friction, Joint
+from clearjoint.joint import Friction, Joint, Losses
 from clearjoint.rig import Campaign, structure_under_test
 from clearjoint.simulate import SteadyState, steady_state
 
@@ -114,9 +114,7 @@ def example_cycle() -> SteadyState:
         joint,
         1000.0,
         2.0 * np.pi * 400.0,
-        damping_ratio=0.01,
-        restitution=0.8,
-        friction=Friction(0.2, 300.0),
+        losses=Losses(damping_ratio=0.01, restitution=0.8, friction=Friction(0.2, 300.0)),
         samples_per_period=512,
     )
 
@@ -142,19 +140,13 @@ def model_checks(
         for n, row in enumerate(jointed):
             spec = specs[Path(row["file"]).stem]
             joint, pin, _ = structure_under_test(rig, spec)
-            losses: dict[str, Any] = {
-                "friction": rig.bearing_friction,
-                "restitution": rig.restitution,
-                "damping_ratio": rig.damping_ratio,
-                "pin": pin,
-                "contact_friction_coefficient": rig.contact_friction_coefficient,
-            }
+            losses = rig.losses(pin)
             a = max(row["compression_penetration_m"], 0.0)
-            model.append(float(energies(joint, a, **losses)["total_j"]))
+            model.append(float(energies(joint, a, losses=losses)["total_j"]))
             if n % 10 == 0:
                 omega = 2 * math.pi * spec.frequency_hz
                 result = compare(
-                    joint, spec.force_amplitude, omega, samples_per_period=256, **losses
+                    joint, spec.force_amplitude, omega, samples_per_period=256, losses=losses
                 )
                 # the paper's "numerical integration": the rig's own losses over the exact
                 # steady cycle, as benchmarks/bench_laws.py times it
@@ -163,9 +155,7 @@ def model_checks(
                     joint,
                     spec.force_amplitude,
                     omega,
-                    damping_ratio=rig.damping_ratio,
-                    friction=rig.bearing_friction,
-                    restitution=rig.restitution,
+                    losses=rig.losses(),
                     samples_per_period=16,
                 )
                 elapsed = time.perf_counter() - start

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,9 +28,10 @@ from clearjoint import checks as _checks
 from clearjoint.contact import contact_friction_power, hertz_contact
 from clearjoint.errors import ParameterError, SimulationError
 from clearjoint.exact import kernel as kn
-from clearjoint.joint import Friction, Joint, Pin
+from clearjoint.joint import Friction, Joint, Losses, Pin
 from clearjoint.results.motion import EnergyLedger, Stage, SteadyState
 from clearjoint.stiffness import viscous_coefficient
+from clearjoint.system import as_joint
 
 FloatArray = NDArray[np.float64]
 
@@ -74,6 +76,21 @@ def parameters(
             kn.FRICTION_EVERYWHERE if friction.region == "everywhere" else kn.FRICTION_FREE_PLAY
         )
     return p
+
+
+def setup(
+    joint: Any, force_amplitude: float, omega: float, losses: Losses | None
+) -> tuple[Joint, Losses, FloatArray]:
+    """Return the joint, its losses and the kernel's parameter vector of a solver's input.
+
+    ``joint`` is a Joint (with ``losses``, None for none) or a one-DOF
+    VibrationSystem (which carries its own): :func:`clearjoint.system.as_joint`.
+    """
+    joint, losses = as_joint(joint, losses)
+    p = parameters(
+        joint, force_amplitude, omega, losses.damping_ratio, losses.friction, losses.restitution
+    )
+    return joint, losses, p
 
 
 def initial_state(p: FloatArray, initial: ArrayLike | None) -> FloatArray:

@@ -191,7 +191,7 @@ def check_orbits(
             f"points must be indices 0 to {n_pts - 1} of the curve, got {index.min()} to "
             f"{index.max()}"
         )
-    model = build(structure, 0.0, None, 1.0)
+    model = build(structure, None)
     basis = aft.Basis.make(int(settings["harmonics"]), int(settings["samples"]))
     pattern = np.asarray(settings["force_pattern"], dtype=np.float64)
     coefficients = response.coefficients

@@ -44,7 +44,7 @@ from clearjoint.harmonic.system import (
     friction_speed,
     scale_length,
 )
-from clearjoint.joint import Friction
+from clearjoint.joint import Losses, takes_losses
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -278,9 +278,7 @@ def _amplitudes(amplitudes: ArrayLike) -> FloatArray:
 def _model(
     system: Any,
     mode: int,
-    damping_ratio: float,
-    friction: Friction | None,
-    restitution: float,
+    losses: Losses | None,
     given: float | None,
 ) -> tuple[LinearSystem, int, float, FloatArray]:
     """(model, reference DOF, closed-pattern frequency, shape) of mode ``mode``.
@@ -293,7 +291,7 @@ def _model(
     import dataclasses
 
     # v_eps does not enter the linear modes: build once with a placeholder, then set it
-    model = build(system, damping_ratio, friction, restitution, 1.0)
+    model = build(system, losses, 1.0)
     ref, omega_lin, shape = _reference(model, mode)
     if model.friction_force is not None or given is not None:
         speed = friction_speed(system, omega_lin, given)
@@ -315,6 +313,7 @@ def _reference(model: LinearSystem, mode: int) -> tuple[int, float, FloatArray]:
     return ref, math.sqrt(max(float(w2[int(mode) - 1]), 0.0)), shape / shape[ref]
 
 
+@takes_losses
 def nonlinear_modes(
     system: Any,
     mode: int = 1,
@@ -322,9 +321,7 @@ def nonlinear_modes(
     *,
     harmonics: int = 7,
     samples: int | None = None,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
     friction_regularization: float | None = None,
 ) -> NonlinearMode:
     """Return a nonlinear mode's frequency, damping and shape against amplitude (MODEL.md 5.4).
@@ -354,20 +351,18 @@ def nonlinear_modes(
         H >= 1.
     samples : int, optional
         N_t, as for :func:`clearjoint.harmonic.frequency_response`.
-    damping_ratio : float
-        zeta of a Joint's linear part (c_v = 2 zeta sqrt(m k_c)).
-    friction : Friction, optional
-        Coulomb friction of a Joint over its whole path (region "everywhere"),
-        regularised as mu_s P tanh(v / v_eps) exactly as in
-        :func:`clearjoint.harmonic.frequency_response`; a Structure's joints carry
-        their own friction (rigid members only) the same way. Friction over the
-        free-play stroke only is refused (HarmonicError). Where a rubbing joint
-        would stick at a turning point (the force that would hold it, for a Joint
+    losses : Losses, optional
+        A Joint's losses (a Structure or VibrationSystem carries its own): the damping
+        ratio zeta of its linear part (c_v = 2 zeta sqrt(m k_c)) and Coulomb friction
+        over its whole path (region "everywhere"), regularised as mu_s P tanh(v / v_eps)
+        exactly as in :func:`clearjoint.harmonic.frequency_response`; a Structure's
+        joints carry their own friction (rigid members only) the same way. Friction
+        over the free-play stroke only is refused (HarmonicError), and so is
+        restitution below 1 (impacts need :mod:`clearjoint.periodic`). Where a rubbing
+        joint would stick at a turning point (the force that would hold it, for a Joint
         its restoring force, within mu_s P: :func:`holding_forces`), the amplitude
-        fails with the reason in ``note``: EPMC's regularised orbit has no stick
-        phase and creeps through there, driven by the negative damping.
-    restitution : float
-        Refused unless 1 (HarmonicError): impacts need :mod:`clearjoint.periodic`.
+        fails with the reason in ``note``: EPMC's regularised orbit has no stick phase
+        and creeps through there, driven by the negative damping.
     friction_regularization : float, optional
         v_eps, m/s. Default 1e-3 w c, with w the mode's closed-pattern frequency
         (frequency_response uses its start frequency) and c a Joint's clearance (for
@@ -386,9 +381,7 @@ def nonlinear_modes(
         friction over the free-play stroke only, or restitution.
     """
     h, n_t = aft.check_harmonics(harmonics, samples)
-    model, ref, omega_lin, shape = _model(
-        system, mode, damping_ratio, friction, restitution, friction_regularization
-    )
+    model, ref, omega_lin, shape = _model(system, mode, losses, friction_regularization)
     length = scale_length(model)
     amps = _amplitudes(
         np.geomspace(0.5 * length, 20.0 * length, 40) if amplitudes is None else amplitudes

@@ -48,7 +48,7 @@ from clearjoint.harmonic.system import (
     friction_speed,
     scale_length,
 )
-from clearjoint.joint import Friction
+from clearjoint.joint import Losses, takes_losses
 from clearjoint.results import FrequencyResponse, ResponseEvent
 
 FloatArray = NDArray[np.float64]
@@ -85,6 +85,7 @@ class NoPeriodicResponse(HarmonicError):
         self.reached = reached
 
 
+@takes_losses
 def frequency_response(
     system: Any,
     force: float | ArrayLike,
@@ -93,9 +94,7 @@ def frequency_response(
     *,
     harmonics: int = 7,
     samples: int | None = None,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
     parameter: Literal["omega", "force"] = "omega",
     force_stop: float | None = None,
     max_points: int = 2000,
@@ -127,20 +126,17 @@ def frequency_response(
         N_t time samples per period for AFT, >= 2 (2H + 1); default 32 (2H + 1)
         rounded up to a power of two (fewer samples leave the sampled law's kinks
         visible as small zigzags of the curve near a fold).
-    damping_ratio : float
-        zeta of a Joint's linear part, c_v = 2 zeta sqrt(m k_c).
-    friction : Friction, optional
-        Coulomb friction of a Joint over its whole path (region "everywhere"),
-        regularised as mu_s P tanh(v / v_eps); its error against the exact
-        stick-slip orbits of :mod:`clearjoint.periodic` is in docs/harmonic.md.
-        Friction over the free-play stroke only is refused. A Structure carries
-        its joints' own friction (rigid members only) the same way, on each
-        joint's relative speed: against exact stick-slip orbits the amplitude is
-        off by about 1e-3 while the joints slide and by about 12 % where they
-        stick; points where a joint sticks get an ``"untrusted"`` event
-        (docs/harmonic.md).
-    restitution : float
-        Must be 1: impacts need :func:`clearjoint.periodic.frequency_response`.
+    losses : Losses, optional
+        A Joint's losses (a Structure or VibrationSystem carries its own): the damping
+        ratio zeta of its linear part, c_v = 2 zeta sqrt(m k_c), and Coulomb friction over
+        its whole path (region "everywhere"), regularised as mu_s P tanh(v / v_eps); its
+        error against the exact stick-slip orbits of :mod:`clearjoint.periodic` is in
+        docs/harmonic.md. Friction over the free-play stroke only is refused, and so is
+        restitution below 1 (impacts need :func:`clearjoint.periodic.frequency_response`).
+        A Structure carries its joints' own friction (rigid members only) the same way,
+        on each joint's relative speed: against exact stick-slip orbits the amplitude is
+        off by about 1e-3 while the joints slide and by about 12 % where they stick;
+        points where a joint sticks get an ``"untrusted"`` event (docs/harmonic.md).
     parameter : {"omega", "force"}
     force_stop : float, optional
         End of the force range, N (largest entry for a Structure).
@@ -193,13 +189,7 @@ def frequency_response(
         raise ParameterError(f"parameter must be 'omega' or 'force', got {parameter!r}")
     h, n_t = aft.check_harmonics(harmonics, samples)
     w0 = _checks.positive("omega_start", omega_start, unit="rad/s")
-    model = build(
-        system,
-        damping_ratio,
-        friction,
-        restitution,
-        friction_speed(system, w0, friction_regularization),
-    )
+    model = build(system, losses, friction_speed(system, w0, friction_regularization))
     pattern = force_vector(model, force)
     peak = float(np.max(np.abs(pattern)))
     start, stop = parameter_range(parameter, peak, w0, omega_stop, force_stop)
@@ -280,7 +270,8 @@ def frequency_response(
         "system": system,
         "harmonics": h,
         "samples": n_t,
-        "damping_ratio": damping_ratio,
+        "damping_ratio": 0.0 if losses is None else losses.damping_ratio,
+        "losses": losses,
         "force_pattern": unit_force,
         "stability": stability or ("hill" if model.is_joint else "monodromy"),
     }

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
-from clearjoint.joint import Friction, Joint
+from clearjoint.joint import Friction, Joint, Losses, checked_losses
 from clearjoint.laws import clearance
 from clearjoint.stiffness import viscous_coefficient
 from clearjoint.system import VibrationSystem, as_system
@@ -166,24 +166,24 @@ def _joint_name(system: VibrationSystem, j: int) -> str:
 
 
 def from_joint(
-    joint: Joint,
-    damping_ratio: float,
-    friction: Friction | None,
-    restitution: float,
-    friction_speed: float = 0.0,
+    joint: Joint, losses: Losses | None = None, friction_speed: float = 0.0
 ) -> LinearSystem:
     """The one-DOF system of a :class:`Joint` with viscous damping c_v = 2 zeta sqrt(m k_c).
 
-    Coulomb friction (region "everywhere") is regularised as mu_s P tanh(v / v_eps),
-    v_eps = ``friction_speed`` (m/s, > 0 when there is friction).
+    ``losses`` (default none) give zeta and the friction. Coulomb friction (region
+    "everywhere") is regularised as mu_s P tanh(v / v_eps), v_eps = ``friction_speed``
+    (m/s, > 0 when there is friction); restitution below 1 is refused. The pin's
+    contact friction, which the exact solvers evaluate along the cycle without feedback
+    on the motion (MODEL.md sec. 2), does not change the harmonic-balance orbit.
     """
-    e = _checks.real_scalar("restitution", restitution)
-    _refuse_losses(friction, e, "on the joint", allow_friction=True)
+    losses = checked_losses(losses)
+    friction = losses.friction
+    _refuse_losses(friction, losses.restitution, "on the joint", allow_friction=True)
     force = None
     if friction is not None and friction.force > 0.0:
         force = np.array([friction.force])
         friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
-    c_v = viscous_coefficient(joint, damping_ratio)
+    c_v = viscous_coefficient(joint, losses.damping_ratio)
     one = np.ones((1, 1))
     return LinearSystem(
         mass=joint.mass * one,
@@ -256,26 +256,21 @@ def _dense(matrix: Any) -> FloatArray:
     return np.asarray(dense, dtype=np.float64)
 
 
-def build(
-    system: Any,
-    damping_ratio: float,
-    friction: Friction | None,
-    restitution: float,
-    friction_speed: float = 0.0,
-) -> LinearSystem:
-    """A :class:`LinearSystem` from a Joint (with its losses), a Structure or a VibrationSystem.
+def build(system: Any, losses: Losses | None, friction_speed: float = 0.0) -> LinearSystem:
+    """A :class:`LinearSystem` from a Joint (with its ``losses``), a Structure or a
+    VibrationSystem (which carry their own: ``losses`` must then be None).
 
     A Structure goes through ``to_system()``; a system built from a Joint
     (``VibrationSystem.from_joint``) stays a Joint's.
     """
     if isinstance(system, Joint):
-        return from_joint(system, damping_ratio, friction, restitution, friction_speed)
+        return from_joint(system, losses, friction_speed)
     from clearjoint.structure.model import Structure
 
     if isinstance(system, Structure | VibrationSystem):
-        if damping_ratio or friction is not None or restitution != 1.0:
+        if losses is not None:
             raise ParameterError(
-                "damping_ratio, friction and restitution apply to a Joint; a "
+                "losses apply to a Joint; a "
                 f"{type(system).__name__} carries its own damping (Member.damping, rayleigh, "
                 "or its C) and joint losses"
             )

@@ -243,7 +243,7 @@ class FrequencyResponse:
             float(self.force_amplitude[index]),
             float(self.omega[index]),
             self.initial_state[index],
-            **self._losses(),
+            losses=self.settings["losses"],
         )
 
     def period_2_orbit(self, event: ResponseEvent) -> PeriodicOrbit:
@@ -266,15 +266,6 @@ class FrequencyResponse:
                 f"{event.kind!r} of a {self.method!r} curve"
             )
         return solver.period_2_orbit(self, event)  # type: ignore[no-any-return]
-
-    def _losses(self) -> dict[str, Any]:
-        """Return the shooting curve's losses as the solver's keywords (from ``settings``)."""
-        s = self.settings
-        return {
-            "damping_ratio": s["damping_ratio"],
-            "friction": s["friction"],
-            "restitution": s["restitution"],
-        }
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """Plot X against frequency (Hz) or force (N): stable solid, unstable dashed, events marked.

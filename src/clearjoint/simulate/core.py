@@ -28,11 +28,11 @@ from clearjoint.exact.single import (
     initial_state,
     motion_fields,
     orbit_from,
-    parameters,
     run_kernel,
     sample_times,
+    setup,
 )
-from clearjoint.joint import Friction, Joint, Losses, Pin, unpack_losses
+from clearjoint.joint import Joint, Losses, takes_losses
 
 # the results moved to clearjoint.results; imported "as" themselves so that the old path
 # clearjoint.simulate.core re-exports them (and the API reference documents them once)
@@ -41,6 +41,7 @@ from clearjoint.results.motion import FrequencySweep as FrequencySweep
 from clearjoint.results.motion import Motion as Motion
 from clearjoint.results.motion import Stage as Stage
 from clearjoint.results.motion import SteadyState as SteadyState
+from clearjoint.system import VibrationSystem, as_joint
 from clearjoint.units import to_si
 
 FloatArray = NDArray[np.float64]
@@ -55,18 +56,14 @@ FloatArray = NDArray[np.float64]
 # ---- public API ---------------------------------------------------------------------------
 
 
+@takes_losses
 def time_response(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega: float,
     duration: float,
     *,
     initial: ArrayLike | None = None,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
-    pin: Pin | None = None,
-    contact_friction_coefficient: float = 0.0,
     samples_per_period: int = 256,
     sampling_rate: float | None = None,
     losses: Losses | None = None,
@@ -76,15 +73,14 @@ def time_response(
     The forcing is F0 sin(omega t) from t = 0 (omega in rad/s). The ledger covers
     the whole run, so input = losses + mechanical_energy_change. The motion is
     sampled ``samples_per_period`` times per forcing period, or at
-    ``sampling_rate`` (Hz) when that is given.
+    ``sampling_rate`` (Hz) when that is given. ``losses`` (:class:`~clearjoint.Losses`,
+    default none) or the one-DOF system given as ``joint`` carry the damping, friction,
+    restitution and the pin.
     """
-    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
-        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
-    )
-    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    joint, losses, p = setup(joint, force_amplitude, omega, losses)
     duration = _checks.positive("duration", duration, unit="s")
     time = sample_times(duration, p[kn.P_TF], samples_per_period, sampling_rate)
-    mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
+    pin, mu_c = losses.pin, losses.contact_friction_coefficient
     state = initial_state(p, initial)
     start = state.copy()
     tf = p[kn.P_TF]
@@ -152,16 +148,12 @@ def _smallest_multiple(
     return multiple
 
 
+@takes_losses
 def steady_state(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega: float,
     *,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
-    pin: Pin | None = None,
-    contact_friction_coefficient: float = 0.0,
     initial: ArrayLike | None = None,
     max_periods: int = 20_000,
     max_multiple: int = 8,
@@ -180,22 +172,18 @@ def steady_state(
 
     Parameters
     ----------
-    joint : Joint
+    joint : Joint or VibrationSystem
+        The joint, or a system of one DOF and one joint (``VibrationSystem.to_joint``).
     force_amplitude : float
         F0 > 0, N.
     omega : float
         Forcing circular frequency w > 0, rad/s.
-    damping_ratio : float
-        zeta >= 0 of the linear part: c_v = 2 zeta sqrt(m k_c), held fixed.
-    friction : Friction, optional
-        Coulomb sliding friction mu_s P sign(x').
-    restitution : float
-        Coefficient of restitution e in [0, 1] on entering contact; each impact
-        removes beta m v^2 with beta = (1 - e^2)/2 (MODEL.md eq 16).
-    pin : Pin, optional
-        With ``contact_friction_coefficient`` > 0, eq 15 is evaluated along the cycle.
-    contact_friction_coefficient : float
-        mu_c on the pin's contact arc.
+    losses : Losses, optional
+        Viscous damping ratio, Coulomb friction, restitution (each impact removes
+        beta m v^2 with beta = (1 - e^2)/2, MODEL.md eq 16) and the pin with its
+        contact friction coefficient (eq 15, evaluated along the cycle). Default none.
+        A one-DOF :class:`~clearjoint.system.VibrationSystem` given as ``joint``
+        carries its own.
 
     Raises
     ------
@@ -203,12 +191,9 @@ def steady_state(
         No periodic orbit was found within ``max_periods`` (e.g. a lossless
         system, which never settles, or a chaotic response).
     """
-    damping_ratio, friction, restitution, pin, contact_friction_coefficient = unpack_losses(
-        losses, damping_ratio, friction, restitution, pin, contact_friction_coefficient
-    )
-    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    joint, losses, p = setup(joint, force_amplitude, omega, losses)
     check_samples(samples_per_period)
-    mu_c = _checks.non_negative("contact_friction_coefficient", contact_friction_coefficient)
+    pin, mu_c = losses.pin, losses.contact_friction_coefficient
     if max_periods < 1 or max_multiple < 1:
         raise ParameterError("max_periods and max_multiple must be >= 1")
     tol = _checks.positive("tolerance", tolerance)
@@ -244,15 +229,14 @@ def steady_state(
     return orbit_from(p, joint, state, multiple, done, pin, mu_c, samples_per_period)
 
 
+@takes_losses
 def frequency_sweep(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omegas: ArrayLike,
     *,
     direction: Literal["up", "down", "both"] = "both",
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
     max_periods: int = 20_000,
     keep_cycles: bool = False,
 ) -> FrequencySweep:
@@ -262,7 +246,9 @@ def frequency_sweep(
     hysteresis of the amplitude-frequency curve show up as they do on a shaker.
     ``omegas`` (rad/s) are sorted ascending; the down sweep visits them in reverse.
     A step with no steady state gives NaN rather than stopping the sweep.
+    ``losses`` as for :func:`steady_state`.
     """
+    joint, losses = as_joint(joint, losses)
     w = np.sort(np.atleast_1d(np.asarray(to_si(omegas, "rad/s", name="omegas"), dtype=float)))
     if w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0.0):
         raise ParameterError("omegas must be a non-empty array of finite values > 0 (rad/s)")
@@ -280,9 +266,7 @@ def frequency_sweep(
                     joint,
                     force_amplitude,
                     float(omega),
-                    damping_ratio=damping_ratio,
-                    friction=friction,
-                    restitution=restitution,
+                    losses=losses,
                     initial=initial,
                     max_periods=max_periods,
                     samples_per_period=16,

@@ -21,8 +21,9 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
 from clearjoint.exact import kernel as kn
-from clearjoint.exact.single import initial_state, parameters
-from clearjoint.joint import Friction, Joint
+from clearjoint.exact.single import initial_state, setup
+from clearjoint.joint import Joint, Losses, takes_losses
+from clearjoint.system import VibrationSystem
 
 FloatArray = NDArray[np.float64]
 
@@ -105,16 +106,15 @@ def _state_equations(
     return moving, events
 
 
+@takes_losses
 def reference_time_response(
-    joint: Joint,
+    joint: Joint | VibrationSystem,
     force_amplitude: float,
     omega: float,
     n_periods: int,
     *,
     initial: ArrayLike | None = None,
-    damping_ratio: float = 0.0,
-    friction: Friction | None = None,
-    restitution: float = 1.0,
+    losses: Losses | None = None,
     rtol: float = 1e-11,
     steps_per_period: float = 20.0,
 ) -> ReferenceResponse:
@@ -125,9 +125,10 @@ def reference_time_response(
     changes sign between two steps, so an excursion shorter than a step (an orbit
     that leaves a contact by a hair and comes straight back) is missed; raise
     ``steps_per_period`` to see finer ones. The event-driven solver has no such
-    blind spot.
+    blind spot. ``losses``: the damping ratio, friction and restitution (its pin is not
+    used); a one-DOF system given as ``joint`` carries its own.
     """
-    p = parameters(joint, force_amplitude, omega, damping_ratio, friction, restitution)
+    joint, losses, p = setup(joint, force_amplitude, omega, losses)
     state = initial_state(p, initial)
     x, v = float(state[kn.S_X]), float(state[kn.S_V])
     region, slip = int(state[kn.S_REGION]), int(state[kn.S_SLIP])

@@ -18,7 +18,6 @@ import numpy as np
 
 from clearjoint.errors import ParameterError
 from clearjoint.io_toml import read_toml
-from clearjoint.joint import Losses
 from clearjoint.structure.study import StructureStudy, load_structure_study
 from clearjoint.studies.harmonic import (
     checked_samples,
@@ -36,7 +35,6 @@ __all__ = [
     "mode_summary",
     "name_dofs",
     "nonlinear_modes_of",
-    "solver_losses",
     "write_curve",
 ]
 
@@ -51,20 +49,6 @@ def load_any_study(path: str | Path, *, optional: Sequence[str] = ()) -> AnyStud
     if "structure" in read_toml(path, what="study", error=StudyError):
         return load_structure_study(path)
     return load_study(path, optional=optional)
-
-
-def solver_losses(losses: Losses) -> dict[str, Any]:
-    """Return the losses as the three keywords the curve solvers take today.
-
-    periodic.frequency_response, harmonic.frequency_response and nonlinear_modes take
-    damping_ratio, friction and restitution (no pin contact friction), not ``losses=``;
-    this is the one place that spells them out.
-    """
-    return {
-        "damping_ratio": losses.damping_ratio,
-        "friction": losses.friction,
-        "restitution": losses.restitution,
-    }
 
 
 def frequency_response_of(
@@ -119,7 +103,6 @@ def frequency_response_of(
         )
     else:
         from clearjoint.periodic import frequency_response as solver
-    losses = solver_losses(study.losses)
     if parameter == "force":
         hz = frequency if frequency is not None else study.omega / (2.0 * math.pi)
         return solver(
@@ -130,7 +113,7 @@ def frequency_response_of(
             parameter="force",
             force_stop=stop,
             max_points=max_points,
-            **losses,
+            losses=study.motion_losses,
         )
     if not (math.isfinite(study.force_amplitude) and study.force_amplitude > 0.0):
         raise ParameterError(
@@ -143,7 +126,7 @@ def frequency_response_of(
         2.0 * math.pi * start,
         2.0 * math.pi * stop,
         max_points=max_points,
-        **losses,
+        losses=study.motion_losses,
     )
 
 
@@ -245,7 +228,7 @@ def nonlinear_modes_of(
         amplitudes,
         harmonics=harmonics,
         samples=samples,
-        **solver_losses(study.losses),
+        losses=study.motion_losses,
     )
 
 

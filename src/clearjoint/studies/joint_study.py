@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -110,6 +110,16 @@ class Study:
             pin=self.pin,
             contact_friction_coefficient=self.contact_friction_coefficient,
         )
+
+    @property
+    def motion_losses(self) -> Losses:
+        """The losses that shape the motion, without the pin: for curves and orbits.
+
+        The pin's contact friction is evaluated along one cycle without feedback on the
+        motion (MODEL.md sec. 2); a curve or an orbit task reports no ledger, so it is
+        left out there (it would only cost time and warn where Hertz does not hold).
+        """
+        return replace(self.losses, pin=None, contact_friction_coefficient=0.0)
 
 
 def load_study(path: str | Path, *, optional: Collection[str] = ()) -> Study:

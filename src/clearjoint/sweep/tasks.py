@@ -44,7 +44,6 @@ from typing import Any
 import numpy as np
 
 from clearjoint.errors import ParameterError
-from clearjoint.studies.curves import solver_losses
 from clearjoint.studies.overrides import structure_at, study_at
 
 __all__ = [
@@ -284,7 +283,7 @@ def _stepped_sine(
         study.joint,
         study.force_amplitude,
         2.0 * math.pi * hz,
-        **solver_losses(study.losses),
+        losses=study.motion_losses,
         max_periods=int(values["task.max_periods"]),
     )
     both = np.vstack([curve.amplitude_up, curve.amplitude_down])
@@ -349,7 +348,7 @@ def _periodic_orbit(
         study.joint,
         study.force_amplitude,
         study.omega,
-        **solver_losses(study.losses),
+        losses=study.motion_losses,
         period_multiple=int(values["task.period_multiple"]),
     )
     per = 1.0 / int(values["task.period_multiple"])  # per forcing period
@@ -404,7 +403,7 @@ def _frequency_response(
         study.force_amplitude,
         2.0 * math.pi * low,
         2.0 * math.pi * high,
-        **solver_losses(study.losses),
+        losses=study.motion_losses,
         max_points=int(values["task.max_points"]),
     )
     if curve.stop_reason != "reached":
@@ -467,7 +466,7 @@ def _nonlinear_mode(
         1,
         [values["task.amplitude"]],
         harmonics=int(values["task.harmonics"]),
-        **solver_losses(study.losses),
+        losses=study.motion_losses,
     )
     if not bool(mode.converged[0]):
         raise SimulationError("the nonlinear mode did not converge at this amplitude")
