@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from clearjoint import ClearanceJoint, Friction, Joint
+from clearjoint import ClearanceJoint, Friction, Joint, Losses
 from clearjoint.simulate import time_response as joint_time_response
 from clearjoint.structure import Structure, StructureError, chain, free_decay, time_response
 from clearjoint.structure.reference import reference_response
@@ -30,7 +30,12 @@ def test_one_joint_chain_agrees_with_the_one_joint_simulator() -> None:
     duration = 12 * 2.0 * math.pi / omega
     mine = time_response(one, [3000.0], omega, duration, samples_per_period=64)
     theirs = joint_time_response(
-        joint, 3000.0, omega, duration, damping_ratio=0.02, restitution=0.8, samples_per_period=64
+        joint,
+        3000.0,
+        omega,
+        duration,
+        losses=Losses(damping_ratio=0.02, restitution=0.8),
+        samples_per_period=64,
     )
     np.testing.assert_array_equal(mine.t, theirs.time)
     scale = np.max(np.abs(theirs.displacement))

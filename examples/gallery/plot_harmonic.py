@@ -29,7 +29,7 @@ PAPER = Joint(mass=2.0, clearance=0.106e-3, compression_stiffness=8e7)
 hb = frequency_response(
     PYHARM, 0.03, 0.5, 1.8, harmonics=12, losses=Losses(damping_ratio=ZETA), max_step=0.05
 )
-ex = exact_response(PYHARM, 0.03, 0.5, 1.8, damping_ratio=ZETA)
+ex = exact_response(PYHARM, 0.03, 0.5, 1.8, losses=Losses(damping_ratio=ZETA))
 print(hb)
 print(ex)
 fig, ax = plt.subplots(figsize=(7.0, 4.2), layout="constrained")
