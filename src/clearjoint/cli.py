@@ -41,22 +41,13 @@ def _plot_target(args: argparse.Namespace) -> Path | None:
 
 
 def _save_plot(result: Any, path: Path | None, *, quiet: bool) -> None:
-    """Draw ``result.plot(ax)`` on a new figure and save it to ``path`` (nothing if None)."""
-    if path is None:
-        return
-    from matplotlib.figure import Figure
+    """Save ``result`` (a Figure, or drawn by its ``plot(ax)``) to ``path`` (nothing if None)."""
+    from clearjoint.plotting import save_figure
 
-    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
-    result.plot(fig.add_subplot())
-    _save_figure(fig, path, quiet=quiet)
-
-
-def _save_figure(fig: Any, path: Path, *, quiet: bool) -> None:
-    """Save a drawn Figure to the --plot file ``path`` (checked by :func:`_plot_target`)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    if not quiet:
-        print(f"wrote {path}")
+    if path is not None:
+        save_figure(result, path)
+        if not quiet:
+            print(f"wrote {path}")
 
 
 def _netcdf_target(args: argparse.Namespace) -> Path:
@@ -354,16 +345,14 @@ def _run_sweep(args: argparse.Namespace) -> int:
 
 def _plot_sweep(args: argparse.Namespace) -> int:
     from clearjoint.sweep import open_sweep
-    from clearjoint.sweep.plot import plot_sweep
+    from clearjoint.sweep.plot import default_picture, save_sweep_plot
 
     store, variable = args.plot
     if args.sweep is not None:
         raise ParameterError("--plot STORE VAR takes no sweep file")
-    default = Path(store).with_name(f"{Path(store).stem}_{variable}.png")
-    out = figure_target(args.out or str(default), "--out", force=args.force)  # the picture
-    ax = plot_sweep(open_sweep(store), variable)
-    ax.figure.savefig(out, dpi=110)
-    print(f"wrote {out}")
+    picture = args.out or str(default_picture(store, variable))
+    out = figure_target(picture, "--out", force=args.force)  # checked before the work
+    print(f"wrote {save_sweep_plot(open_sweep(store), variable, out)}")
     return 0
 
 
@@ -462,20 +451,15 @@ def _run_modes(args: argparse.Namespace) -> int:
 
 
 def _run_structure(args: argparse.Namespace) -> int:
-    from matplotlib.figure import Figure
-
     from clearjoint.structure.study import load_structure_study
-    from clearjoint.studies import run_structure_task
+    from clearjoint.studies import run_structure_task, write_structure_result
 
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
     result = run_structure_task(study, args.task, figure=plot_path is not None)
-    result.data.to_netcdf(out, engine="h5netcdf")
-    if plot_path is not None and isinstance(result.drawn, Figure):
-        _save_figure(result.drawn, plot_path, quiet=True)
-    elif plot_path is not None:
-        _save_plot(result.drawn, plot_path, quiet=True)
+    write_structure_result(result, out)
+    _save_plot(result.drawn, plot_path, quiet=True)
     if args.json:
         print(json.dumps(result.summary))
         return 0
