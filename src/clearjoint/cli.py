@@ -6,6 +6,9 @@ number for a dimensional quantity is refused with the way to write it, since
 Options given beside ``--study`` override the study. Bad input, including a
 file that is missing, a folder, empty, binary or of the wrong kind, ends with
 exit code 2 and one line on stderr that says what is wrong and where.
+
+The subcommands, their options and help are declared in :mod:`clearjoint.cli_parser`;
+here each parsed command is run and its result printed.
 """
 
 from __future__ import annotations
