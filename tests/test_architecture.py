@@ -162,7 +162,6 @@ def test_no_private_name_is_imported_across_packages() -> None:
     assert _private_crossings() == []
 
 
-@pytest.mark.xfail(reason="cli.py is 938 lines: the parser tree to thin further (issue 23 open)")
 @pytest.mark.parametrize(("module", "most"), [("clearjoint.cli", 700)])
 def test_the_command_line_is_thin(module: str, most: int) -> None:
     lines = MODULES[module].read_text(encoding="utf-8").count("\n")

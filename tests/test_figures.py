@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import numpy as np
 
 from clearjoint.figures import Curve, stiffness_coefficient_figure
@@ -110,3 +113,23 @@ def test_identified_loop_figure_of_a_damper_in_mm_with_its_own_stages_and_the_re
     }
     assert len([line for line in ax.get_lines() if np.ptp(line.get_xdata()) == 0]) == 2
     assert not fig.texts
+
+
+def test_save_figure_writes_a_drawn_figure_or_draws_a_result_first(tmp_path: Path) -> None:
+    """clearjoint.plotting.save_figure: the --plot file of every command."""
+    from matplotlib.figure import Figure
+
+    from clearjoint.plotting import save_figure
+
+    class Result:
+        def plot(self, ax: Any) -> Any:
+            ax.plot([0.0, 1.0], [1.0, 0.0], label="drawn")
+            return ax
+
+    fig = Figure()
+    fig.add_subplot().plot([0.0, 1.0])
+    drawn = save_figure(fig, tmp_path / "made" / "fig.png")  # the folder is made
+    assert drawn == tmp_path / "made" / "fig.png"
+    assert drawn.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    result = save_figure(Result(), str(tmp_path / "result.svg"))
+    assert "<svg" in result.read_text(encoding="utf-8")

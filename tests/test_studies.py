@@ -19,7 +19,9 @@ from clearjoint.studies import (
     losses_at,
     refuse_harmonic_losses,
     refuse_harmonic_structure,
+    run_structure_task,
     study_at,
+    write_structure_result,
 )
 
 STUDY = """
@@ -151,6 +153,18 @@ def test_a_structure_study_with_impacts_is_refused_and_needs_harmonic_balance(
         refuse_harmonic_structure(study, "frf")
     with pytest.raises(ParameterError, match="add --method harmonic"):
         frequency_response_of(study, 100.0, 900.0, method="shooting")
+
+
+def test_a_structure_task_is_written_to_netcdf_as_its_dataset(tmp_path: Path) -> None:
+    import xarray as xr
+
+    path = tmp_path / "chain.toml"
+    path.write_text(CHAIN, encoding="utf-8")
+    result = run_structure_task(load_structure_study(path), "modes")
+    out = write_structure_result(result, str(tmp_path / "modes.nc"))
+    assert out == tmp_path / "modes.nc"
+    with xr.open_dataset(out, engine="h5netcdf") as written:
+        xr.testing.assert_identical(written.load(), result.data)
 
 
 def test_too_few_samples_alias_and_are_refused() -> None:

@@ -20,7 +20,7 @@ from clearjoint.cli import main
 from clearjoint.errors import OutputExistsError
 from clearjoint.parallel import StoreError, point_seed
 from clearjoint.sweep import SERIAL, TASKS, Sweep, SweepError, open_sweep, run_sweep
-from clearjoint.sweep.plot import plot_sweep
+from clearjoint.sweep.plot import default_picture, plot_sweep, save_sweep_plot
 from helpers import LINEAR_STUDY
 
 GAP_STUDY = """
@@ -392,6 +392,18 @@ compression_stiffness = ["5e7N/m", "8e7N/m", "1e8N/m"]
     text = MONTE_CARLO.format(samples=20, chunk=20, lower='lower = "0mm"')
     ax = plot_sweep(run_sweep(Sweep.from_toml(_files(tmp_path, text)), client=SERIAL), "impact_j")
     assert ax.get_ylabel() == "samples"
+
+
+def test_a_sweep_picture_is_named_beside_its_store_and_written_where_asked(
+    tmp_path: Path,
+) -> None:
+    assert default_picture("runs/gap.zarr", "total_j") == Path("runs/gap_total_j.png")
+    path = _files(tmp_path, 'base = "study.toml"\n[task]\nname = "energies"\namplitude = "5um"\n'
+                  '[axes.joint]\nclearance = ["0.05mm", "0.1mm"]\n')  # fmt: skip
+    results = run_sweep(Sweep.from_toml(path), client=SERIAL)
+    picture = save_sweep_plot(results, "total_j", str(tmp_path / "total.png"))
+    assert picture == tmp_path / "total.png"
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_stepped_sine_peak_is_the_linear_resonance_on_its_grid(tmp_path: Path) -> None:

@@ -6,13 +6,15 @@ number for a dimensional quantity is refused with the way to write it, since
 Options given beside ``--study`` override the study. Bad input, including a
 file that is missing, a folder, empty, binary or of the wrong kind, ends with
 exit code 2 and one line on stderr that says what is wrong and where.
+
+The subcommands, their options and help are declared in :mod:`clearjoint.cli_parser`;
+here each parsed command is run and its result printed.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import json
 import logging
 import math
@@ -21,284 +23,19 @@ import sys
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any
 
-import numpy as np
-
-from clearjoint import __version__
 from clearjoint.checks import figure_target, netcdf_target, refuse_file_as_folder
+from clearjoint.cli_parser import (
+    EXIT_BAD_INPUT,
+    OPTION_NAMES,
+    amplitude_values,
+    build_parser,
+    study_values,
+)
 from clearjoint.errors import ClearjointError, ParameterError
 
-EXIT_BAD_INPUT = 2
-
-
-class _Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are one line and exit code 2."""
-
-    def error(self, message: str) -> NoReturn:
-        if message.endswith("expected one argument"):  # also "--gap-offset -0.01mm"
-            option = message.removeprefix("argument ").split(":")[0].split("/")[-1]
-            message += f"; for a negative value write {option}=-0.01mm"
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see --help)\n")
-
-
-def _flags(p: argparse.ArgumentParser, **helps: str) -> None:
-    """Add an on/off option ``--NAME`` (``_`` written ``-``) for each keyword, with its help."""
-    for name, text in helps.items():
-        p.add_argument(f"--{name.replace('_', '-')}", action="store_true", help=text)
-
-
-def _options(p: argparse.ArgumentParser, **helps: str) -> None:
-    """Add a text option ``--NAME`` (``_`` written ``-``) for each keyword, with its help."""
-    for name, text in helps.items():
-        p.add_argument(f"--{name.replace('_', '-')}", help=text)
-
-
-def _default(owner: type, name: str, scale: float = 1.0, unit: str = "") -> str:
-    """The default of dataclass field ``owner.name`` in ``--help``, e.g. ``(default 206GPa)``."""
-    value = next(f.default for f in dataclasses.fields(owner) if f.name == name)
-    assert isinstance(value, int | float), f"{owner.__name__}.{name} has no number default"
-    return f"(default {value / scale:g}{unit})"
-
-
-def _stiffness_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "stiffness",
-        help="dynamic stiffness of a clearance joint at given amplitudes (MODEL.md sec. 1)",
-        description=(
-            "Exact period, natural frequency, dynamic stiffness k_d = m w_n^2 and stiffness "
-            "coefficient c_d = k_d / k_inf of a joint with clearance, at one or several "
-            "amplitudes A beyond the compression gap edge. Every dimensional value takes "
-            "a unit (0.106mm, 5um, 8e7N/m); a bare number is refused."
-        ),
-    )
-    _add_joint_options(p, required=True)
-    _flags(p, json=_JSON_TABLE)
-    _add_plot_option(p, force=True)
-
-
-_JSON_TABLE = "print one JSON object instead of a table"
-_JOBS = "processes (default: every core)"
-
-
-def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
-    from clearjoint.joint import Joint
-
-    p.add_argument("--mass", required=required, help="moving mass, e.g. 2kg")
-    p.add_argument(
-        "--stiffness", required=required, help="compression contact stiffness, e.g. 8e7N/m"
-    )
-    _options(
-        p,
-        tension_stiffness="tension contact stiffness (default: the study's, or --stiffness)",
-        gap_stiffness=f"stiffness inside the gap k0 {_default(Joint, 'gap_stiffness')}",
-    )
-    p.add_argument("--clearance", required=required, help="total axial clearance, e.g. 0.106mm")
-    _options(p, gap_offset=f"offset of the gap centre {_default(Joint, 'gap_offset')}")
-    p.add_argument(
-        "--amplitude", required=True, help="penetration(s) beyond the gap edge, e.g. 1um,5um,20um"
-    )
-
-
-def _dissipation_parser(sub: Any) -> None:
-    from clearjoint.joint import Losses, Pin
-
-    p = sub.add_parser(
-        "dissipation",
-        help="energy dissipated per cycle by each mechanism (MODEL.md sec. 2)",
-        description=(
-            "Sliding friction (exact and the paper's viscous form), Hertz contact friction on "
-            "the pin, impact and their total per cycle, with the loss factor, on the free "
-            "cycle at penetration A. The joint, losses and pin come from options or from a "
-            "study file (--study); options given beside --study override it."
-        ),
-    )
-    p.add_argument("--study", help="take the joint, losses and pin from this study TOML")
-    _add_joint_options(p, required=False)
-    _options(
-        p,
-        friction_coefficient="sliding-friction coefficient mu_s",
-        lateral_load="lateral load P, e.g. 300N",
-    )
-    p.add_argument("--friction-region", choices=["everywhere", "free-play"])
-    _options(
-        p,
-        restitution=f"coefficient of restitution e {_default(Losses, 'restitution')}",
-        damping_ratio="viscous damping ratio of the linear part",
-        pin_radius="pin radius, e.g. 5mm (gives a pin)",
-        pin_length="pin contact length, e.g. 25mm",
-        hole_radius="hole radius (default: pin radius + clearance/2)",
-        youngs_modulus="Young's modulus of pin and hole "
-        + _default(Pin, "youngs_modulus", 1e9, "GPa"),
-        poisson_ratio=f"Poisson's ratio of pin and hole {_default(Pin, 'poisson_ratio')}",
-        contact_friction_coefficient="friction coefficient on the pin mu_c",
-    )
-    _flags(p, json=_JSON_TABLE)
-    _add_plot_option(p, force=True)
-
-
-def _reproduce_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "reproduce",
-        help="run the paper's whole study on the virtual rig and write a report",
-        description=(
-            "Run the default campaign of the virtual rig (or --campaign), identify every "
-            "record, fit eq 19-22, re-run the campaign without the rig's installation "
-            "sensitivity as the findings' control, draw Figs. 7-13 and write "
-            "DIR/report.html (opening with the findings table), DIR/results.json, "
-            "DIR/results.csv, DIR/fits.csv and DIR/records/."
-        ),
-    )
-    p.add_argument("--out", default="clearjoint-reproduction", help="output folder")
-    p.add_argument("--campaign", help="campaign file (TOML); default: the shipped one")
-    p.add_argument("--jobs", type=int, default=None, help=_JOBS)
-    p.add_argument(
-        "--scheduler",
-        help="run the rig's tests on a running Dask scheduler, e.g. tcp://host:8786 "
-        "(its workers must see --out)",
-    )
-    p.add_argument("--workers", type=int, help="run them on a local Dask cluster of N workers")
-    _flags(p, force="overwrite existing output files")
-
-
-def _report_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "report",
-        help="identify a folder of your own records, fit the laws and write a report",
-        description=(
-            "Identify every record in --records (CSV, netCDF, BRFD JSON), fit eq 19-22 where "
-            "the tests allow, and write DIR/report.html, results.json, results.csv, fits.csv."
-        ),
-    )
-    p.add_argument("--records", required=True, help="folder of record files")
-    p.add_argument("--out", default="clearjoint-report", help="output folder")
-    _flags(p, force="overwrite existing output files")
-
-
-def _simulate_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "simulate",
-        help="exact forced response of a joint described in a study file",
-        description=(
-            "Run the study in STUDY.toml (joint, excitation, losses; see docs/simulate.md): "
-            "the exact steady state (or transient), its stages, impacts and energy ledger. "
-            "Prints a summary, or with --json one JSON object; --out writes netCDF."
-        ),
-    )
-    p.add_argument("study", help="study file (TOML)")
-    _options(p, out="write the motion as a test record to this netCDF file (.nc; see records)")
-    _flags(
-        p,
-        json="print the summary as one JSON object",
-        force="overwrite --out or --plot if it exists",
-    )
-    _add_plot_option(p, force=False)
-
-
-def _rig_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "rig",
-        help="run a campaign of the virtual test rig and write its records",
-        description=(
-            "Simulate every test of CAMPAIGN.toml (the shipped default when none is given: "
-            "the paper's two joints and the bare beam over a grid of forces and frequencies) "
-            "and write one record per test and DIR/manifest.csv with the truth of each."
-        ),
-    )
-    p.add_argument("campaign", nargs="?", help="campaign file (TOML); default: the shipped one")
-    p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--jobs", type=int, default=None, help=_JOBS)
-    _flags(p, force="overwrite existing records", quiet="no progress bar")
-
-
-def _identify_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "identify",
-        help="clearance, stiffness, friction and energy per cycle from test records",
-        description=(
-            "Identify every record (CSV, netCDF, BRFD JSON; recognised by content): one row "
-            "per file in --out (.csv or .nc) with each quantity's value over the steady "
-            "cycles, its spread over the cycles (_std) and its standard error (_se), then "
-            "a credibility flag (ok, doubtful, rejected) and flag_reason; one line for "
-            "every file not used."
-        ),
-    )
-    p.add_argument("files", nargs="+", help="record files")
-    p.add_argument("--out", required=True, help="results file, .csv or .nc")
-    _options(p, figures="write two figures per test into this folder")
-    p.add_argument(
-        "--plot",
-        metavar="FILE.png",
-        help="draw every identified loop with its flag into one figure (.png, .pdf or .svg)",
-    )
-    p.add_argument(
-        "--jobs", type=int, default=1, help="processes over the files (default 1; same results)"
-    )
-    _flags(p, resample="interpolate records that are not uniformly sampled")
-    p.add_argument(
-        "--tolerance",
-        type=float,
-        default=0.03,
-        help="steady-cycle amplitude tolerance (default 0.03)",
-    )
-    _flags(p, force="overwrite existing output and --plot", quiet="no progress bar")
-
-
-def _frf_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "frf",
-        help="whole frequency-response curve of exact periodic orbits, stable and unstable",
-        description=(
-            "Follow the exact period-1 orbit of the joint in STUDY.toml (joint, force, losses; "
-            "its frequency is not used) by continuation from --from to --to, through folds; "
-            "report folds, period doublings and grazings. With --parameter force, --from and "
-            "--to are forces and --frequency (default: the study's) is held fixed. A structure "
-            "study (clearjoint structure's file: [structure], [joint], [excitation]) is followed "
-            "by harmonic balance (--method harmonic), with per-DOF extremes."
-        ),
-    )
-    p.add_argument("study", help="study file (TOML), as for clearjoint simulate")
-    p.add_argument("--from", dest="start", required=True, help="start: 20Hz (or 100N)")
-    p.add_argument("--to", dest="stop", required=True, help="end: 900Hz (or 2kN)")
-    p.add_argument("--out", required=True, help="write the curve to this netCDF file (.nc)")
-    _add_plot_option(p, force=False)
-    _flags(p, json="print the curve as one JSON object")
-    p.add_argument(
-        "--parameter",
-        choices=["frequency", "force"],
-        default="frequency",
-        help="what varies along the curve (default frequency)",
-    )
-    _options(p, frequency="fixed frequency with --parameter force, e.g. 400Hz")
-    p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
-    _flags(p, force="overwrite --out / --plot if they exist")
-    p.add_argument(
-        "--method",
-        choices=["shooting", "harmonic"],
-        default="shooting",
-        help="exact shooting (default) or harmonic balance (clearjoint.harmonic)",
-    )
-    _add_harmonic_options(p, "H with --method harmonic")
-
-
-def _add_harmonic_options(p: argparse.ArgumentParser, harmonics: str) -> None:
-    # 7 is studies.rules.DEFAULT_HARMONICS, typed here: importing the study layer at
-    # parser build would import every solver
-    p.add_argument("--harmonics", type=int, help=f"{harmonics} (default 7)")
-    p.add_argument(
-        "--samples",
-        type=int,
-        help="harmonic balance: time samples per period, at least 2 (2H + 1) "
-        "(default 32 (2H + 1) rounded up to a power of two)",
-    )
-
-
-def _add_plot_option(p: argparse.ArgumentParser, *, force: bool) -> None:
-    p.add_argument(
-        "--plot", metavar="FILE.png", help="draw the result into this figure (.png, .pdf or .svg)"
-    )
-    if force:
-        _flags(p, force="overwrite --plot if it exists")
+__all__ = ["build_parser", "main"]  # build_parser lives in clearjoint.cli_parser
 
 
 def _plot_target(args: argparse.Namespace) -> Path | None:
@@ -307,22 +44,13 @@ def _plot_target(args: argparse.Namespace) -> Path | None:
 
 
 def _save_plot(result: Any, path: Path | None, *, quiet: bool) -> None:
-    """Draw ``result.plot(ax)`` on a new figure and save it to ``path`` (nothing if None)."""
-    if path is None:
-        return
-    from matplotlib.figure import Figure
+    """Save ``result`` (a Figure, or drawn by its ``plot(ax)``) to ``path`` (nothing if None)."""
+    from clearjoint.plotting import save_figure
 
-    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
-    result.plot(fig.add_subplot())
-    _save_figure(fig, path, quiet=quiet)
-
-
-def _save_figure(fig: Any, path: Path, *, quiet: bool) -> None:
-    """Save a drawn Figure to the --plot file ``path`` (checked by :func:`_plot_target`)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    if not quiet:
-        print(f"wrote {path}")
+    if path is not None:
+        save_figure(result, path)
+        if not quiet:
+            print(f"wrote {path}")
 
 
 def _netcdf_target(args: argparse.Namespace) -> Path:
@@ -330,150 +58,13 @@ def _netcdf_target(args: argparse.Namespace) -> Path:
     return netcdf_target(args.out, args.command, force=args.force)
 
 
-def _sweep_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "sweep",
-        help="parameter study or tolerance Monte Carlo from a sweep file, on Dask",
-        description=(
-            "Run the task of SWEEP.toml at every point of its grid axes and Monte Carlo "
-            "draws (see docs/sweep.md), on a local Dask cluster or on a running scheduler, "
-            "writing --out (a zarr store) chunk by chunk. With --plot STORE VAR: draw one "
-            "output (a map, a line or a histogram) to --out (PNG)."
-        ),
-    )
-    p.add_argument("sweep", nargs="?", help="sweep file (TOML)")
-    _options(
-        p,
-        out="zarr store to write (.zarr); with --plot, the PNG",
-        scheduler="a running Dask scheduler, e.g. tcp://host:8786",
-    )
-    p.add_argument("--workers", type=int, help="local cluster's worker processes (default: cores)")
-    _flags(
-        p,
-        resume="finish an interrupted --out store",
-        force="replace an existing --out",
-        quiet="no progress bar",
-    )
-    p.add_argument("--plot", nargs=2, metavar=("STORE", "VAR"), help="draw VAR of a store")
-
-
-def _modes_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "modes",
-        help="nonlinear mode: frequency and damping ratio against amplitude (EPMC)",
-        description=(
-            "Nonlinear mode of the joint in STUDY.toml (joint and losses; its excitation is "
-            "not used), or of the structure in a structure study, by harmonic balance and the "
-            "extended periodic motion concept, at --points amplitudes spaced logarithmically "
-            "over --amplitude (for a structure: on the DOF where the closed linear mode moves "
-            "most)."
-        ),
-    )
-    p.add_argument("study", help="study file (TOML), as for clearjoint simulate")
-    p.add_argument("--mode", type=int, default=1, help="mode number (default 1)")
-    p.add_argument(
-        "--amplitude", required=True, help="modal amplitude range, e.g. 1um..1mm (or one value)"
-    )
-    p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
-    _add_harmonic_options(p, "H")
-    p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
-    _add_plot_option(p, force=False)
-    _flags(
-        p,
-        json="print the mode as one JSON object",
-        force="overwrite --out / --plot if they exist",
-    )
-
-
-def _structure_parser(sub: Any) -> None:
-    p = sub.add_parser(
-        "structure",
-        help="modes, forced response or free decay of a structure with many joints (MODEL 5.2)",
-        description=(
-            "Read a structure study (TOML with units, see clearjoint.structure.study) and "
-            "compute its linear modes with every joint closed and open (modes), its exact "
-            "forced response (respond) or its exact free decay and backbone (decay)."
-        ),
-    )
-    p.add_argument("study", help="structure study TOML file")
-    p.add_argument("task", choices=("modes", "respond", "decay"), help="what to compute")
-    p.add_argument("--out", required=True, help="netCDF results file (.nc)")
-    _add_plot_option(p, force=False)
-    _flags(p, json="print a JSON summary", force="overwrite existing output")
-
-
-def build_parser() -> argparse.ArgumentParser:
-    """Return the argument parser of the ``clearjoint`` command."""
-    parser = _Parser(prog="clearjoint", description="Dynamics of joints with clearance.")
-    parser.add_argument("--version", action="version", version=f"clearjoint {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for add in (
-        _stiffness_parser,
-        _simulate_parser,
-        _dissipation_parser,
-        _rig_parser,
-        _identify_parser,
-        _reproduce_parser,
-        _report_parser,
-        _frf_parser,
-        _sweep_parser,
-        _modes_parser,
-        _structure_parser,
-    ):
-        add(sub)
-    return parser
-
-
-#: Options that set a study value: (option, its key in the study file, kind of quantity).
-_STUDY_OPTIONS = (
-    ("mass", "joint.mass", "mass"),
-    ("clearance", "joint.clearance", "length"),
-    ("stiffness", "joint.compression_stiffness", "stiffness"),
-    ("tension-stiffness", "joint.tension_stiffness", "stiffness"),
-    ("gap-stiffness", "joint.gap_stiffness", "stiffness"),
-    ("gap-offset", "joint.gap_offset", "length"),
-    ("friction-coefficient", "losses.friction_coefficient", "dimensionless"),
-    ("lateral-load", "losses.lateral_load", "force"),
-    ("friction-region", "losses.friction_region", "text"),
-    ("restitution", "losses.restitution", "dimensionless"),
-    ("damping-ratio", "losses.damping_ratio", "dimensionless"),
-    ("pin-radius", "pin.radius", "length"),
-    ("pin-length", "pin.length", "length"),
-    ("hole-radius", "pin.hole_radius", "length"),
-    ("youngs-modulus", "pin.youngs_modulus", "pressure"),
-    ("poisson-ratio", "pin.poisson_ratio", "dimensionless"),
-    ("contact-friction-coefficient", "losses.contact_friction_coefficient", "dimensionless"),
-)
-#: How the study layer's errors name each value: as the option that gives it.
-_NAMES = {key: f"--{option}" for option, key, _ in _STUDY_OPTIONS} | {
-    "samples": "--samples",
-    "harmonics": "--harmonics",
-}
-
-
-def _overrides(args: argparse.Namespace) -> dict[str, Any]:
-    """The study values given as options, in SI by study key; a bare number is refused."""
-    from clearjoint.units import parse_quantity
-
-    values: dict[str, Any] = {}
-    for option, key, kind in _STUDY_OPTIONS:
-        text = getattr(args, option.replace("-", "_"), None)
-        if text is not None:
-            values[key] = (
-                text
-                if kind == "text"
-                else parse_quantity(text, kind, name=f"--{option}", bare="refuse")
-            )
-    return values
-
-
 def _run_stiffness(args: argparse.Namespace) -> int:
     from clearjoint import stiffness
     from clearjoint.studies import joint_at
     from clearjoint.studies.text import json_value, stiffness_lines, stiffness_table
 
-    joint = joint_at(None, _overrides(args), _NAMES)
-    amplitudes = _amplitudes(args)
+    joint = joint_at(None, study_values(args), OPTION_NAMES)
+    amplitudes = amplitude_values(args)
     plot = _plot_target(args)
     _save_plot(stiffness.stiffness_curve(joint, amplitudes), plot, quiet=args.json)
     table = stiffness_table(joint, amplitudes)
@@ -491,10 +82,10 @@ def _run_dissipation(args: argparse.Namespace) -> int:
     from clearjoint.studies.text import dissipation_lines, json_value
 
     base = load_study(args.study) if args.study else None
-    given = _overrides(args)
-    joint = joint_at(base.joint if base is not None else None, given, _NAMES)
-    losses = losses_at(base, joint, given, _NAMES)
-    amplitudes = _amplitudes(args)
+    given = study_values(args)
+    joint = joint_at(base.joint if base is not None else None, given, OPTION_NAMES)
+    losses = losses_at(base, joint, given, OPTION_NAMES)
+    amplitudes = amplitude_values(args)
     plot = _plot_target(args)
     values = dissipation.energies(joint, amplitudes, losses=losses)
     _save_plot(values, plot, quiet=args.json)
@@ -528,13 +119,6 @@ def _run_simulate(args: argparse.Namespace) -> int:
     lines = simulation_lines(study.source, study.mode, result)
     print("\n".join(lines + ([f"wrote {args.out}"] if args.out else [])))
     return 0
-
-
-def _amplitudes(args: argparse.Namespace) -> Any:
-    from clearjoint.units import parse_quantity_list
-
-    values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
-    return np.array(values)
 
 
 def _run_rig(args: argparse.Namespace) -> int:
@@ -764,16 +348,14 @@ def _run_sweep(args: argparse.Namespace) -> int:
 
 def _plot_sweep(args: argparse.Namespace) -> int:
     from clearjoint.sweep import open_sweep
-    from clearjoint.sweep.plot import plot_sweep
+    from clearjoint.sweep.plot import default_picture, save_sweep_plot
 
     store, variable = args.plot
     if args.sweep is not None:
         raise ParameterError("--plot STORE VAR takes no sweep file")
-    default = Path(store).with_name(f"{Path(store).stem}_{variable}.png")
-    out = figure_target(args.out or str(default), "--out", force=args.force)  # the picture
-    ax = plot_sweep(open_sweep(store), variable)
-    ax.figure.savefig(out, dpi=110)
-    print(f"wrote {out}")
+    picture = args.out or str(default_picture(store, variable))
+    out = figure_target(picture, "--out", force=args.force)  # checked before the work
+    print(f"wrote {save_sweep_plot(open_sweep(store), variable, out)}")
     return 0
 
 
@@ -829,7 +411,7 @@ def _run_frf(args: argparse.Namespace) -> int:
         harmonics=args.harmonics,
         samples=args.samples,
         max_points=args.max_points,
-        names=_NAMES,
+        names=OPTION_NAMES,
     )
     write_curve(curve, args.out, study.source)
     _save_plot(curve, plot_path, quiet=True)
@@ -852,7 +434,12 @@ def _run_modes(args: argparse.Namespace) -> int:
     plot_path = _plot_target(args)
     amplitudes = parse_amplitude_range(args.amplitude, args.points)
     mode = nonlinear_modes_of(
-        study, args.mode, amplitudes, harmonics=args.harmonics, samples=args.samples, names=_NAMES
+        study,
+        args.mode,
+        amplitudes,
+        harmonics=args.harmonics,
+        samples=args.samples,
+        names=OPTION_NAMES,
     )
     write_curve(mode, args.out, study.source)
     _save_plot(mode, plot_path, quiet=True)
@@ -867,20 +454,15 @@ def _run_modes(args: argparse.Namespace) -> int:
 
 
 def _run_structure(args: argparse.Namespace) -> int:
-    from matplotlib.figure import Figure
-
     from clearjoint.structure.study import load_structure_study
-    from clearjoint.studies import run_structure_task
+    from clearjoint.studies import run_structure_task, write_structure_result
 
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
     result = run_structure_task(study, args.task, figure=plot_path is not None)
-    result.data.to_netcdf(out, engine="h5netcdf")
-    if plot_path is not None and isinstance(result.drawn, Figure):
-        _save_figure(result.drawn, plot_path, quiet=True)
-    elif plot_path is not None:
-        _save_plot(result.drawn, plot_path, quiet=True)
+    write_structure_result(result, out)
+    _save_plot(result.drawn, plot_path, quiet=True)
     if args.json:
         print(json.dumps(result.summary))
         return 0

@@ -1,11 +1,12 @@
 """Shared plumbing of the result objects' ``plot``, ``to_xarray`` and ``to_pandas`` methods.
 
-No physics here: where a new Axes comes from, and how a result's 1-D amplitude
-axis is checked before it becomes a table.
+No physics here: where a new Axes comes from, how a drawn result is saved to a file,
+and how a result's 1-D amplitude axis is checked before it becomes a table.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -43,3 +44,21 @@ def one_dimensional(name: str, values: NDArray[np.float64]) -> NDArray[np.float6
             "compute the result for a 1-D array of amplitudes"
         )
     return array
+
+
+def save_figure(drawn: Any, path: str | Path) -> Path:
+    """Save ``drawn`` to the figure file ``path`` (its folder made) and return the path.
+
+    ``drawn`` is a matplotlib Figure already drawn, or a result with ``plot(ax)``, drawn
+    here on a new 6.4 x 4.4 inch Figure (no pyplot, so no display is needed). The file
+    is written at 120 dpi in the format of its suffix (.png, .pdf or .svg).
+    """
+    from matplotlib.figure import Figure
+
+    if not isinstance(drawn, Figure):
+        result, drawn = drawn, Figure(figsize=(6.4, 4.4), layout="constrained")
+        result.plot(drawn.add_subplot())
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    drawn.savefig(path, dpi=120)
+    return path

@@ -54,6 +54,7 @@ _HOMES = {
     "tension_follows": "rules",
     "write_curve": "curves",
     "write_netcdf": "joint_study",
+    "write_structure_result": "structure",
 }
 
 
@@ -86,6 +87,7 @@ __all__ = [
     "tension_follows",
     "write_curve",
     "write_netcdf",
+    "write_structure_result",
 ]
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ __all__ = [
     "STRUCTURE_TASKS",
     "StructureTaskResult",
     "run_structure_task",
+    "write_structure_result",
 ]
 
 #: The tasks :func:`run_structure_task` runs.
@@ -120,3 +122,14 @@ def run_structure_task(
     else:
         raise ParameterError(f"task must be one of {', '.join(STRUCTURE_TASKS)}, got {task!r}")
     return StructureTaskResult(data, summary, drawn)
+
+
+def write_structure_result(result: StructureTaskResult, path: str | Path) -> Path:
+    """Write a structure task's Dataset (``result.data``) to the netCDF file ``path``.
+
+    The folder must exist (the command line checks ``--out`` before the run); returns
+    the path written.
+    """
+    path = Path(path)
+    result.data.to_netcdf(path, engine="h5netcdf")
+    return path

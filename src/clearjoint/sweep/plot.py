@@ -9,6 +9,7 @@ a store not yet computed.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -16,7 +17,9 @@ import numpy as np
 from clearjoint.errors import ParameterError
 
 __all__ = [
+    "default_picture",
     "plot_sweep",
+    "save_sweep_plot",
 ]
 
 #: Display units for SI lengths and energies: (largest magnitude below which, unit, scale).
@@ -134,3 +137,19 @@ def plot_sweep(results: Any, variable: str, ax: Any = None) -> Any:
     counts += [f"{missing} not computed"] if missing else []
     ax.set_title(title + (f" ({', '.join(counts)})" if counts else ""))
     return ax
+
+
+def default_picture(store: str | Path, variable: str) -> Path:
+    """The picture of ``variable`` beside its store: ``STORE_VARIABLE.png`` (``.zarr`` dropped)."""
+    store = Path(store)
+    return store.with_name(f"{store.stem}_{variable}.png")
+
+
+def save_sweep_plot(results: Any, variable: str, path: str | Path) -> Path:
+    """Draw ``variable`` of a sweep's Dataset (:func:`plot_sweep`) into the file ``path``.
+
+    Written at 110 dpi in the format of the file's suffix; returns the path.
+    """
+    path = Path(path)
+    plot_sweep(results, variable).figure.savefig(path, dpi=110)
+    return path
