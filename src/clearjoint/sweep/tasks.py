@@ -43,9 +43,12 @@ from typing import Any
 
 import numpy as np
 
+from clearjoint.dissipation import ENERGY_KEYS
 from clearjoint.errors import ParameterError
+from clearjoint.identify import QUANTITIES
 from clearjoint.studies.curves import solver_losses
 from clearjoint.studies.overrides import structure_at, study_at
+from clearjoint.units import unit_of_name
 
 __all__ = [
     "FORCING_PARAMETERS",
@@ -121,16 +124,9 @@ def _task(
     return register
 
 
-#: An output's unit, read from the end of its name (``_m`` metres, ``_j`` joules, ...).
-_UNIT_SUFFIXES = (("_n_per_m", "N/m"), ("_hz", "Hz"), ("_j", "J"), ("_m", "m"), ("_n", "N"))
-
-
 def _outputs(*names: str) -> dict[str, str]:
-    """Each output name with its unit by :data:`_UNIT_SUFFIXES` (none: dimensionless)."""
-    return {
-        name: next((unit for end, unit in _UNIT_SUFFIXES if name.endswith(end)), "")
-        for name in names
-    }
+    """Each output name with its unit, read from the name's ending (units.unit_of_name)."""
+    return {name: unit_of_name(name) for name in names}
 
 
 def _count(lower: float) -> Parameter:
@@ -237,17 +233,7 @@ def _steady_state(
     "study",
     JOINT_PARAMETERS,
     {"task.amplitude": (None, Parameter("length", "m"))},
-    _outputs(
-        "sliding_friction_j",
-        "sliding_friction_paper_j",
-        "contact_friction_j",
-        "impact_j",
-        "viscous_j",
-        "total_j",
-        "loss_factor",
-        "equivalent_damping_ratio",
-        "hertz_half_width_m",
-    ),
+    _outputs(*ENERGY_KEYS),
     "energies per free cycle at penetration task.amplitude (MODEL.md eq 10-18)",
 )
 def _energies(
@@ -654,19 +640,8 @@ class RecordSet:
     source: str = ""
 
 
-_IDENTIFIED = _outputs(
-    "amplitude_m",
-    "clearance_m",
-    "compression_stiffness_n_per_m",
-    "tension_stiffness_n_per_m",
-    "friction_force_n",
-    "energy_per_cycle_j",
-    "compression_penetration_m",
-    "tension_penetration_m",
-    "gap_stiffness_n_per_m",
-    "secant_stiffness_n_per_m",
-    "dynamic_stiffness_n_per_m",
-)
+#: What ``identify`` reports of a record: the per-cycle quantities of a clearance joint.
+_IDENTIFIED = _outputs(*QUANTITIES[: QUANTITIES.index("dynamic_stiffness_n_per_m") + 1])
 
 
 @_task(
