@@ -334,6 +334,40 @@ _MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*")
 _LINES = ("-", "--", "-.", ":", (0, (5, 1, 1, 1)), (0, (3, 1, 1, 1, 1, 1)))
 
 
+def _points_and_lines(
+    ax: Any,
+    frequency: NDArray[np.float64],
+    amplitude: NDArray[np.float64],
+    values: NDArray[np.float64],
+    lines: dict[float, tuple[NDArray[np.float64], NDArray[np.float64]]],
+    *,
+    divisor: float = 1.0,
+    error: NDArray[np.float64] | None = None,
+) -> None:
+    """Draw, per test frequency, the measured ``values`` (open markers, error bars when
+    given) and its law's line against amplitude in µm, all divided by ``divisor``."""
+    for n, f in enumerate(sorted(set(frequency.tolist()))):
+        sel = frequency == f
+        marker = _MARKERS[n % len(_MARKERS)]
+        style = {"color": "0.3", "mfc": "white", "ms": 5, "label": f"{f:g} Hz"}
+        if error is not None:
+            ax.errorbar(
+                amplitude[sel] * 1e6,
+                values[sel] / divisor,
+                yerr=error[sel] / divisor,
+                fmt=marker,
+                capsize=2,
+                **style,
+            )
+        else:
+            ax.plot(amplitude[sel] * 1e6, values[sel] / divisor, marker, **style)
+        if f in lines:
+            grid, law = lines[f]
+            ax.plot(
+                grid * 1e6, law / divisor, linestyle=_LINES[n % len(_LINES)], color="black", lw=1.0
+            )
+
+
 @dataclass(frozen=True)
 class StiffnessPanel:
     """Measured stiffness points and their eq 19 (or eq 20) lines, for one joint and side.
@@ -359,40 +393,15 @@ def stiffness_panels_figure(
     fig = Figure(figsize=(5.2 * cols, 3.8 * rows), layout="constrained")
     axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
     for ax, panel in zip(axes, panels, strict=False):
-        for n, f in enumerate(sorted(set(panel.frequency.tolist()))):
-            sel = panel.frequency == f
-            marker = _MARKERS[n % len(_MARKERS)]
-            if panel.error is not None:
-                ax.errorbar(
-                    panel.amplitude[sel] * 1e6,
-                    panel.stiffness[sel] / 1e6,
-                    yerr=panel.error[sel] / 1e6,
-                    fmt=marker,
-                    color="0.3",
-                    mfc="white",
-                    ms=5,
-                    capsize=2,
-                    label=f"{f:g} Hz",
-                )
-            else:
-                ax.plot(
-                    panel.amplitude[sel] * 1e6,
-                    panel.stiffness[sel] / 1e6,
-                    marker,
-                    color="0.3",
-                    mfc="white",
-                    ms=5,
-                    label=f"{f:g} Hz",
-                )
-            if f in panel.lines:
-                grid, values = panel.lines[f]
-                ax.plot(
-                    grid * 1e6,
-                    values / 1e6,
-                    linestyle=_LINES[n % len(_LINES)],
-                    color="black",
-                    lw=1.0,
-                )
+        _points_and_lines(
+            ax,
+            panel.frequency,
+            panel.amplitude,
+            panel.stiffness,
+            panel.lines,
+            divisor=1e6,
+            error=panel.error,
+        )
         ax.set_title(panel.title, fontsize="medium")
         ax.set_xlabel("amplitude A (µm)")
         ax.set_ylabel(ylabel)
@@ -445,22 +454,7 @@ def energy_law_figure(panels: Sequence[EnergyLawPanel]) -> Figure:
     fig = Figure(figsize=(5.2 * len(panels), 4.0), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(panels), squeeze=False)).ravel()
     for ax, panel in zip(axes, panels, strict=True):
-        for n, f in enumerate(sorted(set(panel.frequency.tolist()))):
-            sel = panel.frequency == f
-            ax.plot(
-                panel.amplitude[sel] * 1e6,
-                panel.energy[sel],
-                _MARKERS[n % len(_MARKERS)],
-                color="0.3",
-                mfc="white",
-                ms=5,
-                label=f"{f:g} Hz",
-            )
-            if f in panel.curves:
-                grid, values = panel.curves[f]
-                ax.plot(
-                    grid * 1e6, values, linestyle=_LINES[n % len(_LINES)], color="black", lw=1.0
-                )
+        _points_and_lines(ax, panel.frequency, panel.amplitude, panel.energy, panel.curves)
         ax.set_yscale("log")
         ax.set_xlabel("amplitude Abar = X - c/2 (µm)")
         ax.set_ylabel("energy per cycle (J)")

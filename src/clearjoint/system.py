@@ -48,6 +48,33 @@ Matrix: TypeAlias = Any  # (N, N) float64 ndarray or scipy.sparse.csr_matrix
 SPARSE_ABOVE = 200
 
 
+def force_amplitudes(force: ArrayLike, dof_names: Sequence[str], name: str = "force") -> FloatArray:
+    """The force amplitudes (N) as an (N,) array: one finite value per DOF of ``dof_names``.
+
+    Raises
+    ------
+    ParameterTypeError
+        ``force`` is not numbers.
+    ParameterError
+        Not one value per DOF, or a NaN or infinite one.
+    """
+    n = len(dof_names)
+    try:
+        f = np.asarray(force, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterTypeError(
+            f"{name} must be {n} force amplitudes (N), one per DOF, got {force!r}"
+        ) from None
+    if f.shape != (n,):
+        raise ParameterError(
+            f"{name} must hold one amplitude per DOF, shape ({n},) in N, got shape {f.shape}; "
+            f"the DOFs are {', '.join(dof_names[:6])}" + (", ..." if n > 6 else "")
+        )
+    if not np.all(np.isfinite(f)):
+        raise ParameterError(f"{name} has a NaN or infinite entry")
+    return f
+
+
 class VibrationSystemError(ClearjointError, ValueError):
     """A vibration system that cannot be built as given (the message names the item)."""
 
@@ -365,21 +392,7 @@ class VibrationSystem:
         """
         if self.n_dof == 1 and np.ndim(force) == 0:
             return np.array([_checks.real_scalar(name, force, unit="N")])
-        try:
-            f = np.asarray(force, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise ParameterTypeError(
-                f"{name} must be {self.n_dof} force amplitudes (N), one per DOF, got {force!r}"
-            ) from None
-        if f.shape != (self.n_dof,):
-            raise ParameterError(
-                f"{name} must hold one amplitude per DOF ({self.n_dof}), got shape {f.shape}; "
-                f"the DOFs are {', '.join(self.dof_names[:6])}"
-                + (", ..." if self.n_dof > 6 else "")
-            )
-        if not np.all(np.isfinite(f)):
-            raise ParameterError(f"{name} has a NaN or infinite entry")
-        return f
+        return force_amplitudes(force, self.dof_names, name)
 
     def __repr__(self) -> str:
         kind = "sparse" if self.is_sparse else "dense"

@@ -27,56 +27,48 @@ from clearjoint.errors import ParameterError
 if TYPE_CHECKING:
     import pint
 
-#: The SI unit each kind of quantity is converted to, by name.
-SI_UNITS: dict[str, str] = {
-    "length": "m",
-    "mass": "kg",
-    "stiffness": "N/m",
-    "force": "N",
-    "frequency": "Hz",
-    "angular_frequency": "rad/s",
-    "time": "s",
-    "pressure": "Pa",
-    "velocity": "m/s",
-    "acceleration": "m/s^2",
-    "damping": "N s/m",
-    "rate": "1/s",
-    "dimensionless": "",
+#: Per kind of quantity, by name: the SI unit it is converted to, a unit to show after a
+#: bare number in the "give a unit" message, and a value that parses (for error messages).
+_KINDS: dict[str, tuple[str, str, str]] = {
+    "length": ("m", "mm", "0.106mm"),
+    "mass": ("kg", "kg", "1.5kg"),
+    "stiffness": ("N/m", "N/m", "8e7N/m"),
+    "force": ("N", "N", "200N"),
+    "frequency": ("Hz", "Hz", "20Hz"),
+    "angular_frequency": ("rad/s", "rad/s", "2513rad/s"),
+    "time": ("s", "s", "2s"),
+    "pressure": ("Pa", "GPa", "206GPa"),
+    "velocity": ("m/s", "m/s", "0.1m/s"),
+    "acceleration": ("m/s^2", "m/s^2", "100m/s^2"),
+    "damping": ("N s/m", "N*s/m", "50N*s/m"),
+    "rate": ("1/s", "/s", "0.5/s"),
+    "dimensionless": ("", "", "0.3"),
 }
+
+#: The SI unit each kind of quantity is converted to, by name.
+SI_UNITS: dict[str, str] = {kind: si for kind, (si, _, _) in _KINDS.items()}
 
 #: A unit to show after a bare number in the "give a unit" message, per kind.
-UNIT_HINTS: dict[str, str] = {
-    "length": "mm",
-    "mass": "kg",
-    "stiffness": "N/m",
-    "force": "N",
-    "frequency": "Hz",
-    "angular_frequency": "rad/s",
-    "time": "s",
-    "pressure": "GPa",
-    "velocity": "m/s",
-    "acceleration": "m/s^2",
-    "damping": "N*s/m",
-    "rate": "/s",
-    "dimensionless": "",
-}
+UNIT_HINTS: dict[str, str] = {kind: hint for kind, (_, hint, _) in _KINDS.items()}
 
 #: A value of each kind that parses, for error messages.
-EXAMPLES: dict[str, str] = {
-    "length": "0.106mm",
-    "mass": "1.5kg",
-    "stiffness": "8e7N/m",
-    "force": "200N",
-    "frequency": "20Hz",
-    "angular_frequency": "2513rad/s",
-    "time": "2s",
-    "pressure": "206GPa",
-    "velocity": "0.1m/s",
-    "acceleration": "100m/s^2",
-    "damping": "50N*s/m",
-    "rate": "0.5/s",
-    "dimensionless": "0.3",
-}
+EXAMPLES: dict[str, str] = {kind: example for kind, (_, _, example) in _KINDS.items()}
+
+#: The SI unit a result's name ends with ("energy_per_cycle_j" is in J), longest ending first.
+NAME_SUFFIX_UNITS: tuple[tuple[str, str], ...] = (
+    ("_n_per_m", "N/m"),
+    ("_hz", "Hz"),
+    ("_kg", "kg"),
+    ("_j", "J"),
+    ("_m", "m"),
+    ("_n", "N"),
+)
+
+
+def unit_of_name(name: str, dimensionless: str = "") -> str:
+    """The SI unit of a result named by :data:`NAME_SUFFIX_UNITS` (else ``dimensionless``)."""
+    return next((unit for end, unit in NAME_SUFFIX_UNITS if name.endswith(end)), dimensionless)
+
 
 #: The number a quantity's text must start with (pint would read "mm" as 1 mm).
 #: One comma between two digits, as in '0,106mm': a decimal comma.

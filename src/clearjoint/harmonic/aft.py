@@ -153,14 +153,24 @@ class Basis:
         out[:, 0, :] *= 0.5  # the mean's row of P carries 1 / N_t, the others 2 / N_t
         return np.asarray(out, dtype=np.float64)
 
-    def evaluate(self, coefficients: FloatArray, tau: FloatArray) -> FloatArray:
-        """Return u(tau) for coefficients (2H + 1, ...) at phases tau (n,): shape (n, ...)."""
+    def rows_at(self, tau: FloatArray) -> FloatArray:
+        """Return E(tau) (n, 2H + 1): the rows that map coefficients to u at phases tau (n,)."""
         h = np.arange(1, self.harmonics + 1)
         e = np.empty((tau.size, 2 * self.harmonics + 1))
         e[:, 0] = 1.0
         e[:, 1::2] = np.cos(np.outer(tau, h))
         e[:, 2::2] = np.sin(np.outer(tau, h))
-        return np.asarray(np.tensordot(e, coefficients, axes=(1, 0)), dtype=np.float64)
+        return e
+
+    def evaluate(self, coefficients: FloatArray, tau: FloatArray) -> FloatArray:
+        """Return u(tau) for coefficients (2H + 1, ...) at phases tau (n,): shape (n, ...)."""
+        return np.asarray(
+            np.tensordot(self.rows_at(tau), coefficients, axes=(1, 0)), dtype=np.float64
+        )
+
+    def evaluate_each(self, coefficients: FloatArray, tau: FloatArray) -> FloatArray:
+        """Return column k of coefficients (2H + 1, n) at its own phase tau[k]: shape (n,)."""
+        return np.asarray(np.einsum("kc,ck->k", self.rows_at(tau), coefficients), dtype=np.float64)
 
     def extremes(self, coefficients: FloatArray, fine: int = 512) -> tuple[FloatArray, FloatArray]:
         """Return (max, min) over a period of each column of coefficients (2H + 1, n).
@@ -177,11 +187,11 @@ class Basis:
         for pick in (np.argmax, np.argmin):
             t = tau[pick(values, axis=0)]
             for _ in range(3):
-                u1 = _diag_eval(self, d1, t)
-                u2 = _diag_eval(self, d2, t)
+                u1 = self.evaluate_each(d1, t)
+                u2 = self.evaluate_each(d2, t)
                 step = np.where(u2 != 0.0, u1 / np.where(u2 != 0.0, u2, 1.0), 0.0)
                 t = t - np.clip(step, -math.pi / fine, math.pi / fine)
-            out.append(_diag_eval(self, coefficients, t))
+            out.append(self.evaluate_each(coefficients, t))
         return out[0], out[1]
 
 
@@ -224,16 +234,6 @@ def _gather(harmonics: int) -> NDArray[np.int64]:
                 w2 = -w2
             table[:, r, c] = (i1, i2, w1, w2)
     return table
-
-
-def _diag_eval(basis: Basis, coefficients: FloatArray, tau: FloatArray) -> FloatArray:
-    """u_k(tau_k) for each column k of coefficients (2H + 1, n) at its own phase tau (n,)."""
-    h = np.arange(1, basis.harmonics + 1)
-    e = np.empty((tau.size, 2 * basis.harmonics + 1))
-    e[:, 0] = 1.0
-    e[:, 1::2] = np.cos(np.outer(tau, h))
-    e[:, 2::2] = np.sin(np.outer(tau, h))
-    return np.asarray(np.einsum("kc,ck->k", e, coefficients), dtype=np.float64)
 
 
 @dataclass(frozen=True)

@@ -118,10 +118,10 @@ def _bisect(
     step = 2.0 * math.pi / basis.samples
     lo = np.asarray(rows * step, dtype=np.float64)
     hi = lo + step
-    f_lo = _at(basis, columns, lo) - level
+    f_lo = basis.evaluate_each(columns, lo) - level
     for _ in range(_BISECTIONS):
         mid = np.asarray(0.5 * (lo + hi), dtype=np.float64)
-        f_mid = _at(basis, columns, mid) - level
+        f_mid = basis.evaluate_each(columns, mid) - level
         same = np.sign(f_mid) == np.sign(f_lo)
         lo = np.where(same, mid, lo)
         f_lo = np.where(same, f_mid, f_lo)
@@ -134,16 +134,6 @@ def _pattern_stiffness(system: LinearSystem, state: NDArray[np.int64]) -> FloatA
     k_j = system.k0 + system.k_c * (state == 1) + system.k_t * (state == -1)
     b = system.directions
     return np.asarray(system.stiffness + (b.T * k_j) @ b, dtype=np.float64)
-
-
-def _at(basis: Basis, columns: FloatArray, tau: FloatArray) -> FloatArray:
-    """Column k of ``columns`` (2H + 1, k) evaluated at its own phase tau[k]."""
-    h = np.arange(1, basis.harmonics + 1)
-    e = np.empty((tau.size, 2 * basis.harmonics + 1))
-    e[:, 0] = 1.0
-    e[:, 1::2] = np.cos(np.outer(tau, h))
-    e[:, 2::2] = np.sin(np.outer(tau, h))
-    return np.asarray(np.einsum("kc,ck->k", e, columns), dtype=np.float64)
 
 
 #: A pattern's A = V B V^-1 is used when V's 1-norm condition number (balanced

@@ -26,7 +26,7 @@ from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeErro
 from clearjoint.joint import Friction, Joint, Losses, checked_losses
 from clearjoint.laws import clearance
 from clearjoint.stiffness import viscous_coefficient
-from clearjoint.system import VibrationSystem, as_system
+from clearjoint.system import VibrationSystem, as_system, force_amplitudes
 
 FloatArray = NDArray[np.float64]
 
@@ -285,20 +285,9 @@ def force_vector(system: LinearSystem, force: ArrayLike, name: str = "force") ->
     """The force amplitudes per DOF (N): a number for a Joint, an (N,) array for a Structure."""
     if system.is_joint:
         return np.array([_checks.positive(name, force, unit="N")])
-    try:
-        f = np.asarray(force, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ParameterTypeError(
-            f"{name} must be an array of {system.n_dof} force amplitudes (N), one per DOF, "
-            f"got {force!r}"
-        ) from None
-    if f.shape != (system.n_dof,):
-        raise ParameterError(
-            f"{name} must have one amplitude per DOF, shape ({system.n_dof},) in N "
-            f"(DOFs {', '.join(system.dof_names[:4])}...), got shape {f.shape}"
-        )
-    if not np.all(np.isfinite(f)) or not np.any(f != 0.0):
-        raise ParameterError(f"{name} must be finite and not all zero (N)")
+    f = force_amplitudes(force, system.dof_names, name)
+    if not np.any(f != 0.0):
+        raise ParameterError(f"{name} must not be all zero (N)")
     return f
 
 

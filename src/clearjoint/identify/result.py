@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.identify.segments import STAGE_COMPRESSION, STAGE_FREE, STAGE_TENSION
+from clearjoint.units import unit_of_name
 
 #: A damper's free play: where the restoring force's magnitude is below this fraction of
 #: its friction force (:meth:`Identification.stage_runs`).
@@ -64,12 +65,7 @@ QUANTITIES = (
 )
 
 #: The units of each quantity, for to_xarray and the figures.
-UNITS = {
-    key: "N/m"
-    if key.endswith("_n_per_m")
-    else {"m": "m", "n": "N", "j": "J", "kg": "kg"}[key.rsplit("_", 1)[-1]]
-    for key in QUANTITIES
-}
+UNITS = {key: unit_of_name(key) for key in QUANTITIES}
 
 FLAGS = ("ok", "doubtful", "rejected")
 

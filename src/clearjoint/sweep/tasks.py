@@ -43,8 +43,11 @@ from typing import Any
 
 import numpy as np
 
+from clearjoint.dissipation import ENERGY_KEYS
 from clearjoint.errors import ParameterError
+from clearjoint.identify import QUANTITIES
 from clearjoint.studies.overrides import structure_at, study_at
+from clearjoint.units import unit_of_name
 
 __all__ = [
     "FORCING_PARAMETERS",
@@ -100,6 +103,36 @@ def register_task(task: Task) -> None:
     TASKS[task.name] = task
 
 
+Evaluate = Callable[[Any, Mapping[str, float], np.random.SeedSequence], dict[str, float]]
+
+
+def _task(
+    name: str,
+    base: str,
+    parameters: Mapping[str, Parameter],
+    options: Mapping[str, tuple[float | None, Parameter]],
+    outputs: Mapping[str, str],
+    description: str,
+) -> Callable[[Evaluate], Evaluate]:
+    """Register the decorated ``evaluate`` as the task ``name`` (see :class:`Task`)."""
+
+    def register(evaluate: Evaluate) -> Evaluate:
+        register_task(Task(name, base, parameters, options, outputs, evaluate, description))
+        return evaluate
+
+    return register
+
+
+def _outputs(*names: str) -> dict[str, str]:
+    """Each output name with its unit, read from the name's ending (units.unit_of_name)."""
+    return {name: unit_of_name(name) for name in names}
+
+
+def _count(lower: float) -> Parameter:
+    """A whole-number option (a count of steps, periods, harmonics) of at least ``lower``."""
+    return Parameter("dimensionless", "", lower=lower)
+
+
 # ---- the joint of a study file ---------------------------------------------------------------
 
 _POSITIVE = {"open_lower": True}
@@ -120,8 +153,47 @@ FORCING_PARAMETERS: dict[str, Parameter] = {
     "excitation.force_amplitude": Parameter("force", "N", **_POSITIVE),
     "excitation.frequency": Parameter("frequency", "Hz", **_POSITIVE),
 }
+#: A task that sweeps the frequency itself: the joint and the force amplitude, and its range.
+_SWEPT_FREQUENCY_PARAMETERS: dict[str, Parameter] = {
+    **JOINT_PARAMETERS,
+    "excitation.force_amplitude": FORCING_PARAMETERS["excitation.force_amplitude"],
+}
+_FREQUENCY_RANGE: dict[str, tuple[float | None, Parameter]] = {
+    "task.frequency_start": (None, Parameter("frequency", "Hz", open_lower=True)),
+    "task.frequency_stop": (None, Parameter("frequency", "Hz", open_lower=True)),
+}
 
 
+def _frequency_range(values: Mapping[str, float]) -> tuple[float, float]:
+    """The point's (task.frequency_start, task.frequency_stop) in Hz, checked in order."""
+    low, high = values["task.frequency_start"], values["task.frequency_stop"]
+    if not high > low:
+        raise ParameterError(f"task.frequency_stop must exceed frequency_start, got {low}, {high}")
+    return low, high
+
+
+@_task(
+    "steady_state",
+    "study",
+    {**JOINT_PARAMETERS, **FORCING_PARAMETERS},
+    {"task.samples_per_period": (64.0, _count(8.0)), "task.max_periods": (20_000.0, _count(10.0))},
+    _outputs(
+        "amplitude_m",
+        "x_max_m",
+        "x_min_m",
+        "compression_penetration_m",
+        "tension_penetration_m",
+        "period_multiple",
+        "periods_to_converge",
+        "energy_input_j",
+        "viscous_j",
+        "sliding_friction_j",
+        "impact_j",
+        "contact_friction_j",
+        "balance_error",
+    ),
+    "exact steady cycle of the forced joint (energies per forcing period)",
+)
 def _steady_state(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -155,36 +227,14 @@ def _steady_state(
     }
 
 
-register_task(
-    Task(
-        name="steady_state",
-        base="study",
-        parameters={**JOINT_PARAMETERS, **FORCING_PARAMETERS},
-        options={
-            "task.samples_per_period": (64.0, Parameter("dimensionless", "", lower=8.0)),
-            "task.max_periods": (20_000.0, Parameter("dimensionless", "", lower=10.0)),
-        },
-        outputs={
-            "amplitude_m": "m",
-            "x_max_m": "m",
-            "x_min_m": "m",
-            "compression_penetration_m": "m",
-            "tension_penetration_m": "m",
-            "period_multiple": "",
-            "periods_to_converge": "",
-            "energy_input_j": "J",
-            "viscous_j": "J",
-            "sliding_friction_j": "J",
-            "impact_j": "J",
-            "contact_friction_j": "J",
-            "balance_error": "",
-        },
-        evaluate=_steady_state,
-        description="exact steady cycle of the forced joint (energies per forcing period)",
-    )
+@_task(
+    "energies",
+    "study",
+    JOINT_PARAMETERS,
+    {"task.amplitude": (None, Parameter("length", "m"))},
+    _outputs(*ENERGY_KEYS),
+    "energies per free cycle at penetration task.amplitude (MODEL.md eq 10-18)",
 )
-
-
 def _energies(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -199,29 +249,21 @@ def _energies(
     return {key: float(value) for key, value in result.items()}
 
 
-register_task(
-    Task(
-        name="energies",
-        base="study",
-        parameters=JOINT_PARAMETERS,
-        options={"task.amplitude": (None, Parameter("length", "m"))},
-        outputs={
-            "sliding_friction_j": "J",
-            "sliding_friction_paper_j": "J",
-            "contact_friction_j": "J",
-            "impact_j": "J",
-            "viscous_j": "J",
-            "total_j": "J",
-            "loss_factor": "",
-            "equivalent_damping_ratio": "",
-            "hertz_half_width_m": "m",
-        },
-        evaluate=_energies,
-        description="energies per free cycle at penetration task.amplitude (MODEL.md eq 10-18)",
-    )
+@_task(
+    "free_cycle",
+    "study",
+    JOINT_PARAMETERS,
+    {"task.amplitude": (None, Parameter("length", "m"))},
+    _outputs(
+        "natural_frequency_hz",
+        "dynamic_stiffness_n_per_m",
+        "stiffness_coefficient",
+        "equivalent_damping_ratio",
+    ),
+    "the joint's amplitude-dependent modal properties on the free cycle at "
+    "penetration task.amplitude: f_n (MODEL.md eq 5-6), k_d, c_d (eq 8-9), and the "
+    "equivalent damping ratio of every loss (eq 10-18)",
 )
-
-
 def _free_cycle(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -244,28 +286,26 @@ def _free_cycle(
     }
 
 
-register_task(
-    Task(
-        name="free_cycle",
-        base="study",
-        parameters=JOINT_PARAMETERS,
-        options={"task.amplitude": (None, Parameter("length", "m"))},
-        outputs={
-            "natural_frequency_hz": "Hz",
-            "dynamic_stiffness_n_per_m": "N/m",
-            "stiffness_coefficient": "",
-            "equivalent_damping_ratio": "",
-        },
-        evaluate=_free_cycle,
-        description=(
-            "the joint's amplitude-dependent modal properties on the free cycle at "
-            "penetration task.amplitude: f_n (MODEL.md eq 5-6), k_d, c_d (eq 8-9), and the "
-            "equivalent damping ratio of every loss (eq 10-18)"
-        ),
-    )
+@_task(
+    "stepped_sine",
+    "study",
+    _SWEPT_FREQUENCY_PARAMETERS,
+    {
+        **_FREQUENCY_RANGE,
+        "task.frequency_steps": (40.0, _count(2.0)),
+        "task.max_periods": (20_000.0, _count(10.0)),
+    },
+    _outputs(
+        "peak_amplitude_m",
+        "peak_frequency_hz",
+        "peak_amplitude_up_m",
+        "peak_amplitude_down_m",
+        "jump_m",
+        "steps_failed",
+    ),
+    "frequency-response curve by a stepped sine up and down (simulate.frequency_sweep; "
+    "no pin contact friction): its peak, where, and the up/down jump",
 )
-
-
 def _stepped_sine(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -274,10 +314,8 @@ def _stepped_sine(
     from clearjoint.simulate import frequency_sweep
 
     study = study_at(base, values)
-    low, high = values["task.frequency_start"], values["task.frequency_stop"]
+    low, high = _frequency_range(values)
     steps = int(values["task.frequency_steps"])
-    if not high > low:
-        raise ParameterError(f"task.frequency_stop must exceed frequency_start, got {low}, {high}")
     hz = np.linspace(low, high, steps)
     curve = frequency_sweep(
         study.joint,
@@ -307,37 +345,23 @@ def _stepped_sine(
     }
 
 
-register_task(
-    Task(
-        name="stepped_sine",
-        base="study",
-        parameters={
-            **JOINT_PARAMETERS,
-            "excitation.force_amplitude": FORCING_PARAMETERS["excitation.force_amplitude"],
-        },
-        options={
-            "task.frequency_start": (None, Parameter("frequency", "Hz", open_lower=True)),
-            "task.frequency_stop": (None, Parameter("frequency", "Hz", open_lower=True)),
-            "task.frequency_steps": (40.0, Parameter("dimensionless", "", lower=2.0)),
-            "task.max_periods": (20_000.0, Parameter("dimensionless", "", lower=10.0)),
-        },
-        outputs={
-            "peak_amplitude_m": "m",
-            "peak_frequency_hz": "Hz",
-            "peak_amplitude_up_m": "m",
-            "peak_amplitude_down_m": "m",
-            "jump_m": "m",
-            "steps_failed": "",
-        },
-        evaluate=_stepped_sine,
-        description=(
-            "frequency-response curve by a stepped sine up and down (simulate.frequency_sweep; "
-            "no pin contact friction): its peak, where, and the up/down jump"
-        ),
-    )
+@_task(
+    "periodic_orbit",
+    "study",
+    {**JOINT_PARAMETERS, **FORCING_PARAMETERS},
+    {"task.period_multiple": (1.0, _count(1.0))},
+    _outputs(
+        "amplitude_m",
+        "x_max_m",
+        "x_min_m",
+        "stable",
+        "largest_multiplier",
+        "energy_input_j",
+        "balance_error",
+    ),
+    "exact periodic orbit by Newton on the exact map (clearjoint.periodic, MODEL.md "
+    "5.1), stable or not: extremes, stability (Floquet multipliers), input per period",
 )
-
-
 def _periodic_orbit(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -364,30 +388,23 @@ def _periodic_orbit(
     }
 
 
-register_task(
-    Task(
-        name="periodic_orbit",
-        base="study",
-        parameters={**JOINT_PARAMETERS, **FORCING_PARAMETERS},
-        options={"task.period_multiple": (1.0, Parameter("dimensionless", "", lower=1.0))},
-        outputs={
-            "amplitude_m": "m",
-            "x_max_m": "m",
-            "x_min_m": "m",
-            "stable": "",
-            "largest_multiplier": "",
-            "energy_input_j": "J",
-            "balance_error": "",
-        },
-        evaluate=_periodic_orbit,
-        description=(
-            "exact periodic orbit by Newton on the exact map (clearjoint.periodic, MODEL.md "
-            "5.1), stable or not: extremes, stability (Floquet multipliers), input per period"
-        ),
-    )
+@_task(
+    "frequency_response",
+    "study",
+    _SWEPT_FREQUENCY_PARAMETERS,
+    {**_FREQUENCY_RANGE, "task.max_points": (2000.0, _count(10.0))},
+    _outputs(
+        "peak_amplitude_m",
+        "peak_frequency_hz",
+        "peak_x_max_m",
+        "folds",
+        "period_doublings",
+        "unstable_points",
+        "points",
+    ),
+    "whole frequency-response curve of exact periodic orbits by continuation "
+    "(clearjoint.periodic, MODEL.md 5.1): its peak, folds, doublings, unstable points",
 )
-
-
 def _frequency_response(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -395,9 +412,7 @@ def _frequency_response(
     from clearjoint.simulate import SimulationError
 
     study = study_at(base, values)
-    low, high = values["task.frequency_start"], values["task.frequency_stop"]
-    if not high > low:
-        raise ParameterError(f"task.frequency_stop must exceed frequency_start, got {low}, {high}")
+    low, high = _frequency_range(values)
     curve = frequency_response(
         study.joint,
         study.force_amplitude,
@@ -423,37 +438,18 @@ def _frequency_response(
     }
 
 
-register_task(
-    Task(
-        name="frequency_response",
-        base="study",
-        parameters={
-            **JOINT_PARAMETERS,
-            "excitation.force_amplitude": FORCING_PARAMETERS["excitation.force_amplitude"],
-        },
-        options={
-            "task.frequency_start": (None, Parameter("frequency", "Hz", open_lower=True)),
-            "task.frequency_stop": (None, Parameter("frequency", "Hz", open_lower=True)),
-            "task.max_points": (2000.0, Parameter("dimensionless", "", lower=10.0)),
-        },
-        outputs={
-            "peak_amplitude_m": "m",
-            "peak_frequency_hz": "Hz",
-            "peak_x_max_m": "m",
-            "folds": "",
-            "period_doublings": "",
-            "unstable_points": "",
-            "points": "",
-        },
-        evaluate=_frequency_response,
-        description=(
-            "whole frequency-response curve of exact periodic orbits by continuation "
-            "(clearjoint.periodic, MODEL.md 5.1): its peak, folds, doublings, unstable points"
-        ),
-    )
+@_task(
+    "nonlinear_mode",
+    "study",
+    JOINT_PARAMETERS,
+    {
+        "task.amplitude": (None, Parameter("length", "m", open_lower=True)),
+        "task.harmonics": (7.0, _count(1.0)),
+    },
+    _outputs("frequency_hz", "damping_ratio", "energy_per_cycle_j", "x_max_m", "x_min_m"),
+    "the joint's nonlinear mode at modal amplitude task.amplitude by harmonic "
+    "balance (EPMC, clearjoint.harmonic, MODEL.md 5.4): frequency and damping",
 )
-
-
 def _nonlinear_mode(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -479,31 +475,6 @@ def _nonlinear_mode(
     }
 
 
-register_task(
-    Task(
-        name="nonlinear_mode",
-        base="study",
-        parameters=JOINT_PARAMETERS,
-        options={
-            "task.amplitude": (None, Parameter("length", "m", open_lower=True)),
-            "task.harmonics": (7.0, Parameter("dimensionless", "", lower=1.0)),
-        },
-        outputs={
-            "frequency_hz": "Hz",
-            "damping_ratio": "",
-            "energy_per_cycle_j": "J",
-            "x_max_m": "m",
-            "x_min_m": "m",
-        },
-        evaluate=_nonlinear_mode,
-        description=(
-            "the joint's nonlinear mode at modal amplitude task.amplitude by harmonic "
-            "balance (EPMC, clearjoint.harmonic, MODEL.md 5.4): frequency and damping"
-        ),
-    )
-)
-
-
 # ---- a structure study: its joints one by one ---------------------------------------------
 
 #: What a structure sweep may vary of its joints (keys as in the study's [joint] section).
@@ -519,6 +490,25 @@ STRUCTURE_JOINT_PARAMETERS: dict[str, Parameter] = {
 }
 
 
+@_task(
+    "structure_mode",
+    "structure",
+    STRUCTURE_JOINT_PARAMETERS,
+    {
+        "task.amplitude": (None, Parameter("length", "m", open_lower=True)),
+        "task.mode": (1.0, _count(1.0)),
+        "task.harmonics": (7.0, _count(1.0)),
+        "task.start_amplitude": (0.0, Parameter("length", "m")),
+        "task.ladder_steps": (4.0, _count(1.0)),
+    },
+    _outputs(
+        "frequency_hz", "damping_ratio", "energy_per_cycle_j", "x_max_m", "closed_frequency_hz"
+    ),
+    "a nonlinear mode of a structure study (EPMC, clearjoint.harmonic, MODEL.md 5.4) "
+    "at modal amplitude task.amplitude on its reference DOF: frequency, damping "
+    "ratio, energy per cycle, the reference DOF's largest displacement, and the "
+    "closed-pattern linear frequency",
+)
 def _structure_mode(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -592,39 +582,28 @@ class _LastLadder:
 _LAST_LADDER = _LastLadder()
 
 
-register_task(
-    Task(
-        name="structure_mode",
-        base="structure",
-        parameters=STRUCTURE_JOINT_PARAMETERS,
-        options={
-            "task.amplitude": (None, Parameter("length", "m", open_lower=True)),
-            "task.mode": (1.0, Parameter("dimensionless", "", lower=1.0)),
-            "task.harmonics": (7.0, Parameter("dimensionless", "", lower=1.0)),
-            "task.start_amplitude": (0.0, Parameter("length", "m")),
-            "task.ladder_steps": (4.0, Parameter("dimensionless", "", lower=1.0)),
-        },
-        outputs={
-            "frequency_hz": "Hz",
-            "damping_ratio": "",
-            "energy_per_cycle_j": "J",
-            "x_max_m": "m",
-            "closed_frequency_hz": "Hz",
-        },
-        evaluate=_structure_mode,
-        description=(
-            "a nonlinear mode of a structure study (EPMC, clearjoint.harmonic, MODEL.md 5.4) "
-            "at modal amplitude task.amplitude on its reference DOF: frequency, damping "
-            "ratio, energy per cycle, the reference DOF's largest displacement, and the "
-            "closed-pattern linear frequency"
-        ),
-    )
-)
-
-
 # ---- a test of the virtual rig ---------------------------------------------------------------
 
 
+@_task(
+    "rig_test",
+    "campaign",
+    {
+        "test.clearance": Parameter("length", "m", **_POSITIVE),
+        "test.frequency": Parameter("frequency", "Hz", **_POSITIVE),
+        "test.force_amplitude": Parameter("force", "N", **_POSITIVE),
+    },
+    {},
+    _outputs(
+        "clearance_m",
+        "energy_per_cycle_j",
+        "amplitude_m",
+        "identified_clearance_m",
+        "identified_energy_per_cycle_j",
+    ),
+    "one virtual-rig test (the campaign's first jointed structure, frequency and "
+    "force unless varied), measured with the point's own noise, then identified",
+)
 def _rig_test(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -649,32 +628,6 @@ def _rig_test(
     }
 
 
-register_task(
-    Task(
-        name="rig_test",
-        base="campaign",
-        parameters={
-            "test.clearance": Parameter("length", "m", **_POSITIVE),
-            "test.frequency": Parameter("frequency", "Hz", **_POSITIVE),
-            "test.force_amplitude": Parameter("force", "N", **_POSITIVE),
-        },
-        options={},
-        outputs={
-            "clearance_m": "m",
-            "energy_per_cycle_j": "J",
-            "amplitude_m": "m",
-            "identified_clearance_m": "m",
-            "identified_energy_per_cycle_j": "J",
-        },
-        evaluate=_rig_test,
-        description=(
-            "one virtual-rig test (the campaign's first jointed structure, frequency and "
-            "force unless varied), measured with the point's own noise, then identified"
-        ),
-    )
-)
-
-
 # ---- identification of a record set ----------------------------------------------------------
 
 
@@ -686,21 +639,19 @@ class RecordSet:
     source: str = ""
 
 
-_IDENTIFIED = {
-    "amplitude_m": "m",
-    "clearance_m": "m",
-    "compression_stiffness_n_per_m": "N/m",
-    "tension_stiffness_n_per_m": "N/m",
-    "friction_force_n": "N",
-    "energy_per_cycle_j": "J",
-    "compression_penetration_m": "m",
-    "tension_penetration_m": "m",
-    "gap_stiffness_n_per_m": "N/m",
-    "secant_stiffness_n_per_m": "N/m",
-    "dynamic_stiffness_n_per_m": "N/m",
-}
+#: What ``identify`` reports of a record: the per-cycle quantities of a clearance joint.
+_IDENTIFIED = _outputs(*QUANTITIES[: QUANTITIES.index("dynamic_stiffness_n_per_m") + 1])
 
 
+@_task(
+    "identify",
+    "records",
+    {},
+    {"task.tolerance": (0.03, Parameter("dimensionless", "", open_lower=True, upper=1.0))},
+    {**_IDENTIFIED, "frequency_hz": "Hz", "cycles_used": ""},
+    "identification of each record of a set (clearjoint.identify): the mean over its "
+    "steady cycles of each quantity; a record that cannot be identified says why",
+)
 def _identify(
     base: Any, values: Mapping[str, float], seed: np.random.SeedSequence
 ) -> dict[str, float]:
@@ -713,21 +664,3 @@ def _identify(
     out["frequency_hz"] = float(found.frequency_hz)
     out["cycles_used"] = float(found.cycles_used)
     return out
-
-
-register_task(
-    Task(
-        name="identify",
-        base="records",
-        parameters={},
-        options={
-            "task.tolerance": (0.03, Parameter("dimensionless", "", open_lower=True, upper=1.0))
-        },
-        outputs={**_IDENTIFIED, "frequency_hz": "Hz", "cycles_used": ""},
-        evaluate=_identify,
-        description=(
-            "identification of each record of a set (clearjoint.identify): the mean over its "
-            "steady cycles of each quantity; a record that cannot be identified says why"
-        ),
-    )
-)
