@@ -14,7 +14,7 @@ each joint's law in series with its member.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -25,7 +25,6 @@ from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
 from clearjoint.joint import Friction, Joint, Losses, checked_losses
 from clearjoint.laws import clearance
-from clearjoint.stiffness import viscous_coefficient
 from clearjoint.system import VibrationSystem, as_system, force_amplitudes
 
 FloatArray = NDArray[np.float64]
@@ -168,7 +167,8 @@ def _joint_name(system: VibrationSystem, j: int) -> str:
 def from_joint(
     joint: Joint, losses: Losses | None = None, friction_speed: float = 0.0
 ) -> LinearSystem:
-    """The one-DOF system of a :class:`Joint` with viscous damping c_v = 2 zeta sqrt(m k_c).
+    """The one-DOF system of a :class:`Joint` with viscous damping c_v = 2 zeta sqrt(m k_c):
+    :func:`from_system` of ``VibrationSystem.from_joint(joint, losses)``, a Joint's.
 
     ``losses`` (default none) give zeta and the friction. Coulomb friction (region
     "everywhere") is regularised as mu_s P tanh(v / v_eps), v_eps = ``friction_speed``
@@ -177,30 +177,11 @@ def from_joint(
     on the motion (MODEL.md sec. 2), does not change the harmonic-balance orbit.
     """
     losses = checked_losses(losses)
-    friction = losses.friction
-    _refuse_losses(friction, losses.restitution, "on the joint", allow_friction=True)
-    force = None
-    if friction is not None and friction.force > 0.0:
-        force = np.array([friction.force])
+    _refuse_losses(losses.friction, losses.restitution, "on the joint", allow_friction=True)
+    if losses.friction is not None and losses.friction.force > 0.0:
         friction_speed = _checks.positive("friction_regularization", friction_speed, unit="m/s")
-    c_v = viscous_coefficient(joint, losses.damping_ratio)
-    one = np.ones((1, 1))
-    return LinearSystem(
-        mass=joint.mass * one,
-        damping=c_v * one,
-        stiffness=np.zeros((1, 1)),
-        directions=one.copy(),
-        k0=np.array([joint.gap_stiffness]),
-        k_c=np.array([joint.compression_stiffness]),
-        k_t=np.array([joint.tension_stiffness]),
-        g_c=np.array([joint.compression_gap]),
-        g_t=np.array([joint.tension_gap]),
-        dof_names=["x"],
-        is_joint=True,
-        source=joint,
-        friction_force=force,
-        friction_speed=float(friction_speed),
-    )
+    made = from_system(VibrationSystem.from_joint(joint, losses), friction_speed)
+    return replace(made, is_joint=True, source=joint)
 
 
 def from_structure(structure: Any, friction_speed: float = 0.0) -> LinearSystem:
