@@ -260,11 +260,6 @@ class FrequencyResponse:
             No period-2 orbit was found near the event.
         """
         solver = self._solver("period_2_orbit")
-        if event.kind != "period_doubling":
-            raise ParameterError(
-                "period_2_orbit takes a 'period_doubling' event of a shooting curve, got "
-                f"{event.kind!r} of a {self.method!r} curve"
-            )
         return solver.period_2_orbit(self, event)  # type: ignore[no-any-return]
 
     def plot(self, ax: Axes | None = None) -> Axes:
