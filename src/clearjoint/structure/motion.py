@@ -46,7 +46,12 @@ from clearjoint.exact import march, single
 from clearjoint.laws import clearance
 from clearjoint.results import EnergyLedger
 from clearjoint.simulate.core import SimulationError
-from clearjoint.structure.model import Structure, StructureError, system_modes
+from clearjoint.structure.model import (
+    Structure,
+    StructureError,
+    default_dof_names,
+    system_modes,
+)
 from clearjoint.system import Matrix, VibrationSystem, as_system
 
 FloatArray = NDArray[np.float64]
@@ -200,8 +205,7 @@ class StructureMotion:
 
     def __post_init__(self) -> None:
         if not self.dof_names:
-            names = () if self.structure is None else tuple(self.structure.dof_names)
-            names = names or tuple(f"u{i + 1}" for i in range(self.u.shape[1]))
+            names = default_dof_names(self.structure, self.u.shape[1])
             object.__setattr__(self, "dof_names", names)
 
     @property
