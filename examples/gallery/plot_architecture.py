@@ -29,7 +29,7 @@ LAYERS = (
     ("studies", "studies/: study file + overrides -> objects -> run"),
     ("sweep, parallel", "sweep/, parallel.py"),
     ("output", "figures, report, reproduction"),
-    ("cli", "cli.py: parse and print"),
+    ("cli", "cli.py, cli_parser.py: parse and print"),
 )
 
 #: The frf call, top to bottom: (layer index, label).

@@ -34,6 +34,7 @@ from clearjoint import checks as _checks
 from clearjoint.contact import hertz_coefficient, hertz_contact
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Friction, Joint, Losses, Pin, takes_losses
+from clearjoint.plotting import dataset_on_amplitude, frame_on_amplitude
 from clearjoint.simulate import SteadyState, steady_state
 from clearjoint.stiffness import FreeOrbit, free_orbit, viscous_coefficient
 from clearjoint.system import VibrationSystem, as_joint
@@ -357,18 +358,10 @@ class Energies(Mapping[str, FloatArray]):
         ParameterError
             The energies were computed on a grid of more than one dimension.
         """
-        import xarray as xr
-
-        from clearjoint.plotting import one_dimensional
-
-        a = one_dimensional("amplitude", self.amplitude)
-        return xr.Dataset(
-            {
-                key: ("amplitude", np.broadcast_to(self[key], a.shape).copy(), {"units": unit})
-                for key, unit in ENERGY_UNITS.items()
-            },
-            coords={"amplitude": ("amplitude", a, {"units": "m"})},
-            attrs={"title": "clearjoint energies per free cycle"},
+        return dataset_on_amplitude(
+            self.amplitude,
+            {key: (self[key], unit) for key, unit in ENERGY_UNITS.items()},
+            {"title": "clearjoint energies per free cycle"},
         )
 
     def to_pandas(self) -> pd.DataFrame:
@@ -379,15 +372,7 @@ class Energies(Mapping[str, FloatArray]):
         pandas.DataFrame
             (N, 9): the keys of :data:`ENERGY_KEYS` as columns (their names carry the unit).
         """
-        import pandas as pd
-
-        from clearjoint.plotting import one_dimensional
-
-        a = one_dimensional("amplitude", self.amplitude)
-        return pd.DataFrame(
-            {key: np.broadcast_to(self[key], a.shape) for key in ENERGY_KEYS},
-            index=pd.Index(a, name="amplitude_m"),
-        )
+        return frame_on_amplitude(self.amplitude, {key: self[key] for key in ENERGY_KEYS})
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """Draw each mechanism's energy per cycle (mJ) against A (um), log-log; return the Axes.

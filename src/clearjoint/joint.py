@@ -221,17 +221,9 @@ class Joint:
     ----------
     mass : float
         Moving mass m in kg (link plus the moving part of the bearing), > 0.
-    clearance : float
-        Total axial clearance c in m (the free-play stroke), >= 0.
-    compression_stiffness : float
-        Contact stiffness k_c in compression, N/m, > 0.
-    tension_stiffness : float, optional
-        Contact stiffness k_t in tension, N/m, > 0. Defaults to ``compression_stiffness``.
-    gap_stiffness : float, optional
-        Stiffness k0 inside the gap (free-play), N/m, >= 0. Default 0 (the paper's choice).
-    gap_offset : float, optional
-        Position d of the gap's centre relative to x = 0 (the rest position of the
-        k0 spring), m, positive toward compression, with abs(d) <= c/2. Default 0.
+    clearance, compression_stiffness, tension_stiffness, gap_stiffness, gap_offset : float
+        The law of the :class:`ClearanceJoint` the mass sits on: c, k_c, k_t, k0 and d,
+        with their ranges and defaults as documented there (its delta is x here).
 
     Every value may also be a pint Quantity or a unit string (``mass="2kg"``,
     ``clearance="0.106mm"``): it is converted to SI; a bare number is SI.

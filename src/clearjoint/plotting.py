@@ -7,12 +7,16 @@ and how a result's 1-D amplitude axis is checked before it becomes a table.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.errors import ParameterError
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
 
 
 def axes_or_new(ax: Any | None) -> Any:
@@ -62,3 +66,43 @@ def save_figure(drawn: Any, path: str | Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     drawn.savefig(path, dpi=120)
     return path
+
+
+def dataset_on_amplitude(
+    amplitude: NDArray[np.float64],
+    columns: dict[str, tuple[NDArray[Any], str]],
+    attrs: dict[str, object],
+) -> xr.Dataset:
+    """Return ``columns`` (name: (values, unit)) as a Dataset on the 1-D coordinate ``amplitude``.
+
+    Each array broadcast like ``amplitude`` (m), its unit in its attrs; ``attrs`` the
+    Dataset's. The body of the amplitude results' ``to_xarray``.
+    """
+    import xarray as xr
+
+    a = one_dimensional("amplitude", amplitude)
+    return xr.Dataset(
+        {
+            name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
+            for name, (values, unit) in columns.items()
+        },
+        coords={"amplitude": ("amplitude", a, {"units": "m"})},
+        attrs=attrs,
+    )
+
+
+def frame_on_amplitude(
+    amplitude: NDArray[np.float64], columns: dict[str, NDArray[Any]]
+) -> pd.DataFrame:
+    """Return ``columns`` (name: values) as a DataFrame on the 1-D index ``amplitude_m``.
+
+    Each array broadcast like ``amplitude`` (m). The body of the amplitude results'
+    ``to_pandas`` where the column names carry the unit.
+    """
+    import pandas as pd
+
+    a = one_dimensional("amplitude", amplitude)
+    return pd.DataFrame(
+        {name: np.broadcast_to(values, a.shape) for name, values in columns.items()},
+        index=pd.Index(a, name="amplitude_m"),
+    )

@@ -27,6 +27,7 @@ from clearjoint import checks as _checks
 from clearjoint.errors import ParameterError
 from clearjoint.joint import Joint
 from clearjoint.laws import Spring
+from clearjoint.plotting import dataset_on_amplitude, frame_on_amplitude
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -49,29 +50,6 @@ __all__ = [
     "stiffness_curve",
     "viscous_coefficient",
 ]
-
-
-def _on_amplitude(
-    amplitude: FloatArray, columns: dict[str, tuple[NDArray[Any], str]], attrs: dict[str, object]
-) -> xr.Dataset:
-    """Return ``columns`` (name: (values, unit)) as a Dataset on the 1-D coordinate ``amplitude``.
-
-    The shared body of the ``to_xarray`` of :class:`FreeOrbit` and :class:`StiffnessCurve`:
-    each array broadcast like ``amplitude`` (m), its unit in its attrs.
-    """
-    import xarray as xr
-
-    from clearjoint.plotting import one_dimensional
-
-    a = one_dimensional("amplitude", amplitude)
-    return xr.Dataset(
-        {
-            name: ("amplitude", np.broadcast_to(values, a.shape).copy(), {"units": unit})
-            for name, (values, unit) in columns.items()
-        },
-        coords={"amplitude": ("amplitude", a, {"units": "m"})},
-        attrs=attrs,
-    )
 
 
 @dataclass(frozen=True)
@@ -170,7 +148,7 @@ class FreeOrbit:
         ParameterError
             The orbits were computed on a grid of more than one dimension.
         """
-        return _on_amplitude(
+        return dataset_on_amplitude(
             self.compression_penetration,
             self._columns(),
             {"title": "clearjoint free-vibration orbits against penetration"},
@@ -759,7 +737,7 @@ class StiffnessCurve:
             joint's parameters as attrs (SI, the unit in each name).
         """
         j = self.joint
-        return _on_amplitude(
+        return dataset_on_amplitude(
             self.amplitude,
             self._columns(),
             {
@@ -783,20 +761,14 @@ class StiffnessCurve:
             ``natural_frequency_rad_per_s``, ``dynamic_stiffness_n_per_m``,
             ``stiffness_coefficient``.
         """
-        import pandas as pd
-
-        from clearjoint.plotting import one_dimensional
-
-        a = one_dimensional("amplitude", self.amplitude)
         names = {
             "period": "period_s",
             "natural_frequency": "natural_frequency_rad_per_s",
             "dynamic_stiffness": "dynamic_stiffness_n_per_m",
             "stiffness_coefficient": "stiffness_coefficient",
         }
-        return pd.DataFrame(
-            {names[key]: np.broadcast_to(v, a.shape) for key, (v, _) in self._columns().items()},
-            index=pd.Index(a, name="amplitude_m"),
+        return frame_on_amplitude(
+            self.amplitude, {names[key]: v for key, (v, _) in self._columns().items()}
         )
 
     def plot(self, ax: Axes | None = None) -> Axes:

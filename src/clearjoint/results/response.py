@@ -250,21 +250,10 @@ class FrequencyResponse:
         """Switch branches at a period doubling: the period-2 orbit born there (MODEL.md sec. 5.1).
 
         By the solver that made the curve (``solver``): see
-        :func:`clearjoint.periodic.period_2_orbit`.
-
-        Raises
-        ------
-        ParameterError
-            The event is not a period doubling, or the curve is not from shooting.
-        SimulationError
-            No period-2 orbit was found near the event.
+        :func:`clearjoint.periodic.period_2_orbit`, whose errors it raises (and
+        ParameterError for a curve not from shooting).
         """
         solver = self._solver("period_2_orbit")
-        if event.kind != "period_doubling":
-            raise ParameterError(
-                "period_2_orbit takes a 'period_doubling' event of a shooting curve, got "
-                f"{event.kind!r} of a {self.method!r} curve"
-            )
         return solver.period_2_orbit(self, event)  # type: ignore[no-any-return]
 
     def plot(self, ax: Axes | None = None) -> Axes:

@@ -111,6 +111,16 @@ class Member:
         )
 
 
+def default_dof_names(structure: Structure | None, n_dof: int) -> tuple[str, ...]:
+    """Return the structure's DOF names, or u1 ... un when there is none or it names none.
+
+    The default ``dof_names`` of the structure's results (:class:`Modes`,
+    :class:`~clearjoint.structure.motion.StructureMotion`).
+    """
+    names = () if structure is None else tuple(structure.dof_names)
+    return names or tuple(f"u{i + 1}" for i in range(n_dof))
+
+
 @dataclass(frozen=True)
 class Modes:
     """Natural frequencies and mode shapes of one linear contact pattern.
@@ -137,8 +147,7 @@ class Modes:
 
     def __post_init__(self) -> None:
         if not self.dof_names:
-            names = () if self.structure is None else tuple(self.structure.dof_names)
-            names = names or tuple(f"u{i + 1}" for i in range(self.shapes.shape[0]))
+            names = default_dof_names(self.structure, self.shapes.shape[0])
             object.__setattr__(self, "dof_names", names)
 
     @property

@@ -41,11 +41,17 @@ import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
-from clearjoint.exact import march
+from clearjoint.errors import ParameterError
+from clearjoint.exact import march, single
 from clearjoint.laws import clearance
 from clearjoint.results import EnergyLedger
 from clearjoint.simulate.core import SimulationError
-from clearjoint.structure.model import Structure, StructureError, system_modes
+from clearjoint.structure.model import (
+    Structure,
+    StructureError,
+    default_dof_names,
+    system_modes,
+)
 from clearjoint.system import Matrix, VibrationSystem, as_system
 
 FloatArray = NDArray[np.float64]
@@ -199,8 +205,7 @@ class StructureMotion:
 
     def __post_init__(self) -> None:
         if not self.dof_names:
-            names = () if self.structure is None else tuple(self.structure.dof_names)
-            names = names or tuple(f"u{i + 1}" for i in range(self.u.shape[1]))
+            names = default_dof_names(self.structure, self.u.shape[1])
             object.__setattr__(self, "dof_names", names)
 
     @property
@@ -325,19 +330,15 @@ def _check_joints(system: VibrationSystem) -> None:
 
 
 def _sample_times(duration: float, period: float, samples_per_period: int) -> FloatArray:
-    """As the one-joint simulator samples: uniform over [0, duration)."""
-    if (
-        isinstance(samples_per_period, bool)
-        or not isinstance(samples_per_period, int)
-        or (samples_per_period < 8)
-    ):
-        raise StructureError(
-            f"samples_per_period must be an integer >= 8, got {samples_per_period!r}"
-        )
-    n = max(round(samples_per_period * duration / period), 2)
-    if duration >= period:
-        return np.linspace(0.0, duration, n + 1)[:-1]
-    return np.linspace(0.0, duration, n)
+    """Uniform sample times over [0, duration), as the one-joint simulator samples them.
+
+    By :func:`clearjoint.exact.single.sample_times`; its refusal of ``samples_per_period``
+    is raised as a StructureError, with the same message.
+    """
+    try:
+        return single.sample_times(duration, period, samples_per_period, None)
+    except ParameterError as exc:
+        raise StructureError(str(exc)) from None
 
 
 def _patterns_visited(
