@@ -156,7 +156,7 @@ def _workload_cpu(args: argparse.Namespace) -> dict[str, float]:
     time_response(s, force, omega, 0.5 * 2 * math.pi / omega, samples_per_period=16)
     tower, u0, period, _ = _decay_case()
     free_decay(tower, (u0, np.zeros(tower.n_dof)), 0.5 * period, samples_per_period=64)
-    cpu = {}
+    cpu: dict[str, float] = {}
     for name, bays, periods in [("mast", 10, args.mast_periods)] + [
         (f"{b} bays", int(b), args.scaling_periods) for b in args.bays.split(",")
     ]:
