@@ -26,13 +26,32 @@ wall clock of section 2 is printed beside them.
    cycle.
 5. Linear checks: a uniform fixed-free bar's first modes against
    (2k - 1) (pi / 2L) sqrt(E / rho) as n grows; a two-mass chain against its closed form.
+
+``--old-src DIR`` (issue 23: "within 5 % of before, side by side") runs none of that: it
+times the speed workloads, section 2's mast over ``--mast-periods``, section 3's masts of
+``--bays`` over ``--scaling-periods`` and section 4's free decay (default base step) over
+``--decay-periods``, with the clearjoint of another ``src`` tree and with this one, each in
+a fresh child process (PYTHONPATH, OPENBLAS_NUM_THREADS=1) that warms up (imports, numba's
+compilation or cache) before it times, alternating old, new, ... ``--rounds`` times. Each
+child builds every case anew and reports CPU seconds (``time.process_time``) per workload;
+printed are the best and the median over the rounds and new / old. The child runs this
+file, so the other tree needs the public names it imports (b1c5d4f has them)::
+
+    python benchmarks/bench_structure.py --old-src /work/wt-old/src [--rounds 5]
+        [--mast-periods 200] [--bays 5,10,20,40] [--scaling-periods 5] [--decay-periods 80]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import os
+import statistics
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -86,14 +105,19 @@ def _mast_case(bays: int) -> tuple[Structure, np.ndarray, float]:
     return s, force, omega
 
 
-def _decay_sensitivity() -> None:
-    """The docs' free decay with three step sequences: where they part, and the backbone."""
+def _decay_case() -> tuple[Structure, np.ndarray, float, int]:
+    """The docs' damped 10-bay mast, its first closed mode at 3 mm of tip: (mast, u0, T, tip)."""
     hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
     tower = mast(10, joints=hinge, rayleigh=(0.5, 2e-6))
     closed = tower.modes("closed")
     tip = tower.dof_names.index("n21x")
     u0 = 3e-3 * closed.shapes[:, 0] / closed.shapes[tip, 0]
-    period = 2 * math.pi / closed.omega[0]
+    return tower, u0, 2 * math.pi / float(closed.omega[0]), tip
+
+
+def _decay_sensitivity() -> None:
+    """The docs' free decay with three step sequences: where they part, and the backbone."""
+    tower, u0, period, tip = _decay_case()
     default = motion_module.BASE_STEP_PERIODS
     runs = []
     for fraction in (default, 1.0 / 5.0, 1.0 / 16.0):
@@ -126,6 +150,64 @@ def _decay_sensitivity() -> None:
         )
 
 
+def _workload_cpu(args: argparse.Namespace) -> dict[str, float]:
+    """CPU seconds of each speed workload in this process, after an untimed warm-up."""
+    s, force, omega = _mast_case(2)  # imports, numba's compilation (or cache), first calls
+    time_response(s, force, omega, 0.5 * 2 * math.pi / omega, samples_per_period=16)
+    tower, u0, period, _ = _decay_case()
+    free_decay(tower, (u0, np.zeros(tower.n_dof)), 0.5 * period, samples_per_period=64)
+    cpu: dict[str, float] = {}
+    for name, bays, periods in [("mast", 10, args.mast_periods)] + [
+        (f"{b} bays", int(b), args.scaling_periods) for b in args.bays.split(",")
+    ]:
+        s, force, omega = _mast_case(bays)
+        start = time.process_time()
+        time_response(s, force, omega, periods * 2 * math.pi / omega, samples_per_period=16)
+        cpu[name] = time.process_time() - start
+    tower, u0, period, _ = _decay_case()
+    start = time.process_time()
+    free_decay(
+        tower, (u0, np.zeros(tower.n_dof)), args.decay_periods * period, samples_per_period=64
+    )
+    cpu["free decay"] = time.process_time() - start
+    return cpu
+
+
+def against_old(args: argparse.Namespace) -> None:
+    """The speed workloads under ``args.old_src`` and this tree, alternately: new / old."""
+    trees = {"old": args.old_src, "new": str(Path(__file__).resolve().parents[1] / "src")}
+    forwarded = [f"--{k.replace('_', '-')}={getattr(args, k)}" for k in ("mast_periods", "bays")]
+    forwarded += [f"--scaling-periods={args.scaling_periods}"]
+    forwarded += [f"--decay-periods={args.decay_periods}", "--child"]
+    cpu: dict[str, list[dict[str, float]]] = {"old": [], "new": []}
+    print(f"load average before: {os.getloadavg()[0]:.2f}")
+    for round_ in range(args.rounds):
+        for side, src in trees.items():
+            env = dict(os.environ, PYTHONPATH=src, OPENBLAS_NUM_THREADS="1")
+            done = subprocess.run(
+                [sys.executable, __file__, *forwarded],
+                env=env,
+                capture_output=True,
+                text=True,
+                check=True,
+            )
+            cpu[side].append(json.loads(done.stdout.splitlines()[-1]))
+            line = ", ".join(f"{k} {v:.3f}" for k, v in cpu[side][-1].items())
+            print(f"  round {round_ + 1} {side}: {line} (CPU s)")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+    print(f"old {trees['old']}, new {trees['new']}; CPU s over {args.rounds} rounds")
+    print(
+        f"  {'workload':12s} {'old best':>9s} {'new best':>9s} {'new/old':>8s}   "
+        f"{'old median':>10s} {'new median':>10s} {'new/old':>8s}"
+    )
+    for name in cpu["old"][0]:
+        old = [run[name] for run in cpu["old"]]
+        new = [run[name] for run in cpu["new"]]
+        o, n = min(old), min(new)
+        om, nm = statistics.median(old), statistics.median(new)
+        print(f"  {name:12s} {o:9.3f} {n:9.3f} {n / o:8.3f}   {om:10.3f} {nm:10.3f} {nm / om:8.3f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -138,7 +220,17 @@ def main() -> None:
     parser.add_argument("--ivp-periods", type=int, default=2)
     parser.add_argument("--bays", default="5,10,20,40")
     parser.add_argument("--scaling-periods", type=int, default=5)
+    parser.add_argument("--old-src", help="only time the speed workloads against this src tree")
+    parser.add_argument("--rounds", type=int, default=5, help="old/new child pairs (--old-src)")
+    parser.add_argument("--decay-periods", type=int, default=80, help="free decay (--old-src)")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child:
+        print(json.dumps(_workload_cpu(args)))
+        return
+    if args.old_src:
+        against_old(args)
+        return
 
     n = args.chain_periods
     print(f"1. 3-link chain, 2 joints, {n} periods: exact vs solve_ivp (rtol 1e-12, edge events)")
