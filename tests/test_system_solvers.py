@@ -219,3 +219,17 @@ def test_every_solver_refuses_a_loose_loss_keyword_with_the_fix(
     joint, _ = _joint_and_losses()
     with pytest.raises(ParameterTypeError, match=rf"losses=Losses\({keyword}=0\.5\) instead"):
         solver(joint, *arguments, **{keyword: 0.5})
+
+
+def test_the_single_joint_kernel_is_a_fast_path_equal_to_the_structure_solver() -> None:
+    # one system object, two solvers: the single-joint kernel and the structure's march
+    joint, _ = _joint_and_losses()
+    system = VibrationSystem.from_joint(joint, Losses(damping_ratio=0.02, restitution=0.8))
+    w = 0.8 * math.sqrt(8e7 / 2.0)
+    duration = 12 * 2.0 * math.pi / w
+    general = time_response(system, [3000.0], w, duration, samples_per_period=64)
+    fast = sim.time_response(system, 3000.0, w, duration, samples_per_period=64)
+    assert general.events > 20
+    scale = float(np.max(np.abs(fast.displacement)))
+    assert float(np.max(np.abs(general.u[:, 0] - fast.displacement))) <= 1e-9 * scale
+    assert general.energy.impact == pytest.approx(fast.energy.impact, rel=1e-9)
