@@ -585,12 +585,19 @@ def main() -> None:
         help="only compare the curve's CPU time with another clearjoint src tree, e.g. "
         "main's (git archive main src | tar -x -C OLD)",
     )
+    parser.add_argument(
+        "--rounds",
+        type=int,
+        default=10,
+        help="--old-src: alternating rounds of each tree (the curve takes ~15 ms, so a few "
+        "rounds swing the ratio by 30 %%; 10 rounds of 61 held it to 1.00x)",
+    )
     args = parser.parse_args()
     if args.stiff_only:
         stiff_contact()
         return
     if args.old_src:
-        against_old(args.old_src)
+        against_old(args.old_src, rounds=args.rounds, repeat=61)
         return
 
     print("case: pyHarm SDOF clearance, F0 = 0.03, omega 0.05 -> 1.8 rad/s, c_v = 0.05")

@@ -191,7 +191,7 @@ def homogeneous_parts(alpha: float, d2: float, root: float, tau: float) -> tuple
     """e(tau) and g(tau) of the homogeneous flow x_h = e x_h0 + g (v_h0 - alpha x_h0).
 
     Under-damped (d2 < 0), over-damped (d2 > 0, with expm1 for small root tau) and
-    critical; shared by evaluate and the monodromy flow of the shooting (_shooting.py).
+    critical; shared by evaluate and the monodromy flow of the shooting (exact/shooting.py).
     """
     if d2 < 0.0:
         ea = math.exp(alpha * tau)

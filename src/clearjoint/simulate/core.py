@@ -2,8 +2,8 @@
 
 MODEL.md sec. 2: m x'' + c_v x' + f(x) + mu_s P sgn(x') = F0 sin(w t), with
 x' -> e x' on entering contact. The motion is advanced state by state in closed
-form by the compiled kernel (``_kernel.py``); this module sets it up, detects the
-steady state (period-1 or period-n, from the stroboscopic map at every forcing
+form by the compiled kernel (``clearjoint.exact.kernel``); this module sets it up,
+detects the steady state (period-1 or period-n, from the stroboscopic map at every forcing
 period), samples the cycle and closes the energy balance.
 
 The contact-friction term of MODEL.md (mu_c on the pin's contact arc) is
