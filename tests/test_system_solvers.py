@@ -233,3 +233,47 @@ def test_the_single_joint_kernel_is_a_fast_path_equal_to_the_structure_solver() 
     scale = float(np.max(np.abs(fast.displacement)))
     assert float(np.max(np.abs(general.u[:, 0] - fast.displacement))) <= 1e-9 * scale
     assert general.energy.impact == pytest.approx(fast.energy.impact, rel=1e-9)
+
+
+def test_the_orbit_check_of_harmonic_balance_runs_on_a_system_as_on_its_structure(
+    links: Structure,
+) -> None:
+    force = np.array([0.0, 0.0, 30.0])
+    kwargs = {"harmonics": 5, "max_points": 6, "check_points": 3}
+    one = frequency_response(links, force, 300.0, 320.0, **kwargs)
+    two = frequency_response(links.to_system(), force, 300.0, 320.0, **kwargs)
+    np.testing.assert_array_equal(
+        one.settings["orbit_check"].residual, two.settings["orbit_check"].residual
+    )
+    assert np.all(np.isfinite(two.settings["orbit_check"].residual))
+
+
+def test_a_one_dof_system_takes_a_number_as_its_force_in_every_solver() -> None:
+    joint, _ = _joint_and_losses()
+    system = VibrationSystem.from_joint(joint, Losses(damping_ratio=0.05))
+    by_number = frequency_response(system, 300.0, 5000.0, 5200.0, harmonics=3, max_points=3)
+    by_array = frequency_response(system, [300.0], 5000.0, 5200.0, harmonics=3, max_points=3)
+    np.testing.assert_array_equal(by_number.x_max, by_array.x_max)
+
+
+def test_losses_refuse_a_contact_friction_coefficient_without_a_pin() -> None:
+    with pytest.raises(ParameterError, match="these losses have no pin"):
+        Losses(contact_friction_coefficient=0.3)
+
+
+@pytest.mark.parametrize(
+    ("direction", "stiffness", "words"),
+    [
+        (-1.0, 0.0, "swap k_c and k_t"),
+        (0.5, 0.0, "own displacement"),
+        (1.0, -2e6, "must be >= 0"),
+    ],
+)
+def test_a_system_that_is_no_single_joint_says_why(
+    direction: float, stiffness: float, words: str
+) -> None:
+    one = np.ones((1, 1))
+    law = ClearanceJoint(1e-4, 8e7, gap_stiffness=1e6)
+    system = VibrationSystem(one, 0.0 * one, stiffness * one, direction * one, (law,))
+    with pytest.raises(VibrationSystemError, match=words):
+        system.to_joint()

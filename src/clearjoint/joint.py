@@ -450,6 +450,12 @@ class Losses:
             "contact_friction_coefficient",
             _checks.non_negative("contact_friction_coefficient", self.contact_friction_coefficient),
         )
+        if self.contact_friction_coefficient > 0.0 and self.pin is None:
+            raise ParameterError(
+                f"contact_friction_coefficient {self.contact_friction_coefficient!r} acts on the "
+                "pin's contact arc, and these losses have no pin: give pin=clearjoint.Pin(...) "
+                "or leave the coefficient at 0"
+            )
 
 
 LOSS_KEYWORDS = ("damping_ratio", "friction", "restitution", "pin", "contact_friction_coefficient")

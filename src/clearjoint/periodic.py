@@ -789,9 +789,6 @@ def frequency_response(
         solver=__name__,
         settings={
             "joint": joint,
-            "damping_ratio": losses.damping_ratio,
-            "friction": losses.friction,
-            "restitution": losses.restitution,
             "losses": losses,
         },
     )

@@ -49,7 +49,8 @@ SPARSE_ABOVE = 200
 
 
 def force_amplitudes(force: ArrayLike, dof_names: Sequence[str], name: str = "force") -> FloatArray:
-    """The force amplitudes (N) as an (N,) array: one finite value per DOF of ``dof_names``.
+    """The force amplitudes (N) as an (N,) array: one finite value per DOF of ``dof_names``
+    (for one DOF, a number too).
 
     Raises
     ------
@@ -59,6 +60,8 @@ def force_amplitudes(force: ArrayLike, dof_names: Sequence[str], name: str = "fo
         Not one value per DOF, or a NaN or infinite one.
     """
     n = len(dof_names)
+    if n == 1 and np.ndim(force) == 0:
+        return np.array([_checks.real_scalar(name, force, unit="N")])
     try:
         f = np.asarray(force, dtype=np.float64)
     except (TypeError, ValueError):
@@ -257,14 +260,25 @@ class VibrationSystem:
                 f"{self.n_dof} DOFs and {self.n_joints} joints; use clearjoint.structure's "
                 "solvers or clearjoint.harmonic for this system"
             )
-        if float(self.directions[0, 0]) != 1.0:
+        b = float(self.directions[0, 0])
+        if b != 1.0:
+            flip = (
+                "; flip the law's sides instead (swap k_c and k_t, negate gap_offset)"
+                if b == -1.0
+                else "; write the system in the joint's own displacement delta = b u"
+            )
             raise VibrationSystemError(
-                f"a single-joint solver needs the joint's direction b = +1 (x positive in "
-                f"compression), got {float(self.directions[0, 0])!r}; flip the law's sides "
-                "(swap k_c and k_t, negate gap_offset) instead"
+                "a single-joint solver needs the joint's direction b = +1 (x positive in "
+                f"compression), got {b!r}" + flip
             )
         law = self.laws[0]
         mass = float(self.mass[0, 0])
+        if law.gap_stiffness + float(self.stiffness[0, 0]) < 0.0:
+            raise VibrationSystemError(
+                f"the linear stiffness K = {float(self.stiffness[0, 0])!r} N/m plus the law's "
+                f"k0 = {law.gap_stiffness!r} N/m is negative: a single joint's stiffness inside "
+                "the gap must be >= 0"
+            )
         joint = Joint(
             mass,
             law.clearance,
@@ -390,8 +404,6 @@ class VibrationSystem:
         ParameterError
             Not one finite value per DOF; a number for a system of several DOFs.
         """
-        if self.n_dof == 1 and np.ndim(force) == 0:
-            return np.array([_checks.real_scalar(name, force, unit="N")])
         return force_amplitudes(force, self.dof_names, name)
 
     def __repr__(self) -> str:

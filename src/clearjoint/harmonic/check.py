@@ -141,7 +141,7 @@ def check_orbits(
     Parameters
     ----------
     response : FrequencyResponse
-        From :func:`clearjoint.harmonic.frequency_response` on a Structure.
+        From :func:`clearjoint.harmonic.frequency_response` on a Structure or a VibrationSystem.
     points : (k,) array_like of int, optional
         Indices into the curve; default every point.
     tolerance : float
@@ -154,7 +154,8 @@ def check_orbits(
     Raises
     ------
     ParameterError
-        Not a harmonic-balance curve of a Structure, an index off the curve, a bad tolerance.
+        Not a harmonic-balance curve of a Structure or VibrationSystem, an index off
+        the curve, a bad tolerance.
     HarmonicError
         A structure with Coulomb friction in a joint: its exact motion does not carry
         friction, so there is nothing exact to check against.
@@ -162,15 +163,18 @@ def check_orbits(
     from clearjoint.harmonic import aft, monodromy
     from clearjoint.harmonic.system import build
     from clearjoint.structure import Structure, time_response
+    from clearjoint.system import VibrationSystem, as_system
 
     settings = response.settings
-    structure = settings.get("system")
-    if response.method != "harmonic" or not isinstance(structure, Structure):
+    source = settings.get("system")
+    if response.method != "harmonic" or not isinstance(source, Structure | VibrationSystem):
         raise ParameterError(
             "check_orbits needs a curve of clearjoint.harmonic.frequency_response on a "
-            "Structure; a Joint's orbits are checked by clearjoint.periodic's exact shooting"
+            "Structure or a VibrationSystem; a Joint's orbits are checked by "
+            "clearjoint.periodic's exact shooting"
         )
-    if any(law.friction is not None and law.friction.force > 0.0 for law in structure.joint_laws):
+    structure = as_system(source)
+    if np.any(structure.friction_force() > 0.0):
         from clearjoint.harmonic.system import HarmonicError
 
         raise HarmonicError(

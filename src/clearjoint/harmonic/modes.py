@@ -362,7 +362,9 @@ def nonlinear_modes(
         joint would stick at a turning point (the force that would hold it, for a Joint
         its restoring force, within mu_s P: :func:`holding_forces`), the amplitude
         fails with the reason in ``note``: EPMC's regularised orbit has no stick phase
-        and creeps through there, driven by the negative damping.
+        and creeps through there, driven by the negative damping. The pin and its
+        contact friction coefficient are not used (no feedback on the motion, MODEL.md
+        sec. 2).
     friction_regularization : float, optional
         v_eps, m/s. Default 1e-3 w c, with w the mode's closed-pattern frequency
         (frequency_response uses its start frequency) and c a Joint's clearance (for

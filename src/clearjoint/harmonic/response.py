@@ -137,6 +137,9 @@ def frequency_response(
         on each joint's relative speed: against exact stick-slip orbits the amplitude is
         off by about 1e-3 while the joints slide and by about 12 % where they stick;
         points where a joint sticks get an ``"untrusted"`` event (docs/harmonic.md).
+        The pin and its contact friction coefficient are not used: the exact solvers
+        evaluate that friction along a cycle without feedback on the motion (MODEL.md
+        sec. 2), so it does not change the orbit.
     parameter : {"omega", "force"}
     force_stop : float, optional
         End of the force range, N (largest entry for a Structure).
@@ -270,7 +273,6 @@ def frequency_response(
         "system": system,
         "harmonics": h,
         "samples": n_t,
-        "damping_ratio": 0.0 if losses is None else losses.damping_ratio,
         "losses": losses,
         "force_pattern": unit_force,
         "stability": stability or ("hill" if model.is_joint else "monodromy"),

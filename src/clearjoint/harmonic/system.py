@@ -263,7 +263,8 @@ def build(system: Any, losses: Losses | None, friction_speed: float = 0.0) -> Li
 
 
 def force_vector(system: LinearSystem, force: ArrayLike, name: str = "force") -> FloatArray:
-    """The force amplitudes per DOF (N): a number for a Joint, an (N,) array for a Structure."""
+    """The force amplitudes per DOF (N): a number for a Joint (or any one-DOF system), an (N,)
+    array for a Structure."""
     if system.is_joint:
         return np.array([_checks.positive(name, force, unit="N")])
     f = force_amplitudes(force, system.dof_names, name)
