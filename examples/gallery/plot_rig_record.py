@@ -11,7 +11,6 @@ import math
 
 import numpy as np
 
-from clearjoint import Losses
 from clearjoint.figures import displacement_stages_figure, force_displacement_figure
 from clearjoint.rig import load_campaign, simulate_test, structure_under_test
 from clearjoint.simulate import steady_state
@@ -28,9 +27,7 @@ cycle = steady_state(
     joint,
     spec.force_amplitude,
     2 * math.pi * spec.frequency_hz,
-    losses=Losses(
-        damping_ratio=rig.damping_ratio, friction=rig.bearing_friction, restitution=rig.restitution
-    ),
+    losses=rig.losses(),
 )
 period = 1.0 / spec.frequency_hz
 first = campaign.periods - 3
