@@ -72,7 +72,7 @@ from clearjoint.results.motion import SteadyState
 from clearjoint.results.orbit import PeriodicOrbit as PeriodicOrbit
 from clearjoint.results.response import FrequencyResponse as FrequencyResponse
 from clearjoint.results.response import ResponseEvent as ResponseEvent
-from clearjoint.system import VibrationSystem, as_joint
+from clearjoint.system import VibrationSystem
 
 __all__ = [
     "frequency_response",
@@ -565,7 +565,7 @@ def frequency_response(
     start, stop = parameter_range(parameter, f0, w0, omega_stop, force_stop)
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
-    joint, losses = as_joint(joint, losses)
+    joint, losses, p = setup(joint, f0, w0, losses)
     first = periodic_orbit(joint, f0, w0, losses=losses)
     if np.min(np.abs(first.multipliers - 1.0)) < 1e-9:
         refusal = SimulationError(
@@ -615,7 +615,6 @@ def frequency_response(
         else:
             turned = frequency_response(joint, f0, stop, w0, max_points=max_points, losses=losses)
         return _turned_round(turned)
-    p = setup(joint, f0, w0, losses)[2]
     x_scale = max(joint.clearance / 2.0, first.amplitude)
     v_scale = x_scale * max(w0, stop if parameter == "omega" else w0)
     code = 0 if parameter == "omega" else 1

@@ -224,9 +224,7 @@ class VibrationSystem:
         """
         if not isinstance(joint, Joint):
             raise ParameterTypeError(f"joint must be a clearjoint.Joint, got {joint!r}")
-        losses = Losses() if losses is None else losses
-        if not isinstance(losses, Losses):
-            raise ParameterTypeError(f"losses must be a clearjoint.Losses, got {losses!r}")
+        losses = checked_losses(losses)
         c_v = 2.0 * losses.damping_ratio * math.sqrt(joint.mass * joint.compression_stiffness)
         one = np.ones((1, 1))
         return cls(
