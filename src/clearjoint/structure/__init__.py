@@ -3,7 +3,10 @@
 ``Structure`` holds nodes with lumped masses, axial members (each optionally with a
 :class:`~clearjoint.ClearanceJoint` in series), supports and damping; ``chain`` and
 ``truss`` build one; ``time_response`` and ``free_decay`` give its exact event-driven
-motion with an energy ledger, and ``system_modes`` the linear modes of a contact pattern.
+motion with an energy ledger, and ``system_modes`` the linear modes of a contact pattern;
+``periodic_orbit``, ``frequency_response`` and ``stepped_sine`` its exact steady response
+(MODEL.md 5.1 on 5.2): periodic orbits by shooting with their Floquet multipliers, whole
+curves by continuation, and what the motion does where no orbit is stable.
 Each of them takes a Structure or the :class:`~clearjoint.system.VibrationSystem` it
 produces (``Structure.to_system()``), or one built from matrices.
 """
@@ -12,18 +15,28 @@ from clearjoint.structure.backbone import Backbone, decay_backbone
 from clearjoint.structure.builders import chain, mast, truss
 from clearjoint.structure.model import Member, Modes, Structure, StructureError, system_modes
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
+from clearjoint.structure.orbit import OrbitError, StructureOrbit, periodic_orbit
+from clearjoint.structure.shooting import frequency_response
+from clearjoint.structure.stepped import SteppedSine, SteppedSineError, stepped_sine
 
 __all__ = [
     "Backbone",
     "Member",
     "Modes",
+    "OrbitError",
+    "SteppedSine",
+    "SteppedSineError",
     "Structure",
     "StructureError",
     "StructureMotion",
+    "StructureOrbit",
     "chain",
     "decay_backbone",
     "free_decay",
+    "frequency_response",
     "mast",
+    "periodic_orbit",
+    "stepped_sine",
     "system_modes",
     "time_response",
     "truss",

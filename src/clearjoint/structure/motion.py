@@ -184,6 +184,11 @@ class StructureMotion:
         A name per DOF, from the system.
     system : VibrationSystem or None
         The system moved.
+    event_states : (E,) ndarray of int8
+        The state each event's joint entered (0 open, 1 compression, -1 tension).
+    start_pattern : (J,) ndarray of int8
+        Every joint's state at t = 0; with ``event_states`` it gives the pattern of every
+        stretch between events (``clearjoint.exact.march.pattern_history``).
     """
 
     t: FloatArray
@@ -202,6 +207,12 @@ class StructureMotion:
     steps: int = 0
     dof_names: tuple[str, ...] = field(default=(), repr=False)
     system: VibrationSystem | None = field(default=None, repr=False)
+    event_states: NDArray[np.int8] = field(
+        default_factory=lambda: np.zeros(0, dtype=np.int8), repr=False
+    )
+    start_pattern: NDArray[np.int8] = field(
+        default_factory=lambda: np.zeros(0, dtype=np.int8), repr=False
+    )
 
     def __post_init__(self) -> None:
         if not self.dof_names:
@@ -439,6 +450,8 @@ def _run(
         steps=int(steps),
         dof_names=flow.system.dof_names,
         system=flow.system,
+        event_states=np.asarray(ev_s, dtype=np.int8),
+        start_pattern=np.asarray(states, dtype=np.int8).copy(),
     )
 
 

@@ -1,0 +1,246 @@
+"""The exact tangent flow along a structure's exact motion (MODEL.md 5.1 and 5.2).
+
+Between two gap-edge events the structure is linear in one contact pattern p, so a
+perturbation (du, dv) of its state obeys the constant-coefficient equation
+
+    d/dt (du, dv) = A_p (du, dv),   A_p = [[0, I], [-M^-1 K_p, -M^-1 C]],
+
+and is carried over a stretch of length dt by expm(A_p dt) exactly. At an event the
+vector field is continuous (the clearance law's force is continuous in the shortening,
+MODEL.md section 0), so the saltation matrix S = R + (f+ - R f-) grad(h)^T / (grad(h) . f-)
+of MODEL.md 5.1 is the identity (R = I without restitution): the tangent flow over a
+motion is the ordered product of the stretches' exponentials, the stretches and their
+patterns being those the exact event-driven motion (``clearjoint.exact.march``) met.
+Over one forcing period of a periodic orbit that product is the monodromy matrix.
+
+A restitution below 1 makes R (and so S) differ from the identity at every impact; this
+module refuses it in one line rather than give a Jacobian without its jumps.
+
+Each pattern's A is decomposed once, A = V B V^-1 with B real block-diagonal
+(``clearjoint.harmonic.monodromy``'s decomposition, the same cache rules: an
+ill-conditioned V keeps ``scipy.linalg.expm``), and the product is carried in the
+patterns' eigen-coordinates, so a stretch costs one diagonal scaling and a change of
+coordinates where the pattern changes.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from clearjoint.exact import march
+from clearjoint.harmonic.monodromy import _decompose, _Flow
+from clearjoint.structure.model import StructureError
+from clearjoint.system import VibrationSystem
+
+FloatArray = NDArray[np.float64]
+
+
+class PatternFlows:
+    """The exact linear flows expm(A_p t) of one system's contact patterns, each decomposed once.
+
+    Parameters
+    ----------
+    system : VibrationSystem
+        Lumped (diagonal) M; every joint's restitution 1.
+
+    Raises
+    ------
+    StructureError
+        A joint with a restitution below 1 (its impacts would need saltation jumps).
+    """
+
+    def __init__(self, system: VibrationSystem) -> None:
+        e = system.restitution()
+        if np.any(e < 1.0):
+            joint = int(np.flatnonzero(e < 1.0)[0])
+            raise StructureError(
+                f"joint {joint} has a restitution of {float(e[joint]):g}: the exact tangent "
+                "flow (monodromy, Lyapunov exponent) of a structure carries continuous "
+                "contact only; give that joint restitution=1 (its contact stiffness "
+                "carries the impact), or study one joint with clearjoint.periodic"
+            )
+        self.system = system
+        self.n = n = system.n_dof
+        inv_m = 1.0 / system.mass_diagonal()
+        damping = system.damping
+        c = damping.toarray() if hasattr(damping, "toarray") else np.asarray(damping)
+        self._inv_m = inv_m
+        self._base = np.zeros((2 * n, 2 * n))
+        self._base[:n, n:] = np.eye(n)
+        self._base[n:, n:] = -inv_m[:, None] * np.asarray(c, dtype=np.float64)
+        self._flows: dict[bytes, _Flow | FloatArray] = {}
+        self._transitions: dict[tuple[bytes, bytes], FloatArray] = {}
+        self._norms: dict[bytes, FloatArray] = {}
+        self._mass = system.mass_diagonal()
+
+    def energy_norm(self, states: NDArray[np.int8], w: FloatArray) -> float:
+        """sqrt(du^T K_n du + dv^T M dv) of a perturbation w = (du, dv), K_n = K_p + 1e-3 K_closed.
+
+        The pattern's own stiffness makes the norm of a perturbation along one lightly
+        damped mode of that pattern vary only by its decay (an undamped mode keeps its
+        energy), so a growth rate measured over a stretch in one pattern carries no
+        oscillation of the norm; the small share of the closed stiffness keeps it a norm
+        where the pattern leaves a mechanism (an open joint with k0 = 0).
+        """
+        key = np.asarray(states, dtype=np.int8).tobytes()
+        k = self._norms.get(key)
+        if k is None:
+            k_p, _ = self.system.pattern_stiffness(np.asarray(states, dtype=np.int64))
+            k_c = self.system.closed_stiffness()
+            k = k_p + 1e-3 * k_c
+            k = np.asarray(k.toarray() if hasattr(k, "toarray") else k, dtype=np.float64)
+            k = 0.5 * (k + k.T)
+            self._norms[key] = k
+        du, dv = w[: self.n].ravel(), w[self.n :].ravel()
+        value = float(du @ k @ du + dv @ (self._mass * dv))
+        return math.sqrt(max(value, 0.0))
+
+    def generator(self, states: NDArray[np.int8]) -> FloatArray:
+        """A_p of the pattern ``states`` (n_j,), (2N, 2N) in 1/s."""
+        k, _ = self.system.pattern_stiffness(np.asarray(states, dtype=np.int64))
+        k = k.toarray() if hasattr(k, "toarray") else np.asarray(k)
+        a = self._base.copy()
+        a[self.n :, : self.n] = -self._inv_m[:, None] * k
+        return a
+
+    def flow(self, states: NDArray[np.int8]) -> tuple[bytes, _Flow | FloatArray]:
+        """(key, the pattern's decomposition, or its generator A where V is ill-conditioned)."""
+        key = np.asarray(states, dtype=np.int8).tobytes()
+        found = self._flows.get(key)
+        if found is None:
+            a = self.generator(states)
+            decomposed = _decompose(a)
+            found = a if decomposed is None else decomposed
+            self._flows[key] = found
+        return key, found
+
+    def _transition(self, source: bytes, here: _Flow, target: bytes, there: _Flow) -> FloatArray:
+        found = self._transitions.get((source, target))
+        if found is None:
+            found = there.inverse @ here.vectors
+            self._transitions[(source, target)] = found
+        return found
+
+    def product(
+        self, widths: FloatArray, patterns: NDArray[np.int8], start: FloatArray | None = None
+    ) -> FloatArray:
+        """Return expm(A_k dt_k) ... expm(A_1 dt_1) @ start (start: identity by default).
+
+        Parameters
+        ----------
+        widths : (k,) ndarray
+            Each stretch's length, s (stretches of zero length are skipped).
+        patterns : (k, n_j) ndarray of int8
+            Each stretch's contact pattern.
+        start : (2N, m) ndarray, optional
+        """
+        phi = np.eye(2 * self.n) if start is None else np.array(start, dtype=np.float64)
+        here: _Flow | None = None
+        here_key = b""
+        for width, states in zip(widths, patterns, strict=True):
+            if width <= 0.0:
+                continue
+            key, flow = self.flow(states)
+            if not isinstance(flow, _Flow):
+                if here is not None:
+                    phi = here.vectors @ phi
+                    here = None
+                phi = scipy.linalg.expm(flow * width) @ phi
+                continue
+            if here is None:
+                phi = flow.inverse @ phi
+            elif here_key != key:
+                phi = self._transition(here_key, here, key, flow) @ phi
+            phi = flow.propagate(float(width), phi)
+            here, here_key = flow, key
+        if here is not None:
+            phi = here.vectors @ phi
+        return np.asarray(phi, dtype=np.float64)
+
+
+def stretches(motion: Any, start: float, stop: float) -> tuple[FloatArray, NDArray[np.int8]]:
+    """The stretches between events of ``motion`` within [start, stop] and their patterns.
+
+    Parameters
+    ----------
+    motion : StructureMotion
+        An exact motion (it carries ``event_times``, ``event_joints``, ``event_states``
+        and ``start_pattern``).
+    start, stop : float
+        s, within the motion's run.
+
+    Returns
+    -------
+    widths : (k,) ndarray
+        s; they sum to stop - start.
+    patterns : (k, n_j) ndarray of int8
+    """
+    times = np.asarray(motion.event_times, dtype=np.float64)
+    history = march.pattern_history(
+        np.ascontiguousarray(motion.start_pattern, dtype=np.int8),
+        np.ascontiguousarray(motion.event_joints, dtype=np.int64),
+        np.ascontiguousarray(motion.event_states, dtype=np.int8),
+    )
+    first = int(np.searchsorted(times, start, side="right"))
+    last = int(np.searchsorted(times, stop, side="left"))
+    inner = times[first:last]
+    edges = np.concatenate(([start], inner, [stop]))
+    return np.diff(edges), np.asarray(history[first : last + 1], dtype=np.int8)
+
+
+def largest_exponent(
+    flows: PatternFlows,
+    motion: Any,
+    period: float,
+    periods: int,
+    *,
+    start: FloatArray | None = None,
+    aligning: int = 0,
+) -> tuple[float, float, FloatArray]:
+    """The largest Lyapunov exponent of the motion from its exact tangent flow, and its error.
+
+    One tangent vector (``start``, else a fixed pseudo-random one) is carried over the
+    ``periods`` forcing periods of ``motion`` from t = 0 (Benettin's method with the
+    exact flow), renormalised at the end of every period in the energy norm of the
+    pattern in force there (:meth:`PatternFlows.energy_norm`). The first ``aligning``
+    periods only turn it towards the most growing direction; the log growths g_k of
+    the others give lambda = mean(g_k) / T (they telescope, so the norm biases lambda by
+    at most the log of the norms' ratio over the whole record). The uncertainty is the
+    standard error of the mean of g over blocks of periods (ten blocks, so neighbouring
+    periods' correlation is averaged out), divided by T.
+
+    Returns
+    -------
+    (lambda, sigma, vector) : lambda and sigma in 1/s, and the tangent vector at the end
+        (unit energy norm), to carry on to a next record.
+    """
+    if start is None:
+        w = np.random.default_rng(0).standard_normal((2 * flows.n, 1))
+    else:
+        w = np.asarray(start, dtype=np.float64).reshape(2 * flows.n, 1).copy()
+    _, patterns = stretches(motion, 0.0, period)
+    w /= flows.energy_norm(patterns[0], w)
+    growth = np.empty(periods)
+    for k in range(periods):
+        t0 = k * period
+        widths, patterns = stretches(motion, t0, t0 + period)
+        w = flows.product(widths, patterns, w)
+        size = flows.energy_norm(patterns[-1], w)
+        if not size > 0.0 or not math.isfinite(size):
+            raise StructureError("the tangent vector vanished or overflowed over one period")
+        growth[k] = math.log(size)
+        w /= size
+    used = growth[min(aligning, periods - 1) :]
+    rate = float(np.mean(used)) / period
+    block = max(1, used.size // 10)
+    n_blocks = used.size // block
+    means = used[: n_blocks * block].reshape(n_blocks, block).mean(axis=1)
+    sigma = (
+        float(np.std(means, ddof=1) / math.sqrt(n_blocks)) / period if n_blocks > 1 else math.inf
+    )
+    return rate, sigma, w
