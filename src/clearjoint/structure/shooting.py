@@ -37,7 +37,8 @@ from clearjoint.structure.tangent import PatternFlows
 
 #: Relative step of the central difference of P over w.
 D_OMEGA = 1e-7
-#: Samples a period along the curve (extremes refined by the local cubic: ~1e-7 of X).
+#: Samples a period along the curve (extremes refined by the local cubic: about 1e-4 of X
+#: where a turning point lies near a gap edge; periodic_orbit samples 512 for 1e-9).
 CURVE_SAMPLES = 64
 #: Periods of the short transient that restarts Newton across a kink.
 RESTART_PERIODS = 20

@@ -1,0 +1,259 @@
+"""Exact steady response of structures: orbits, curves and stepped sine (MODEL.md 5.1, 5.2).
+
+Checked by independent routes: the one-joint solver (clearjoint.periodic) on a one-link
+chain, a solve_ivp integration of our own restarted at every gap-edge event, a finite-
+difference monodromy of the exact map, the closed-form linear FRF and the closed-form
+decay rate of a linear damped chain.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import clearjoint as cj
+from clearjoint import periodic
+from clearjoint.structure import (
+    SteppedSineError,
+    StructureError,
+    chain,
+    frequency_response,
+    periodic_orbit,
+    stepped_sine,
+)
+from clearjoint.structure.orbit import ShootingMap
+
+LAW = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4)
+
+
+def _chain(n: int = 5):
+    return chain([0.5] * n, [math.inf] * n, [LAW] * n, [2.0] * n)
+
+
+def _force(n: int, value: float = 30.0) -> np.ndarray:
+    f = np.zeros(n)
+    f[-1] = value
+    return f
+
+
+def _reference_map(n: int, force: np.ndarray, omega: float, z0: np.ndarray) -> np.ndarray:
+    """P(z0) over one period by solve_ivp (DOP853, rtol 1e-12), restarted at each gap edge.
+
+    Written from MODEL.md 5.2 alone: a chain of masses m linked by the clearance law
+    (k0 inside +-g, k0 u + k_c (u -+ g) beyond) and dashpots c, ground at the left.
+    """
+    m, c, k0, kc, g = 0.5, 2.0, 2e4, 4e5, 1e-4
+
+    def link_force(d: float) -> float:
+        if d > g:
+            return k0 * d + kc * (d - g)
+        if d < -g:
+            return k0 * d + kc * (d + g)
+        return k0 * d
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        u, v = y[:n], y[n:]
+        du = np.diff(np.concatenate(([0.0], u)))
+        dv = np.diff(np.concatenate(([0.0], v)))
+        link = np.array([link_force(d) for d in du]) + c * dv
+        a = -link.copy()
+        a[:-1] += link[1:]
+        return np.concatenate((v, (a + force * math.sin(omega * t)) / m))
+
+    def edge(j: int, level: float):
+        def hit(t: float, y: np.ndarray) -> float:
+            u = y[:n]
+            return (u[j] - (u[j - 1] if j else 0.0)) - level
+
+        return hit
+
+    events = [edge(j, s * g) for j in range(n) for s in (1.0, -1.0)]
+    for hit in events:
+        hit.terminal = True  # type: ignore[attr-defined]
+    t, y, end = 0.0, z0.copy(), 2.0 * math.pi / omega
+    while t < end:
+        sol = solve_ivp(rhs, (t, end), y, method="DOP853", rtol=1e-12, atol=1e-15, events=events)
+        t, y = float(sol.t[-1]), sol.y[:, -1]
+        if sol.status == 1 and t < end:
+            # leave the edge without looking for events, then look again
+            step = solve_ivp(rhs, (t, min(t + 1e-10, end)), y, method="DOP853", rtol=1e-12)
+            t, y = float(step.t[-1]), step.y[:, -1]
+    return y
+
+
+def test_one_link_chain_orbit_is_the_one_joint_orbit():
+    s = _chain(1)
+    j, losses = s.to_system().to_joint()
+    w = 2 * math.pi * 40.0
+    reference = periodic.periodic_orbit(j, 30.0, w, losses=losses)
+    x0, v0 = np.asarray(reference.initial_state)
+    orbit = periodic_orbit(s, [30.0], w, initial=([x0 * 1.01], [v0]))
+    assert orbit.x_max[0] == pytest.approx(reference.x_max, abs=1e-8 * reference.amplitude)
+    assert orbit.x_min[0] == pytest.approx(reference.x_min, abs=1e-8 * reference.amplitude)
+    mine = np.sort_complex(orbit.multipliers)
+    theirs = np.sort_complex(np.asarray(reference.multipliers))
+    assert np.max(np.abs(mine - theirs)) < 1e-6
+    assert orbit.stable == reference.stable
+    assert orbit.closure < 1e-10
+
+
+def test_map_and_orbit_against_solve_ivp_restarted_at_events():
+    n = 3
+    s = _chain(n)
+    f = _force(n, 2.0)
+    w = 2 * math.pi * 15.0
+    orbit = periodic_orbit(s, f, w)
+    assert orbit.events > 10  # in contact, many times a period
+    z = np.concatenate(orbit.initial_state)
+    ref = _reference_map(n, f, w, z)
+    scale = np.concatenate((np.full(n, w), np.ones(n)))
+    assert np.max(np.abs((ref - z) * scale)) < 1e-7 * np.max(np.abs(z * scale))
+    # the map off the orbit (a Poincaré map step) agrees too
+    z1 = z + 0.05 * np.concatenate((orbit.amplitude, np.zeros(n)))
+    mine = ShootingMap(s.to_system(), f, w)(z1)[0]
+    ref1 = _reference_map(n, f, w, z1)
+    assert np.max(np.abs((ref1 - mine) * scale)) < 1e-7 * np.max(np.abs(z1 * scale))
+
+
+def test_monodromy_is_the_finite_difference_jacobian_of_the_exact_map():
+    n = 3
+    s = _chain(n)
+    f = _force(n, 2.0)
+    w = 2 * math.pi * 15.0
+    orbit = periodic_orbit(s, f, w)
+    shoot = ShootingMap(s.to_system(), f, w)
+    z = np.concatenate(orbit.initial_state)
+    fd = np.empty((2 * n, 2 * n))
+    for k in range(2 * n):
+        h = 1e-6 * (np.max(np.abs(z[:n])) if k < n else np.max(np.abs(z[n:])))
+        dz = np.zeros(2 * n)
+        dz[k] = h
+        fd[:, k] = (shoot(z + dz)[0] - shoot(z - dz)[0]) / (2 * h)
+    scale = np.concatenate((np.full(n, w), np.ones(n)))
+    rel = np.abs((fd - orbit.monodromy) * scale[:, None] / scale[None, :])
+    assert np.max(rel) < 1e-5 * np.max(np.abs(orbit.monodromy * scale[:, None] / scale[None, :]))
+    mu_fd = np.sort(np.abs(np.linalg.eigvals(fd)))
+    assert np.max(np.abs(mu_fd - np.sort(np.abs(orbit.multipliers)))) < 1e-5
+
+
+def test_shooting_curve_points_are_one_joint_orbits():
+    s = _chain(1)
+    j, losses = s.to_system().to_joint()
+    curve = frequency_response(s, [30.0], 2 * math.pi * 30, 2 * math.pi * 34, max_points=60)
+    assert curve.method == "shooting"
+    assert curve.x_max.shape == (curve.omega.size, 1)
+    for i in range(0, curve.omega.size, max(1, curve.omega.size // 4)):
+        ref = periodic.periodic_orbit(
+            j, 30.0, float(curve.omega[i]), losses=losses, initial=curve.initial_state[i]
+        )
+        # the curve samples 64 points a period (its extremes to ~1e-4 of X; the orbit 1e-9)
+        assert curve.x_max[i, 0] == pytest.approx(ref.x_max, abs=1e-4 * ref.amplitude)
+        assert bool(curve.stable[i]) == bool(ref.stable)
+
+
+def test_linear_limit_is_the_closed_form_frf_and_decays_at_the_least_damped_rate():
+    n = 5
+    s = _chain(n)
+    system = s.to_system()
+    f = _force(n, 3e-3)  # 1.5e-7 m against gaps of 1e-4 m: every joint stays open
+    hz = np.array([2.0, 10.0, 20.0])
+    diagram = stepped_sine(s, f, 2 * np.pi * hz, settle_periods=50, record_periods=100)
+    k, m, c = system.open_stiffness(), system.mass, system.damping
+    for i, w in enumerate(2 * np.pi * hz):
+        x = np.abs(np.linalg.solve(k - w * w * m + 1j * w * c, f))
+        assert diagram.kind[0, i] == "periodic"
+        assert np.max(np.abs(diagram.amplitude[0, i] - x)) < 1e-6 * np.max(x)
+    # linear, damped: the largest exponent is the largest real part of the eigenvalues
+    a = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(m, k), -np.linalg.solve(m, c)]])
+    rate = float(np.max(np.linalg.eigvals(a).real))
+    assert rate < 0
+    for i in range(hz.size):
+        assert diagram.lyapunov[0, i] == pytest.approx(
+            rate, rel=0.02, abs=3 * diagram.lyapunov_error[0, i]
+        )
+
+
+def test_positive_exponent_where_nearby_motions_separate_exponentially():
+    n = 5
+    s = _chain(n)
+    f = _force(n)
+    w = 2 * math.pi * 20.0
+    diagram = stepped_sine(s, f, [w], settle_periods=100, record_periods=100)
+    lam = float(diagram.lyapunov[0, 0])
+    assert diagram.kind[0, 0] == "chaotic"
+    assert lam > 0
+    # our own estimate: two exact runs 1e-9 apart, the growth of their distance
+    system = s.to_system()
+    start = np.concatenate((diagram.poincare[0, 0, -1, :n], diagram.poincare[0, 0, -1, n:]))
+    shoot = ShootingMap(system, f, w)
+    a, b = start.copy(), start + 1e-9 * np.max(np.abs(start)) * np.linspace(1, -1, 2 * n)
+    scale = np.concatenate((np.full(n, w), np.ones(n)))
+    d0 = np.linalg.norm((a - b) * scale)
+    logs = []
+    for _ in range(12):
+        a, b = shoot(a)[0], shoot(b)[0]
+        logs.append(math.log(np.linalg.norm((a - b) * scale) / d0))
+    slope = np.polyfit(np.arange(1, 13) * shoot.period, logs, 1)[0]
+    assert slope > 0
+    assert slope == pytest.approx(lam, rel=0.6)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"omegas": [10.0, -1.0]}, "finite and > 0"),
+        ({"omegas": [20.0, 10.0]}, "strictly increasing"),
+        ({"settle_periods": 0}, "settle_periods must be an integer >= 1"),
+        ({"record_periods": 0}, "record_periods must be an integer >= 1"),
+        ({"direction": "sideways"}, "direction must be"),
+    ],
+)
+def test_stepped_sine_refuses_bad_input_in_one_line(kwargs, message):
+    args = {"omegas": [10.0, 20.0], **kwargs}
+    omegas = args.pop("omegas")
+    with pytest.raises(SteppedSineError, match=message) as info:
+        stepped_sine(_chain(2), _force(2), omegas, **args)
+    assert "\n" not in str(info.value)
+
+
+def test_a_force_of_the_wrong_length_is_one_line():
+    with pytest.raises(StructureError) as info:
+        stepped_sine(_chain(2), [1.0, 2.0, 3.0], [10.0])
+    assert "\n" not in str(info.value)
+    with pytest.raises(StructureError):
+        periodic_orbit(_chain(2), [1.0], 10.0)
+
+
+def test_restitution_is_refused_where_the_jacobian_would_miss_its_jumps():
+    law = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.8)
+    s = chain([0.5], [math.inf], [law], [2.0])
+    with pytest.raises(StructureError, match="restitution"):
+        periodic_orbit(s, [30.0], 2 * math.pi * 40)
+
+
+def test_results_have_repr_plot_and_xarray():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    s = _chain(2)
+    diagram = stepped_sine(
+        s,
+        _force(2),
+        2 * np.pi * np.array([20.0, 30.0]),
+        direction="both",
+        settle_periods=20,
+        record_periods=8,
+    )
+    assert "SteppedSine(2 frequencies" in repr(diagram)
+    ds = diagram.to_xarray()
+    assert ds["amplitude"].dims == ("direction", "frequency", "dof")
+    assert list(ds["direction"].values) == ["up", "down"]
+    assert ds["frequency"].attrs["units"] == "Hz"
+    assert diagram.plot() is not None
+    orbit = periodic_orbit(s, _force(2), 2 * math.pi * 30)
+    assert "StructureOrbit(30 Hz" in repr(orbit)
+    assert orbit.to_xarray()["x_max"].attrs["units"] == "m"
+    assert orbit.plot() is not None
