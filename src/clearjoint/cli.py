@@ -453,14 +453,52 @@ def _run_modes(args: argparse.Namespace) -> int:
     return 0
 
 
+#: The options of ``clearjoint structure STUDY stepped-sine`` and nothing else.
+_STEPPED_ONLY = (
+    ("--from", "start", None),
+    ("--to", "stop", None),
+    ("--points", "points", 100),
+    ("--direction", "direction", "up"),
+    ("--settle-periods", "settle_periods", 200),
+    ("--record-periods", "record_periods", 100),
+    ("--workers", "workers", None),
+    ("--scheduler", "scheduler", None),
+)
+
+
 def _run_structure(args: argparse.Namespace) -> int:
     from clearjoint.structure.study import load_structure_study
     from clearjoint.studies import run_structure_task, write_structure_result
 
+    stepped = args.task == "stepped-sine"
+    for option, name, default in _STEPPED_ONLY:
+        if not stepped and getattr(args, name) != default:
+            raise ParameterError(f"{option} goes with the stepped-sine task; drop it or use that")
+    if stepped and (args.start is None or args.stop is None):
+        raise ParameterError("stepped-sine needs --from and --to, e.g. --from 2Hz --to 60Hz")
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
-    result = run_structure_task(study, args.task, figure=plot_path is not None)
+    if stepped:
+        from clearjoint.parallel import optional_client
+        from clearjoint.studies import stepped_sine_of
+        from clearjoint.units import parse_quantity
+
+        start = parse_quantity(args.start, "frequency", name="--from")
+        stop = parse_quantity(args.stop, "frequency", name="--to")
+        with optional_client(args.scheduler, args.workers) as client:
+            result = stepped_sine_of(
+                study,
+                start,
+                stop,
+                points=args.points,
+                direction=args.direction,
+                settle_periods=args.settle_periods,
+                record_periods=args.record_periods,
+                runner=client,
+            )
+    else:
+        result = run_structure_task(study, args.task, figure=plot_path is not None)
     write_structure_result(result, out)
     _save_plot(result.drawn, plot_path, quiet=True)
     if args.json:

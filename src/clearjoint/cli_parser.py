@@ -354,18 +354,41 @@ def _modes_parser(sub: Any) -> None:
 def _structure_parser(sub: Any) -> None:
     p = sub.add_parser(
         "structure",
-        help="modes, forced response or free decay of a structure with many joints (MODEL 5.2)",
+        help="modes, forced response, free decay or stepped sine of a structure (MODEL 5.2)",
         description=(
             "Read a structure study (TOML with units, see clearjoint.structure.study) and "
             "compute its linear modes with every joint closed and open (modes), its exact "
-            "forced response (respond) or its exact free decay and backbone (decay)."
+            "forced response (respond), its exact free decay and backbone (decay), or a "
+            "stepped-sine test run exactly (stepped-sine: at each of --points frequencies "
+            "from --from to --to, from the state the last one left, the motion settles and is "
+            "recorded; each frequency's amplitude, kind of motion and Lyapunov exponent)."
         ),
     )
     p.add_argument("study", help="structure study TOML file")
-    p.add_argument("task", choices=("modes", "respond", "decay"), help="what to compute")
+    p.add_argument(
+        "task", choices=("modes", "respond", "decay", "stepped-sine"), help="what to compute"
+    )
     p.add_argument("--out", required=True, help="netCDF results file (.nc)")
     _add_plot_option(p, force=False)
     _flags(p, json="print a JSON summary", force="overwrite existing output")
+    g = p.add_argument_group("stepped-sine")
+    g.add_argument("--from", dest="start", help="first frequency, e.g. 2Hz")
+    g.add_argument("--to", dest="stop", help="last frequency, e.g. 60Hz")
+    g.add_argument("--points", type=int, default=100, help="frequencies (default 100)")
+    g.add_argument(
+        "--direction",
+        choices=("up", "down", "both"),
+        default="up",
+        help="step up, down, or up then down marking the jumps (default up)",
+    )
+    g.add_argument(
+        "--settle-periods", type=int, default=200, help="periods to settle (default 200)"
+    )
+    g.add_argument("--record-periods", type=int, default=100, help="periods recorded (default 100)")
+    g.add_argument(
+        "--workers", type=int, help="run chunks of frequencies on a local Dask cluster of N"
+    )
+    g.add_argument("--scheduler", help="run them on a running Dask scheduler, tcp://host:8786")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -29,8 +29,10 @@ frequency:
   4. "unsettled": the exponent is negative beyond that (the motion converges to an
      attractor) but no stable orbit was confirmed: more settling periods would decide it.
 
-``direction="both"`` runs up then down and marks the ``jumps``: neighbouring frequencies
-whose largest amplitude differs by more than ``JUMP_RATIO``.
+``direction="both"`` runs up then down and marks the ``jumps``: steps whose largest
+amplitude changes by more than ``JUMP_RATIO`` where the two sweeps disagree (by as much)
+at one end of the step, the hysteresis that makes it a jump (one direction alone: every
+change by more than ``JUMP_RATIO``).
 
 With a ``runner`` (a ``concurrent.futures`` executor or a ``dask.distributed`` client,
 :mod:`clearjoint.parallel`) each direction's frequencies are cut into ``chunks``
@@ -425,23 +427,33 @@ def _frequencies(omegas: ArrayLike) -> FloatArray:
 def _jumps(
     omega: FloatArray, directions: tuple[str, ...], amplitude: FloatArray
 ) -> list[dict[str, Any]]:
+    """Steps where the largest amplitude changes by more than ``JUMP_RATIO``; with both
+    directions, only those where the two sweeps disagree at one end of the step (by more
+    than ``JUMP_RATIO``): the hysteresis of a jump, not a steep slope of one branch."""
     out: list[dict[str, Any]] = []
     f = omega / (2 * math.pi)
+    top = np.max(amplitude, axis=2)  # (d, n)
+    both = len(directions) == 2
+    if both:
+        low, high = np.minimum(top[0], top[1]), np.maximum(top[0], top[1])
+        apart = high > JUMP_RATIO * np.maximum(low, 1e-300)
     for d, name in enumerate(directions):
-        top = np.max(amplitude[d], axis=1)
         order = np.arange(f.size) if name == "up" else np.arange(f.size)[::-1]
         for a, b in itertools.pairwise(order):
-            low, high = sorted((float(top[a]), float(top[b])))
-            if high > JUMP_RATIO * max(low, 1e-300):
-                out.append(
-                    {
-                        "direction": name,
-                        "from_hz": float(f[a]),
-                        "to_hz": float(f[b]),
-                        "from_amplitude_m": float(top[a]),
-                        "to_amplitude_m": float(top[b]),
-                    }
-                )
+            small, large = sorted((float(top[d, a]), float(top[d, b])))
+            if large <= JUMP_RATIO * max(small, 1e-300):
+                continue
+            if both and not (apart[a] or apart[b]):
+                continue
+            out.append(
+                {
+                    "direction": name,
+                    "from_hz": float(f[a]),
+                    "to_hz": float(f[b]),
+                    "from_amplitude_m": float(top[d, a]),
+                    "to_amplitude_m": float(top[d, b]),
+                }
+            )
     return out
 
 

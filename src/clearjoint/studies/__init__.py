@@ -13,7 +13,7 @@ written once:
 * :mod:`~clearjoint.studies.harmonic`: what harmonic balance cannot carry, refused;
 * :mod:`~clearjoint.studies.curves`: frequency-response curves and nonlinear modes,
   the method chosen, run and written;
-* :mod:`~clearjoint.studies.structure`: a structure study's modes, response and decay;
+* :mod:`~clearjoint.studies.structure`: a structure study's modes, response, decay and stepped sine;
 * :mod:`~clearjoint.studies.identify`: a set of identifications written.
 """
 
@@ -48,6 +48,7 @@ _HOMES = {
     "refuse_harmonic_structure": "harmonic",
     "run_structure_task": "structure",
     "run_study": "joint_study",
+    "stepped_sine_of": "structure",
     "structure_at": "overrides",
     "study_at": "overrides",
     "summary": "joint_study",
@@ -81,6 +82,7 @@ __all__ = [
     "refuse_harmonic_structure",
     "run_structure_task",
     "run_study",
+    "stepped_sine_of",
     "structure_at",
     "study_at",
     "summary",

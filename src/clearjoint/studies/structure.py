@@ -22,6 +22,7 @@ __all__ = [
     "STRUCTURE_TASKS",
     "StructureTaskResult",
     "run_structure_task",
+    "stepped_sine_of",
     "write_structure_result",
 ]
 
@@ -122,6 +123,67 @@ def run_structure_task(
     else:
         raise ParameterError(f"task must be one of {', '.join(STRUCTURE_TASKS)}, got {task!r}")
     return StructureTaskResult(data, summary, drawn)
+
+
+def stepped_sine_of(
+    study: StructureStudy,
+    start: float,
+    stop: float,
+    *,
+    points: int = 100,
+    direction: str = "up",
+    settle_periods: int = 200,
+    record_periods: int = 100,
+    runner: Any = None,
+) -> StructureTaskResult:
+    """The study's stepped-sine test, run exactly, from ``start`` to ``stop`` Hz (MODEL.md 5.2).
+
+    ``points`` frequencies evenly spaced (both ends included) at the study's force
+    (``clearjoint.structure.stepped_sine``).
+
+    Raises
+    ------
+    ParameterError
+        No [excitation] section, a range that is not increasing and positive, fewer than
+        2 points.
+    """
+    from clearjoint.structure import stepped_sine
+
+    if study.force is None:
+        raise ParameterError(
+            f"{study.source}: stepped-sine needs an [excitation] section (force_dof, "
+            "force_amplitude); put it in the study file"
+        )
+    for name, value in (("--from", start), ("--to", stop)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ParameterError(f"{name} must be a frequency > 0, got {value!r} Hz")
+    if not stop > start:
+        raise ParameterError(
+            f"--to ({stop:g} Hz) must be above --from ({start:g} Hz); the direction of the "
+            "steps is --direction"
+        )
+    if isinstance(points, bool) or not isinstance(points, int) or points < 2:
+        raise ParameterError(f"--points must be an integer >= 2, got {points!r}")
+    hz = np.linspace(start, stop, points)
+    diagram = stepped_sine(
+        study.structure,
+        study.force,
+        2.0 * math.pi * hz,
+        direction=direction,  # type: ignore[arg-type]
+        settle_periods=settle_periods,
+        record_periods=record_periods,
+        runner=runner,
+    )
+    kinds = {str(k): int(np.sum(diagram.kind == k)) for k in np.unique(diagram.kind)}
+    summary: dict[str, Any] = {
+        "structure": repr(study.structure),
+        "frequencies": points,
+        "directions": list(diagram.directions),
+        "kinds": kinds,
+        "max_amplitude_m": float(np.max(diagram.amplitude)),
+        "jumps": diagram.jumps,
+    }
+    return StructureTaskResult(diagram.to_xarray(), summary, diagram)
 
 
 def write_structure_result(result: StructureTaskResult, path: str | Path) -> Path:
