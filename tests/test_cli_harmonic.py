@@ -169,11 +169,28 @@ def test_frf_of_a_structure_study(tmp_path: Path, capsys: pytest.CaptureFixture[
         assert ds["x_max"].dims == ("point", "dof")
         assert list(ds["dof"].values) == ["n1x", "n2x", "n3x"]  # the DOF names, as in --json
         assert ds.attrs["method"] == "harmonic"
-    # the default method (exact shooting of one joint) cannot do a structure: one line
-    code, _, err = run([*args[:-2], "--out", str(tmp_path / "y.nc")], capsys)
+    # the default method follows the structure's exact orbits by shooting (issue 24); its
+    # points are the exact orbits clearjoint.structure.periodic_orbit closes
+    from clearjoint.structure import periodic_orbit
+
+    code, text, err = run([*args[:-2], "--out", str(tmp_path / "y.nc"), "--json"], capsys)
+    assert code == 0, err
+    exact = json.loads(text)
+    with xr.open_dataset(tmp_path / "y.nc", engine="h5netcdf") as ds:
+        assert ds.attrs["method"] == "shooting"
+        omega = float(ds["omega"].values[-1])
+        u0 = ds["initial_displacement"].values[-1]
+        v0 = ds["initial_velocity"].values[-1]
+    orbit = periodic_orbit(s, force, omega, initial=(u0, v0))
+    np.testing.assert_allclose(exact["x_max_m"][-1], orbit.x_max, rtol=1e-4)
+    # a force curve of a structure is harmonic balance's only: one line
+    code, _, err = run(
+        [*args[:-2], "--out", str(tmp_path / "z.nc"), "--parameter", "force",
+         "--from", "10N", "--to", "20N"],
+        capsys,
+    )
     assert code == 2
-    assert "is a structure study" in err
-    assert "add --method harmonic" in err
+    assert "follows the frequency only" in err
     assert len(err.strip().splitlines()) == 1
 
 

@@ -360,7 +360,6 @@ def _plot_sweep(args: argparse.Namespace) -> int:
 
 
 def _run_frf(args: argparse.Namespace) -> int:
-    from clearjoint.structure.study import StructureStudy
     from clearjoint.studies import (
         curve_summary,
         frequency_response_of,
@@ -390,9 +389,8 @@ def _run_frf(args: argparse.Namespace) -> int:
         )
     if args.max_points < 2:
         raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
-    structure = isinstance(study, StructureStudy)
     for option, given in (("--harmonics", args.harmonics), ("--samples", args.samples)):
-        if args.method != "harmonic" and given is not None and not structure:
+        if args.method != "harmonic" and given is not None:
             raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")
     frequency = None
     if args.frequency and not force_curve:

@@ -249,7 +249,8 @@ def _frf_parser(sub: Any) -> None:
             "report folds, period doublings and grazings. With --parameter force, --from and "
             "--to are forces and --frequency (default: the study's) is held fixed. A structure "
             "study (clearjoint structure's file: [structure], [joint], [excitation]) is followed "
-            "by harmonic balance (--method harmonic), with per-DOF extremes."
+            "by exact shooting too (its frequency only), or by harmonic balance (--method "
+            "harmonic), with per-DOF extremes."
         ),
     )
     p.add_argument("study", help="study file (TOML), as for clearjoint simulate")

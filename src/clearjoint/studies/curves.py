@@ -75,7 +75,8 @@ def frequency_response_of(
     frequency : float, optional
         The fixed frequency (Hz) of a force curve; default: the study's.
     method : {"shooting", "harmonic"}
-        A structure study takes "harmonic" only.
+        A structure study by shooting (``clearjoint.structure.frequency_response``)
+        follows the frequency only.
     harmonics, samples : int, optional
         H (default :data:`DEFAULT_HARMONICS`) and samples per period of harmonic balance.
     max_points : int
@@ -85,7 +86,7 @@ def frequency_response_of(
     Raises
     ------
     ParameterError
-        A structure study by shooting, a study without the force the curve needs,
+        A structure study's force curve by shooting, a study without the force the curve needs,
         losses harmonic balance cannot carry, too few samples, or no orbit at the start.
     """
     if isinstance(study, StructureStudy):
@@ -142,19 +143,30 @@ def _structure_curve(
     max_points: int,
     names: Mapping[str, str] | None,
 ) -> Any:
-    """The frequency response of a structure study by harmonic balance (MODEL.md 5.3)."""
+    """The frequency response of a structure study, exact by shooting (MODEL.md 5.1 on 5.2)
+    or by harmonic balance (MODEL.md 5.3)."""
     from clearjoint import harmonic
     from clearjoint.harmonic.response import NoPeriodicResponse
 
-    if method != "harmonic":
-        raise ParameterError(
-            f"{study.source} is a structure study: its frequency response is computed by "
-            "harmonic balance; add --method harmonic"
-        )
     if study.force is None or study.omega is None:
         raise ParameterError(
             f"{study.source}: frf needs the [excitation] section (force_dof, force_amplitude; "
             "frequency for --parameter force); put it in the study file"
+        )
+    if method != "harmonic":
+        from clearjoint import structure
+
+        if parameter == "force":
+            raise ParameterError(
+                f"{study.source} is a structure study: its exact curve by shooting follows the "
+                "frequency only; drop --parameter force, or add --method harmonic"
+            )
+        return structure.frequency_response(
+            study.structure,
+            study.force,
+            2.0 * math.pi * start,
+            2.0 * math.pi * stop,
+            max_points=max_points,
         )
     refuse_harmonic_structure(study, "frf")
     h = DEFAULT_HARMONICS if harmonics is None else harmonics
