@@ -185,8 +185,17 @@ def test_frf_of_a_structure_study(tmp_path: Path, capsys: pytest.CaptureFixture[
     np.testing.assert_allclose(exact["x_max_m"][-1], orbit.x_max, rtol=1e-4)
     # a force curve of a structure is harmonic balance's only: one line
     code, _, err = run(
-        [*args[:-2], "--out", str(tmp_path / "z.nc"), "--parameter", "force",
-         "--from", "10N", "--to", "20N"],
+        [
+            *args[:-2],
+            "--out",
+            str(tmp_path / "z.nc"),
+            "--parameter",
+            "force",
+            "--from",
+            "10N",
+            "--to",
+            "20N",
+        ],
         capsys,
     )
     assert code == 2
