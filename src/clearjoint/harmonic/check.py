@@ -34,7 +34,16 @@ if TYPE_CHECKING:
 
     from clearjoint.results import FrequencyResponse
 
-__all__ = ["RESIDUAL_TOLERANCE", "OrbitCheck", "check_orbits", "spread", "untrusted_events"]
+__all__ = [
+    "RESIDUAL_TOLERANCE",
+    "OrbitCheck",
+    "StabilityCheck",
+    "check_orbits",
+    "confirm_stable",
+    "spread",
+    "unconfirmed_events",
+    "untrusted_events",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -272,4 +281,158 @@ def untrusted_events(response: FrequencyResponse, check: OrbitCheck) -> list[Any
                 "trusted; raise harmonics= or lower the force",
             )
         )
+    return out
+
+
+#: An exact orbit found by Newton from a harmonic-balance orbit is "nearby" when it lies
+#: within this fraction of the orbit's state (norm of (w u, v)).
+NEARBY = 0.2
+#: Periods the exact motion is run from an orbit Newton could not close, to see whether it
+#: stays (each period's phase-0 state within ``NEARBY`` of the orbit's).
+STAY_PERIODS = 30
+#: At most this many stable points of one curve are confirmed (spread evenly over them);
+#: the others are left unconfirmed, and so not stable.
+CONFIRM_LIMIT = 400
+
+
+@dataclass(frozen=True)
+class StabilityCheck:
+    """Harmonic balance's "stable" points of a structure, confirmed (or not) by the exact motion.
+
+    MODEL.md 5.1 on 5.2: from each point's state, Newton on the exact one-period map
+    (:class:`clearjoint.structure.orbit.ShootingMap`); an exact orbit within ``NEARBY`` of
+    it whose Floquet multipliers all lie inside the unit circle confirms the verdict.
+    Where Newton does not close, the exact motion is run ``STAY_PERIODS`` periods from
+    the state: staying within ``NEARBY`` confirms it, leaving refutes it.
+
+    Attributes
+    ----------
+    index : (k,) ndarray of int
+        The points checked (harmonic balance called them stable).
+    verdict : (k,) ndarray of str
+        "confirmed", "exact orbit unstable", "exact orbit far", "motion leaves",
+        "motion stays" (confirmed without a closed orbit) or "not computable".
+    multiplier : (k,) ndarray
+        max abs(mu) of the exact orbit found (NaN where none).
+    confirmed : (k,) ndarray of bool
+    unchecked : (m,) ndarray of int
+        Stable points beyond ``CONFIRM_LIMIT``, not checked (so not stable).
+    """
+
+    index: NDArray[np.int64]
+    verdict: NDArray[np.str_] = field(repr=False)
+    multiplier: FloatArray = field(repr=False)
+    confirmed: NDArray[np.bool_] = field(repr=False)
+    unchecked: NDArray[np.int64] = field(repr=False)
+
+    def __repr__(self) -> str:
+        return (
+            f"StabilityCheck({self.index.size} stable points checked, "
+            f"{int(np.sum(self.confirmed))} confirmed, {self.unchecked.size} not checked)"
+        )
+
+
+def confirm_stable(response: FrequencyResponse) -> StabilityCheck:
+    """Confirm (or refute) by the exact motion each point harmonic balance calls stable.
+
+    See :class:`StabilityCheck`. ``response`` is a harmonic-balance curve of a Structure
+    or VibrationSystem without friction (lumped mass).
+    """
+    from clearjoint.structure.motion import _run
+    from clearjoint.structure.orbit import ShootingMap, _newton
+    from clearjoint.structure.tangent import PatternFlows
+    from clearjoint.system import as_system
+
+    system = as_system(response.settings["system"])
+    pattern = np.asarray(response.settings["force_pattern"], dtype=np.float64)
+    stable = np.flatnonzero(response.stable)
+    chosen = stable
+    if stable.size > CONFIRM_LIMIT:
+        chosen = stable[spread(stable.size, CONFIRM_LIMIT)]
+    unchecked = np.setdiff1d(stable, chosen)
+    n = system.n_dof
+    verdict = np.full(chosen.size, "not computable", dtype=object)
+    multiplier = np.full(chosen.size, math.nan)
+    try:
+        flows: Any = PatternFlows(system)
+    except ClearjointError:
+        flows = None
+    for m, i in enumerate(chosen):
+        if flows is None:
+            break
+        w = float(response.omega[i])
+        z = np.asarray(response.initial_state[i], dtype=np.float64)
+        try:
+            shoot = ShootingMap(system, pattern * float(response.force_amplitude[i]), w, 1, flows)
+            size = shoot.size(z)
+            found = _newton(shoot, z, 1e-12 * size)
+            if found is not None:
+                mu = np.abs(np.linalg.eigvals(found[1]))
+                multiplier[m] = float(np.max(mu))
+                if shoot.size(found[0] - z) > NEARBY * size:
+                    verdict[m] = "exact orbit far"
+                elif np.all(mu < 1.0):
+                    verdict[m] = "confirmed"
+                else:
+                    verdict[m] = "exact orbit unstable"
+                continue
+            motion = _run(
+                shoot.flow,
+                z[:n],
+                z[n:],
+                STAY_PERIODS * shoot.period,
+                np.arange(STAY_PERIODS, dtype=np.float64) * shoot.period,
+            )
+            states = np.concatenate((motion.u, motion.v), axis=1)
+            away = max(shoot.size(s - z) for s in states)
+            verdict[m] = "motion stays" if away <= NEARBY * size else "motion leaves"
+        except ClearjointError:
+            verdict[m] = "not computable"
+    confirmed = np.isin(verdict, ("confirmed", "motion stays"))
+    return StabilityCheck(
+        index=np.asarray(chosen, dtype=np.int64),
+        verdict=verdict.astype(str),
+        multiplier=multiplier,
+        confirmed=np.asarray(confirmed, dtype=bool),
+        unchecked=np.asarray(unchecked, dtype=np.int64),
+    )
+
+
+_SAYS = {
+    "exact orbit unstable": "the exact orbit nearby is unstable",
+    "exact orbit far": "Newton on the exact map reaches only an orbit far from it",
+    "motion leaves": "the exact motion started on it leaves it",
+    "not computable": "the exact motion could not be computed from it",
+}
+
+
+def unconfirmed_events(response: FrequencyResponse, found: StabilityCheck) -> list[Any]:
+    """One ``"untrusted"`` event per run of neighbouring points whose "stable" is refuted."""
+    out = []
+    bad = [
+        (int(i), str(v))
+        for i, v, ok in zip(found.index, found.verdict, found.confirmed, strict=True)
+        if not ok
+    ]
+    bad += [(int(i), "not checked") for i in found.unchecked]
+    bad.sort()
+    start = 0
+    for k in range(1, len(bad) + 1):
+        if k < len(bad) and bad[k][0] == bad[k - 1][0] + 1 and bad[k][1] == bad[start][1]:
+            continue
+        i0, what = bad[start]
+        i1 = bad[k - 1][0]
+        hz = response.omega[[i0, i1]] / (2 * math.pi)
+        said = _SAYS.get(what, f"not checked (more than {CONFIRM_LIMIT} stable points)")
+        out.append(
+            untrusted(
+                response.omega,
+                response.force_amplitude,
+                response.amplitude,
+                i0,
+                f"harmonic balance calls {i1 - i0 + 1} point(s) at {hz[0]:.6g}-{hz[1]:.6g} Hz "
+                f"stable, but {said}: they are not stable here",
+            )
+        )
+        start = k
     return out

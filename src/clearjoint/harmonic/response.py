@@ -156,8 +156,14 @@ def frequency_response(
         (:func:`clearjoint.harmonic.check.check_orbits`); each whose orbit misses by
         more than the tolerance gets an ``"untrusted"`` event (its stability verdict
         is not to be trusted), and the whole check is in ``settings["orbit_check"]``.
-        0 skips the check; it is skipped (no ``"orbit_check"``) when a joint has
-        friction, which the exact structure motion does not carry.
+        Every point harmonic balance calls stable is then confirmed or refuted by the
+        exact motion (:func:`clearjoint.harmonic.check.confirm_stable`): ``stable`` is
+        True only where confirmed, harmonic balance's own verdict is kept in
+        ``settings["harmonic_stable"]``, the check in ``settings["stability_check"]``,
+        and each run of refuted points gets an ``"untrusted"`` event saying what the
+        exact motion does. 0 skips both checks (``stable`` is then harmonic balance's
+        verdict alone); they are skipped when a joint has friction, which the exact
+        structure motion does not carry.
     stability : {"hill", "monodromy"}, optional
         How the Floquet multipliers are found. ``"hill"``: Hill's method (the
         infinite determinant for one DOF without friction, else the quadratic
@@ -304,8 +310,18 @@ def frequency_response(
         return response
     found = check.check_orbits(response, check.spread(response.omega.size, check_points))
     settings["orbit_check"] = found
+    # a structure's point is stable only where the exact motion confirms it (issue 24)
+    confirmed = check.confirm_stable(response)
+    settings["stability_check"] = confirmed
+    settings["harmonic_stable"] = response.stable.copy()
+    stable = np.zeros_like(response.stable)
+    stable[confirmed.index[confirmed.confirmed]] = True
     return dataclasses.replace(
-        response, events=response.events + check.untrusted_events(response, found)
+        response,
+        stable=stable,
+        events=response.events
+        + check.untrusted_events(response, found)
+        + check.unconfirmed_events(response, confirmed),
     )
 
 

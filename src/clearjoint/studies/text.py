@@ -151,7 +151,18 @@ def curve_warnings(curve: Any) -> list[str]:
             f"{curve.omega[-1] / (2 * math.pi):.6g} Hz, {curve.force_amplitude[-1]:.6g} N; "
             "the curve covers only part of the range"
         )
-    untrusted = [e for e in curve.events if e.kind == "untrusted"]
+    found = curve.settings.get("stability_check")
+    if found is not None and (not np.all(found.confirmed) or found.unchecked.size):
+        refuted = int(np.sum(~found.confirmed)) + int(found.unchecked.size)
+        out.append(
+            f"harmonic balance called {refuted} of its points stable that the exact motion "
+            "does not confirm (an unstable exact orbit nearby, or motion that leaves the "
+            "orbit); they are marked unstable: see the curve's events, or run clearjoint "
+            "structure STUDY stepped-sine for what the motion does there"
+        )
+    untrusted = [
+        e for e in curve.events if e.kind == "untrusted" and "not stable here" not in e.note
+    ]
     if untrusted:  # harmonic balance of a structure: orbits the exact motion does not follow
         where = ", ".join(f"{e.omega / (2 * math.pi):.4g}" for e in untrusted)
         out.append(
