@@ -163,7 +163,9 @@ class PatternFlows:
         return np.asarray(phi, dtype=np.float64)
 
 
-def stretches(motion: Any, start: float, stop: float) -> tuple[FloatArray, NDArray[np.int8]]:
+def stretches(
+    motion: Any, start: float, stop: float, history: NDArray[np.int8] | None = None
+) -> tuple[FloatArray, NDArray[np.int8]]:
     """The stretches between events of ``motion`` within [start, stop] and their patterns.
 
     Parameters
@@ -173,6 +175,8 @@ def stretches(motion: Any, start: float, stop: float) -> tuple[FloatArray, NDArr
         and ``start_pattern``).
     start, stop : float
         s, within the motion's run.
+    history : (E + 1, n_j) ndarray of int8, optional
+        The motion's :func:`pattern_history` (computed here when not given).
 
     Returns
     -------
@@ -181,16 +185,25 @@ def stretches(motion: Any, start: float, stop: float) -> tuple[FloatArray, NDArr
     patterns : (k, n_j) ndarray of int8
     """
     times = np.asarray(motion.event_times, dtype=np.float64)
-    history = march.pattern_history(
-        np.ascontiguousarray(motion.start_pattern, dtype=np.int8),
-        np.ascontiguousarray(motion.event_joints, dtype=np.int64),
-        np.ascontiguousarray(motion.event_states, dtype=np.int8),
-    )
+    if history is None:
+        history = pattern_history(motion)
     first = int(np.searchsorted(times, start, side="right"))
     last = int(np.searchsorted(times, stop, side="left"))
     inner = times[first:last]
     edges = np.concatenate(([start], inner, [stop]))
     return np.diff(edges), np.asarray(history[first : last + 1], dtype=np.int8)
+
+
+def pattern_history(motion: Any) -> NDArray[np.int8]:
+    """(E + 1, n_j): the motion's contact pattern at the start and after each event."""
+    return np.asarray(
+        march.pattern_history(
+            np.ascontiguousarray(motion.start_pattern, dtype=np.int8),
+            np.ascontiguousarray(motion.event_joints, dtype=np.int64),
+            np.ascontiguousarray(motion.event_states, dtype=np.int8),
+        ),
+        dtype=np.int8,
+    )
 
 
 def largest_exponent(
@@ -223,12 +236,13 @@ def largest_exponent(
         w = np.random.default_rng(0).standard_normal((2 * flows.n, 1))
     else:
         w = np.asarray(start, dtype=np.float64).reshape(2 * flows.n, 1).copy()
-    _, patterns = stretches(motion, 0.0, period)
+    history = pattern_history(motion)
+    _, patterns = stretches(motion, 0.0, period, history)
     w /= flows.energy_norm(patterns[0], w)
     growth = np.empty(periods)
     for k in range(periods):
         t0 = k * period
-        widths, patterns = stretches(motion, t0, t0 + period)
+        widths, patterns = stretches(motion, t0, t0 + period, history)
         w = flows.product(widths, patterns, w)
         size = flows.energy_norm(patterns[-1], w)
         if not size > 0.0 or not math.isfinite(size):
