@@ -303,3 +303,20 @@ def test_stepped_sine_from_the_command_line(tmp_path, capsys):
         err = capsys.readouterr().err
         assert text in err
         assert len(err.strip().splitlines()) == 1
+
+
+def test_one_link_curve_has_the_one_joint_curves_period_doublings():
+    """Two independent exact solvers (the one-joint kernel with its own shooting, and the
+    structure's march with its pattern exponentials) follow the same branch from the same
+    orbit and find the same period doublings."""
+    s = _chain(1)
+    j, losses = s.to_system().to_joint()
+    w0, w1 = 2 * math.pi * 46, 2 * math.pi * 40
+    theirs = periodic.frequency_response(j, 30.0, w0, w1, losses=losses)
+    x0, v0 = theirs.initial_state[0]
+    mine = frequency_response(s, [30.0], w0, w1, initial=([x0], [v0]))
+    assert mine.stop_reason == "reached"
+    a = sorted(e.omega for e in mine.events if e.kind == "period_doubling")
+    b = sorted(e.omega for e in theirs.events if e.kind == "period_doubling")
+    assert len(a) == len(b) == 2  # near 41.56 and 44.71 Hz
+    np.testing.assert_allclose(a, b, atol=2 * math.pi * 2e-3)
