@@ -265,14 +265,19 @@ class SteppedSine:
     ) -> Any:
         """The bifurcation diagram: Poincaré samples of ``dof`` against frequency, by kind.
 
+        Each frequency shows its recorded states at forcing phase 0; a periodic or
+        period-k one only its last k (settled: its verdict is the orbit Newton closed
+        from them). Curves drawn over it show their orbits' state at phase 0 too
+        (``initial_state``), so a stable orbit of a curve and a periodic point meet.
+
         Parameters
         ----------
         ax : matplotlib Axes, optional
         dof : int or str, optional
             A DOF index or name; default the DOF that moves most.
         curves : sequence of FrequencyResponse
-            Curves to draw over it (harmonic balance, shooting): x_max of ``dof``, stable
-            solid, unstable dashed.
+            Curves to draw over it (harmonic balance, shooting), stable solid, unstable
+            dashed.
 
         Returns
         -------
@@ -295,25 +300,29 @@ class SteppedSine:
         r = self.poincare.shape[2]
         for d, name in enumerate(self.directions):
             for kind, colour in colours.items():
-                chosen = self.kind[d] == kind
-                if not np.any(chosen):
+                chosen = np.flatnonzero(self.kind[d] == kind)
+                if not chosen.size:
                     continue
-                xs = np.repeat(f[chosen], r)
-                ys = 1e3 * self.poincare[d, chosen, :, k].ravel()
+                xs: list[float] = []
+                ys: list[float] = []
+                for i in chosen:
+                    keep = int(self.period[d, i]) if self.period[d, i] > 0 else r
+                    xs += [float(f[i])] * keep
+                    ys += (1e3 * self.poincare[d, i, r - keep :, k]).tolist()
                 label = f"{kind} ({name})" if len(self.directions) > 1 else kind
                 ax.plot(
                     xs,
                     ys,
                     markers[name],
                     color=colour,
-                    ms=2.0 if name == "up" else 2.5,
+                    ms=2.0 if name == "up" else 3.0,
                     alpha=0.6,
                     ls="none",
                     label=label,
                 )
         for j, curve in enumerate(curves):
-            x_max = np.asarray(curve.x_max)
-            column = x_max[:, k] if x_max.ndim == 2 else x_max
+            state = np.asarray(curve.initial_state)
+            column = state[:, k]
             cf = curve.omega / (2 * math.pi)
             stable = np.asarray(curve.stable, dtype=bool)
             tag = getattr(curve, "method", "curve")
@@ -324,17 +333,19 @@ class SteppedSine:
                 "-",
                 color=colour,
                 lw=1.2,
-                label=f"{tag}: x_max, stable",
+                label=f"{tag} {j + 1}: stable",
             )
             ax.plot(
                 cf,
                 1e3 * np.where(stable, np.nan, column),
                 "--",
                 color=colour,
-                lw=0.9,
-                label=f"{tag}: x_max, unstable",
+                lw=0.8,
+                label=f"{tag} {j + 1}: unstable",
             )
         name = self.dof_names[k] if self.dof_names else f"DOF {k}"
+        margin = 0.02 * float(f[-1] - f[0]) if f.size > 1 else 0.5
+        ax.set_xlim(float(f[0]) - margin, float(f[-1]) + margin)  # curves may run past
         ax.set_xlabel("frequency (Hz)")
         ax.set_ylabel(f"{name} at forcing phase 0 (mm)")
         ax.legend(frameon=False, fontsize="x-small", markerscale=3, ncol=2)
