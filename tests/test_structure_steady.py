@@ -101,12 +101,17 @@ def test_one_link_chain_orbit_is_the_one_joint_orbit():
     assert orbit.closure < 1e-10
 
 
+def _three_masses_in_contact():
+    """A 3-mass chain at 2 N and 15 Hz: a stable orbit with many gap-edge events."""
+    s = _chain(3)
+    f = _force(3, 2.0)
+    w = 2 * math.pi * 15.0
+    return s, f, w, periodic_orbit(s, f, w)
+
+
 def test_map_and_orbit_against_solve_ivp_restarted_at_events():
     n = 3
-    s = _chain(n)
-    f = _force(n, 2.0)
-    w = 2 * math.pi * 15.0
-    orbit = periodic_orbit(s, f, w)
+    s, f, w, orbit = _three_masses_in_contact()
     assert orbit.events > 10  # in contact, many times a period
     z = np.concatenate(orbit.initial_state)
     ref = _reference_map(n, f, w, z)
@@ -121,10 +126,7 @@ def test_map_and_orbit_against_solve_ivp_restarted_at_events():
 
 def test_monodromy_is_the_finite_difference_jacobian_of_the_exact_map():
     n = 3
-    s = _chain(n)
-    f = _force(n, 2.0)
-    w = 2 * math.pi * 15.0
-    orbit = periodic_orbit(s, f, w)
+    s, f, w, orbit = _three_masses_in_contact()
     shoot = ShootingMap(s.to_system(), f, w)
     z = np.concatenate(orbit.initial_state)
     fd = np.empty((2 * n, 2 * n))
