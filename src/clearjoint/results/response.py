@@ -224,6 +224,12 @@ class FrequencyResponse:
 
     def _solver(self, what: str) -> Any:
         """The module that made this shooting curve, which re-runs its orbits."""
+        if self.method == "shooting" and self.solver is None:
+            raise ParameterError(
+                f"{what} re-runs a single joint's orbits; for a point of a structure's curve "
+                "use clearjoint.structure.periodic_orbit(structure, force, omega[index], "
+                "initial=(u0, v0)) with initial_state[index] split into u(0) and u'(0)"
+            )
         if self.method != "shooting" or self.solver is None:
             raise ParameterError(
                 f"{what} re-runs exact orbits of a shooting curve, and this is a "
