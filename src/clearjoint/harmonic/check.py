@@ -338,8 +338,7 @@ def confirm_stable(response: FrequencyResponse) -> StabilityCheck:
     See :class:`StabilityCheck`. ``response`` is a harmonic-balance curve of a Structure
     or VibrationSystem without friction (lumped mass).
     """
-    from clearjoint.structure.motion import _run
-    from clearjoint.structure.orbit import ShootingMap, _newton
+    from clearjoint.structure.poincare import ShootingMap, newton_orbit
     from clearjoint.structure.tangent import PatternFlows
     from clearjoint.system import as_system
 
@@ -350,7 +349,6 @@ def confirm_stable(response: FrequencyResponse) -> StabilityCheck:
     if stable.size > CONFIRM_LIMIT:
         chosen = stable[spread(stable.size, CONFIRM_LIMIT)]
     unchecked = np.setdiff1d(stable, chosen)
-    n = system.n_dof
     verdict = np.full(chosen.size, "not computable", dtype=object)
     multiplier = np.full(chosen.size, math.nan)
     try:
@@ -365,7 +363,7 @@ def confirm_stable(response: FrequencyResponse) -> StabilityCheck:
         try:
             shoot = ShootingMap(system, pattern * float(response.force_amplitude[i]), w, 1, flows)
             size = shoot.size(z)
-            found = _newton(shoot, z, 1e-12 * size)
+            found = newton_orbit(shoot, z, 1e-12 * size)
             if found is not None:
                 mu = np.abs(np.linalg.eigvals(found[1]))
                 multiplier[m] = float(np.max(mu))
@@ -376,13 +374,8 @@ def confirm_stable(response: FrequencyResponse) -> StabilityCheck:
                 else:
                     verdict[m] = "exact orbit unstable"
                 continue
-            motion = _run(
-                shoot.flow,
-                z[:n],
-                z[n:],
-                STAY_PERIODS * shoot.period,
-                np.arange(STAY_PERIODS, dtype=np.float64) * shoot.period,
-            )
+            stay = ShootingMap(shoot.system, shoot.force, w, STAY_PERIODS, flows)
+            motion = stay.run(z, 1)  # the state at phase 0 of each period
             states = np.concatenate((motion.u, motion.v), axis=1)
             away = max(shoot.size(s - z) for s in states)
             verdict[m] = "motion stays" if away <= NEARBY * size else "motion leaves"

@@ -42,10 +42,10 @@ scaling and one matrix product V_q^-1 V_p per segment, the transition V_q^-1 V_p
 per pair of patterns, instead of a Pade approximant with about log2(norm(A t))
 squarings. The decompositions live in a bounded cache (``_FLOW_BYTES``) keyed by the
 system's matrices and the pattern, so neighbouring curve points share them
-(:func:`clear_cache` frees them). A pattern
-whose V is badly conditioned (1-norm condition above ``_MAX_CONDITION``: a defective A,
-e.g. a free mass with no damping, or nearly parallel eigenvectors) keeps
-``scipy.linalg.expm``, and so does an orbit whose patterns would not fit in the cache.
+(:func:`clear_cache` frees them). A pattern whose V is badly conditioned (1-norm
+condition above ``clearjoint.exact.patterns.MAX_CONDITION``: a defective A, e.g. a free
+mass with no damping, or nearly parallel eigenvectors) keeps ``scipy.linalg.expm``, and
+so does an orbit whose patterns would not fit in the cache.
 ``method="expm"`` forces the plain product (the reference the tests compare with).
 """
 
@@ -55,7 +55,6 @@ import hashlib
 import math
 import threading
 from collections import OrderedDict
-from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -64,6 +63,8 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
 from clearjoint.errors import ParameterError
+from clearjoint.exact.patterns import PatternFlow as _Flow
+from clearjoint.exact.patterns import decompose as _decompose
 from clearjoint.harmonic.aft import Basis
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
 
@@ -136,92 +137,12 @@ def _pattern_stiffness(system: LinearSystem, state: NDArray[np.int64]) -> FloatA
     return np.asarray(system.stiffness + (b.T * k_j) @ b, dtype=np.float64)
 
 
-#: A pattern's A = V B V^-1 is used when V's 1-norm condition number (balanced
-#: coordinates) is at most this; above it (a defective or nearly defective A) the segment
-#: keeps scipy.linalg.expm. The similarity's rounding is about cond(V) eps per segment.
-_MAX_CONDITION = 1e6
-
 #: Bytes the decompositions may hold (the 40-bay mast's orbits need about 200 MiB each),
 #: and the transitions between patterns; each store drops its least recently used entries
 #: first. An orbit whose own patterns' decompositions would not fit keeps scipy.linalg.expm
 #: (a transition that does not fit only costs its one matrix product again).
 _FLOW_BYTES = 512 * 2**20
 _TRANSITION_BYTES = 256 * 2**20
-
-
-@dataclass(frozen=True)
-class _Flow:
-    """expm(A t) = vectors @ expm(B t) @ inverse for one contact pattern's A (2N, 2N).
-
-    The columns are the ``real`` real eigenvectors, then Re v of each pair a +- i b,
-    then Im v of each pair in the same order: B is ``rate`` on the diagonal, and for
-    pair i the block [[a, b], [-b, a]] on (real + i, real + p + i), p pairs, with a =
-    ``rate[real + i]`` and b = ``frequency[i]``.
-    """
-
-    vectors: FloatArray
-    inverse: FloatArray
-    rate: FloatArray
-    real: int
-    frequency: FloatArray
-
-    def propagate(self, t: float, psi: FloatArray) -> FloatArray:
-        """Return expm(B t) @ psi, psi (2N, m) in this pattern's eigen-coordinates."""
-        out = psi * np.exp(self.rate * t)[:, None]
-        p = self.frequency.size
-        c = np.cos(self.frequency * t)[:, None]
-        s = np.sin(self.frequency * t)[:, None]
-        first = out[self.real : self.real + p].copy()
-        second = out[self.real + p :]
-        out[self.real : self.real + p] = c * first + s * second
-        second *= c
-        second -= s * first
-        return out
-
-
-def _decompose(a: FloatArray) -> _Flow | None:
-    """Return A's real block eigen-decomposition, or None where it is not to be trusted.
-
-    Parameters
-    ----------
-    a : (2N, 2N) ndarray
-        The pattern's state matrix, 1/s.
-
-    Returns
-    -------
-    _Flow or None
-        None when A (balanced by powers of 2) has an eigenvector matrix whose 1-norm
-        condition number exceeds ``_MAX_CONDITION`` or cannot be inverted.
-    """
-    balanced, (scale, _) = scipy.linalg.matrix_balance(a, permute=False, separate=True)
-    lam, v = np.linalg.eig(balanced)
-    upper = np.flatnonzero(lam.imag > 0.0)
-    real = np.flatnonzero(lam.imag == 0.0)
-    if real.size + 2 * upper.size != lam.size:  # not in conjugate pairs: let expm decide
-        return None
-    vectors = np.empty_like(a)
-    rate = np.empty(lam.size)
-    vectors[:, : real.size] = v[:, real].real
-    rate[: real.size] = lam[real].real
-    p, r = upper.size, real.size
-    vectors[:, r : r + p] = v[:, upper].real
-    vectors[:, r + p :] = v[:, upper].imag
-    rate[r : r + p] = rate[r + p :] = lam[upper].real
-    try:
-        inverse = np.linalg.inv(vectors)
-    except np.linalg.LinAlgError:
-        return None
-    condition = np.linalg.norm(vectors, 1) * np.linalg.norm(inverse, 1)
-    if not condition <= _MAX_CONDITION:
-        return None
-    # back to the unbalanced coordinates: A = D balanced D^-1, D = diag(scale) (powers of 2)
-    return _Flow(
-        vectors=scale[:, None] * vectors,
-        inverse=inverse / scale[None, :],
-        rate=rate,
-        real=r,
-        frequency=np.asarray(lam[upper].imag, dtype=np.float64),
-    )
 
 
 class _Cache:

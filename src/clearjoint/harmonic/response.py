@@ -733,3 +733,43 @@ def _events(
             continue
         merged.append((index, event))
     return [e for _, e in merged]
+
+
+def start_coefficients(
+    model: LinearSystem, basis: aft.Basis, omega: float, force: FloatArray
+) -> FloatArray:
+    """Harmonic balance's orbit at one frequency, found as :func:`frequency_response` finds its
+    start: Newton from the open and the closed linear responses, else a continuation in the
+    force (with friction, from smoother regularisations too).
+
+    Returns
+    -------
+    (2H + 1) N ndarray
+        The coefficients a_0, a_1, b_1, ..., a_H, b_H (per DOF), m.
+
+    Raises
+    ------
+    HarmonicError
+        No orbit found (``NoPeriodicResponse``).
+    """
+    return _start(model, basis, omega, force, model.reference_stiffness)
+
+
+def curve_events(
+    model: LinearSystem,
+    lam: FloatArray,
+    multipliers: NDArray[np.complex128],
+    d_max: FloatArray,
+    d_min: FloatArray,
+    omega: FloatArray,
+    force: FloatArray,
+    amplitude: FloatArray,
+) -> list[ResponseEvent]:
+    """Folds, period doublings, Neimark-Sacker crossings and grazings along a curve.
+
+    For any curve of periodic orbits with Floquet multipliers and the joints' extreme
+    shortenings ``d_max``, ``d_min`` (n, n_j) per point; ``model`` gives the joints'
+    directions and gap edges (``directions``, ``g_c``, ``g_t``, ``is_joint``). See
+    ``_events`` for how each is located.
+    """
+    return _events(model, lam, multipliers, d_max, d_min, omega, force, amplitude)

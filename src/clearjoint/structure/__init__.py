@@ -11,13 +11,35 @@ Each of them takes a Structure or the :class:`~clearjoint.system.VibrationSystem
 produces (``Structure.to_system()``), or one built from matrices.
 """
 
+import importlib
+from typing import Any
+
 from clearjoint.structure.backbone import Backbone, decay_backbone
 from clearjoint.structure.builders import chain, mast, truss
 from clearjoint.structure.model import Member, Modes, Structure, StructureError, system_modes
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
-from clearjoint.structure.orbit import OrbitError, StructureOrbit, periodic_orbit
-from clearjoint.structure.shooting import frequency_response
+from clearjoint.structure.poincare import OrbitError, StructureOrbit
 from clearjoint.structure.stepped import SteppedSine, SteppedSineError, stepped_sine
+
+# periodic_orbit (seeded by harmonic balance) and frequency_response (its events found as
+# harmonic balance finds them) import clearjoint.harmonic, whose check of its own orbits
+# imports this package's exact motion: they are imported on first use (PEP 562), so this
+# package's import never needs harmonic balance
+_LAZY = {
+    "periodic_orbit": "clearjoint.structure.orbit",
+    "frequency_response": "clearjoint.structure.shooting",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import ``periodic_orbit`` and ``frequency_response`` from their modules on first use."""
+    home = _LAZY.get(name)
+    if home is None:
+        raise AttributeError(f"module 'clearjoint.structure' has no attribute {name!r}")
+    value = getattr(importlib.import_module(home), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "Backbone",

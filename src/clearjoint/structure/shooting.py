@@ -26,11 +26,11 @@ from clearjoint.errors import ParameterError
 from clearjoint.results import FrequencyResponse
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.motion import _run, _system, _vector
-from clearjoint.structure.orbit import (
+from clearjoint.structure.orbit import periodic_orbit
+from clearjoint.structure.poincare import (
     FloatArray,
     ShootingMap,
-    _sorted_multipliers,
-    periodic_orbit,
+    sorted_multipliers,
     turning_extremes,
 )
 from clearjoint.structure.tangent import PatternFlows
@@ -136,7 +136,7 @@ def frequency_response(
             x_min=x_min,
             d_max=d_max,
             d_min=d_min,
-            multipliers=_sorted_multipliers(phi),
+            multipliers=sorted_multipliers(phi),
         )
         return end - z, phi - np.eye(2 * n), d_lam, data
 
@@ -183,9 +183,9 @@ def frequency_response(
     force_amplitude = np.full(omega.size, peak)
     law = system.law_arrays()
     model = SimpleNamespace(directions=b, g_c=law.g_c, g_t=law.g_t, is_joint=False)
-    from clearjoint.harmonic.response import _events
+    from clearjoint.harmonic.response import curve_events
 
-    events = _events(
+    events = curve_events(
         model,  # type: ignore[arg-type]
         omega,
         multipliers,

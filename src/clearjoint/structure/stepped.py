@@ -56,7 +56,7 @@ from clearjoint.errors import ParameterError
 from clearjoint.parallel import run_ordered
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.motion import _Flow, _run, _system, _vector
-from clearjoint.structure.orbit import OrbitError, ShootingMap, _newton, turning_extremes
+from clearjoint.structure.poincare import OrbitError, ShootingMap, newton_orbit, turning_extremes
 from clearjoint.structure.tangent import PatternFlows, largest_exponent
 from clearjoint.system import VibrationSystem
 
@@ -131,7 +131,7 @@ def _classify(
         if gap > LOOSE * size and not (settling and k <= SETTLING_PERIOD):
             continue
         orbit_map = ShootingMap(shoot.system, shoot.force, shoot.omega, k, flows)
-        found = _newton(orbit_map, poincare[-1].copy(), 1e-12 * size)
+        found = newton_orbit(orbit_map, poincare[-1].copy(), 1e-12 * size)
         if found is None:
             continue
         mu = np.linalg.eigvals(found[1])

@@ -17,7 +17,7 @@ A restitution below 1 makes R (and so S) differ from the identity at every impac
 module refuses it in one line rather than give a Jacobian without its jumps.
 
 Each pattern's A is decomposed once, A = V B V^-1 with B real block-diagonal
-(``clearjoint.harmonic.monodromy``'s decomposition, the same cache rules: an
+(``clearjoint.exact.patterns``, as harmonic balance's monodromy uses it: an
 ill-conditioned V keeps ``scipy.linalg.expm``), and the product is carried in the
 patterns' eigen-coordinates, so a stretch costs one diagonal scaling and a change of
 coordinates where the pattern changes.
@@ -33,7 +33,8 @@ import scipy.linalg
 from numpy.typing import NDArray
 
 from clearjoint.exact import march
-from clearjoint.harmonic.monodromy import _decompose, _Flow
+from clearjoint.exact.patterns import PatternFlow as _Flow
+from clearjoint.exact.patterns import decompose as _decompose
 from clearjoint.structure.model import StructureError
 from clearjoint.system import VibrationSystem
 
