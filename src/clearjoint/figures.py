@@ -509,7 +509,7 @@ def law_versus_measured_figure(
     enough labelled ticks to read a value (1, 2, 3, 5 per decade over a decade or so,
     1, 2, 5 up to three, decades beyond), written as plain numbers (0.05, 0.2).
     """
-    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+    from matplotlib.ticker import LogLocator, NullFormatter
 
     fig = Figure(figsize=(5.6, 4.8), layout="constrained")
     ax = fig.add_subplot()
@@ -545,7 +545,7 @@ def law_versus_measured_figure(
     subs = (1.0, 2.0, 3.0, 5.0) if decades < 1.5 else (1.0, 2.0, 5.0) if decades < 3 else (1.0,)
     for axis in (ax.xaxis, ax.yaxis):
         axis.set_major_locator(LogLocator(base=10.0, subs=subs, numticks=15))
-        axis.set_major_formatter(FuncFormatter(_plain_number))
+        axis.set_major_formatter(_plain_numbers())
         axis.set_minor_formatter(NullFormatter())
     ax.tick_params(axis="x", labelrotation=35)
     ax.set_xlabel(f"{reference} energy per cycle (J)")
@@ -554,9 +554,20 @@ def law_versus_measured_figure(
     return fig
 
 
-def _plain_number(value: float, _position: object = None) -> str:
-    """A log axis' tick as a plain number (0.05, 2, 300), scientific only when tiny or huge."""
-    return f"{value:g}"
+def _plain_numbers() -> Any:
+    """A log axis' tick formatter: plain numbers (0.05, 2, 300), and no label for a tick
+    outside the axis' view (the locator returns some beyond it; they are never drawn)."""
+    from matplotlib.ticker import Formatter
+
+    class PlainNumbers(Formatter):
+        def __call__(self, value: float, pos: int | None = None) -> str:
+            if self.axis is not None:
+                low, high = sorted(self.axis.get_view_interval())
+                if not low * (1 - 1e-9) <= value <= high * (1 + 1e-9):
+                    return ""
+            return f"{value:g}"
+
+    return PlainNumbers()
 
 
 def identification_accuracy_figure(accuracy: Sequence[dict[str, Any]]) -> Figure:

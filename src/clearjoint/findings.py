@@ -125,15 +125,20 @@ class _Check:
         return f"{text} ({where})" if where else text
 
     def margin(self) -> str:
-        """The weakest number's distance from a trend, in standard errors (s.e.), short."""
+        """The weakest number's distance from a trend in standard errors (s.e.), short."""
         part = self.weakest
         if part is None:
             return ""
-        if math.isnan(part.z):
+        z = part.z
+        if math.isnan(z):
             return "no finite standard error"
-        if part.z < -Z:
-            return f"the other way by {-part.z:.1f} s.e." if part.z > -math.inf else "the other way"
-        return f"{part.z:.1f} s.e. of the {Z:g} needed" if part.z <= Z else f"{part.z:.1f} s.e."
+        if z < -Z:
+            return f"the other way by {-z:.1f} s.e." if z > -math.inf else "the other way"
+        if z > Z:
+            return f"{z:.1f} s.e." if z < math.inf else ""
+        if z < -0.05:
+            return f"{-z:.1f} s.e. the other way, within the noise"
+        return f"{max(z, 0.0):.1f} s.e., {Z:g} needed"
 
     def why_not(self) -> str:
         """Why a testable check does not hold, in words, from its weakest number."""

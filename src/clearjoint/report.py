@@ -232,8 +232,8 @@ def findings_html(findings: Sequence[Finding]) -> str:
     body = "".join(
         f'<tr class="{_CLASS[_mark(f)]}"><td class="finding"><b>{html.escape(f.finding)}</b></td>'
         f'<td class="verdict">{_mark(f)}</td><td class="headline">{html.escape(f.headline)}</td>'
-        f'<td>{html.escape(f.source)}</td><td class="more"><details><summary>why, every '
-        f"number</summary><p>Paper: {html.escape(f.paper)}.</p>"
+        f'<td>{html.escape(f.source)}</td><td class="more"><details><summary>why, numbers'
+        f"</summary><p>Paper: {html.escape(f.paper)}.</p>"
         f"<p><i>{html.escape(f.why)}</i></p>{_evidence_html(f.evidence)}</details></td></tr>"
         for f in findings
     )
@@ -386,7 +386,8 @@ table{{border-collapse:collapse;font-size:0.85em;margin:0.5em 0;display:block;ov
 td,th{{border:1px solid #999;padding:0.15em 0.4em;vertical-align:top}}img{{max-width:100%}}
 #findings{{font-size:0.8em}}#findings tr.no td.verdict{{font-weight:bold}}
 #findings td.finding,#findings td.verdict{{white-space:nowrap}}
-#findings td.more{{min-width:9em;max-width:36em}}#findings td.more summary{{font-weight:normal}}
+#findings td.more{{max-width:36em}}
+#findings td.more summary{{font-weight:normal;white-space:nowrap}}
 #findings ul{{margin:0.2em 0;padding-left:1.2em}}#findings p{{margin:0.2em 0}}
 details{{margin:0.4em 0}}summary{{cursor:pointer;font-weight:bold}}</style>
 </head><body>
