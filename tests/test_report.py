@@ -189,6 +189,70 @@ def test_report_in_a_real_browser(reproduction: Path, tmp_path: Path) -> None:
         driver.quit()
 
 
+def _findings_at_a_glance(driver: Any, page: Path) -> list[str]:
+    """What keeps the findings table from being read at a glance on a 1400 px wide screen:
+    the table past the first screen, a verdict cut off or hidden, a details box open, a
+    row taller than two lines."""
+    driver.set_window_size(1400, 900)
+    driver.get(page.resolve().as_uri())
+    found = driver.execute_script(
+        "const t = document.getElementById('findings');"
+        "if (!t) return null;"
+        "const r = t.getBoundingClientRect();"
+        "const cells = Array.from(t.querySelectorAll('td.verdict')).map(c => {"
+        "  const b = c.getBoundingClientRect();"
+        "  return [c.textContent, b.top, b.bottom, b.left, b.right, c.scrollWidth > c.clientWidth];"
+        "});"
+        "const rows = Array.from(t.querySelectorAll('tr')).slice(1).map("
+        "  x => x.getBoundingClientRect().height);"
+        "const line = parseFloat(getComputedStyle(t).fontSize) * 1.35;"
+        "const open = t.querySelectorAll('details[open]').length;"
+        "return [r.top, r.bottom, r.right, window.innerWidth, window.innerHeight, cells, rows,"
+        " line, open];"
+    )
+    if found is None:
+        return ["no findings table"]
+    top, bottom, right, width, height, cells, rows, line, open_ = found
+    problems = []
+    if width != 1400 and abs(width - 1400) > 20:  # a scroll bar may take a few pixels
+        problems.append(f"the window is {width} px wide, not 1400")
+    if top < 0 or bottom > height or right > width:
+        problems.append(f"the table {[top, bottom, right]} is not in one screen {[width, height]}")
+    if not cells:
+        problems.append("no verdict cells")
+    for text, c_top, c_bottom, c_left, c_right, clipped in cells:
+        visible = c_top >= 0 and c_bottom <= height and c_left >= 0 and c_right <= width
+        if text.strip() not in ("yes", "NO", "n/a") or not visible or clipped:
+            problems.append(f"verdict {text!r} not visible at {[c_top, c_bottom, c_left, c_right]}")
+    problems += [f"a row {h:.0f} px tall: more than two lines" for h in rows if h > 2.6 * line + 8]
+    if open_:
+        problems.append(f"{open_} details open: the details are one click away, closed")
+    return problems
+
+
+def test_findings_table_fits_one_screen_at_1400_px(reproduction: Path, tmp_path: Path) -> None:
+    """Issue 28: every verdict of the findings table visible in one 1400 px wide screen."""
+    driver = _browser(tmp_path / "chromium-profile")
+    try:
+        assert _findings_at_a_glance(driver, reproduction / "report.html") == []
+        # the check sees a table of walls of text (the old evidence cells) for what it is
+        wall = "joint-1 compression: a1 = 0.375 ± 0.34 MN/m per 100 Hz; " * 12
+        row = f'<tr><td>k_c &gt; k_t</td><td class="verdict">NO</td><td>{wall}</td></tr>'
+        bad = tmp_path / "wall.html"
+        bad.write_text(
+            '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>wall</title>'
+            '</head><body style="max-width:72em"><table id="findings"><tr><th>h</th></tr>'
+            + row * 10
+            + "</table></body></html>"
+        )
+        found = _findings_at_a_glance(driver, bad)
+        assert any("not in one screen" in p for p in found), found
+        assert any("not visible" in p for p in found), found
+        assert any("more than two lines" in p for p in found), found
+    finally:
+        driver.quit()
+
+
 def test_names_moved_out_of_report_still_import() -> None:
     from clearjoint import analysis, reproduction, verification
     from clearjoint.report import analyse, example_cycle, reproduce
