@@ -44,8 +44,10 @@ class Finding:
     ``source`` is "model" or "rig input"; ``evidence`` gives the numbers (slopes with
     their standard errors, in engineering units); ``why`` says what makes it so, or why
     the data do not show it. ``headline`` is the one number the verdict rests on, with
-    the quantity and the joint named (``k_d,c - k_d,t = 0.791 ± 0.125 MN/m (joint-1)``):
-    the weakest joint and side, as every one of them must hold.
+    the quantity and the joint named (``mean k_d,c - k_d,t = 0.231 ± 0.0791 MN/m (joint-2,
+    weakest of 2)``): the weakest joint and side, as every one of them must hold; for a
+    NO, with how far it is from a trend (``: 0.5 s.e., 2 needed``, ``: the other way by
+    4.0 s.e.``); for an n/a, what the data lack.
     """
 
     finding: str
