@@ -231,7 +231,7 @@ def findings_html(findings: Sequence[Finding]) -> str:
     )
     body = "".join(
         f'<tr class="{_CLASS[_mark(f)]}"><td class="finding"><b>{html.escape(f.finding)}</b></td>'
-        f'<td class="verdict">{_mark(f)}</td><td class="headline">{html.escape(f.headline)}</td>'
+        f'<td>{_mark(f)}</td><td class="headline">{html.escape(f.headline)}</td>'
         f'<td>{html.escape(f.source)}</td><td class="more"><details><summary>why, numbers'
         f"</summary><p>Paper: {html.escape(f.paper)}.</p>"
         f"<p><i>{html.escape(f.why)}</i></p>{_evidence_html(f.evidence)}</details></td></tr>"
@@ -384,8 +384,8 @@ def _html(study: Study) -> str:
 h1{{font-size:1.4em;margin:0.3em 0}}
 table{{border-collapse:collapse;font-size:0.85em;margin:0.5em 0;display:block;overflow-x:auto}}
 td,th{{border:1px solid #999;padding:0.15em 0.4em;vertical-align:top}}img{{max-width:100%}}
-#findings{{font-size:0.8em}}#findings tr.no td.verdict{{font-weight:bold}}
-#findings td.finding,#findings td.verdict{{white-space:nowrap}}
+#findings{{font-size:0.8em}}#findings tr.no td:nth-child(2){{font-weight:bold}}
+#findings td.finding,#findings td:nth-child(2){{white-space:nowrap}}
 #findings td.more{{max-width:36em}}
 #findings td.more summary{{font-weight:normal;white-space:nowrap}}
 #findings ul{{margin:0.2em 0;padding-left:1.2em}}#findings p{{margin:0.2em 0}}
