@@ -78,11 +78,18 @@ sphinx_gallery_conf = {
 }
 
 # ---- HTML ----------------------------------------------------------------------------------
-html_theme = "alabaster"
+# pydata-sphinx-theme: the theme of numpy, scipy and xarray's sites, which a scientific
+# Python user already knows how to read (navigation left, page contents right).
+html_theme = "pydata_sphinx_theme"
 html_title = f"clearjoint {release}"
 html_static_path: list[str] = []
 html_theme_options = {
-    "description": "Dynamics of pin joints with clearance",
-    "page_width": "1100px",
-    "sidebar_width": "240px",
+    "navigation_with_keys": False,
+    "show_toc_level": 2,
+    "navbar_align": "left",
+    "header_links_before_dropdown": 4,  # the rest of the guide under "More", not two rows
+    "footer_start": ["copyright"],
+    "footer_end": ["sphinx-version"],
+    "secondary_sidebar_items": ["page-toc"],
 }
+html_sidebars: dict[str, list[str]] = {"index": []}  # the front page uses the full width

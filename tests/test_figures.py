@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 from clearjoint.figures import Curve, stiffness_coefficient_figure
 
@@ -133,3 +134,95 @@ def test_save_figure_writes_a_drawn_figure_or_draws_a_result_first(tmp_path: Pat
     assert drawn.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     result = save_figure(Result(), str(tmp_path / "result.svg"))
     assert "<svg" in result.read_text(encoding="utf-8")
+
+
+# ---- issue 28: the report's figures read at a glance --------------------------------------
+
+
+def _labelled_ticks(axis: Any) -> list[tuple[float, str]]:
+    """The major ticks inside the axis' view with their labels (the figure drawn first)."""
+    low, high = sorted(axis.get_view_interval())
+    labels = [text.get_text() for text in axis.get_majorticklabels()]
+    return [
+        (loc, label)
+        for loc, label in zip(axis.get_majorticklocs(), labels, strict=True)
+        if label and low <= loc <= high
+    ]
+
+
+def test_fig13_log_axes_have_enough_labelled_ticks_as_plain_numbers() -> None:
+    """The issue's report: energies over about a decade (0.04 to 0.6 J) got two labels."""
+    from clearjoint.figures import law_versus_measured_figure
+
+    measured = np.geomspace(0.04, 0.6, 40)
+    fig = law_versus_measured_figure(measured, measured * 1.2, model=measured * 1.5)
+    fig.canvas.draw()
+    (ax,) = fig.axes
+    for axis in (ax.xaxis, ax.yaxis):
+        ticks = _labelled_ticks(axis)
+        assert len(ticks) >= 4, ticks
+        # a plain number, read back as the tick's own value (no 10^x mathtext)
+        assert all(float(text) == pytest.approx(loc) for loc, text in ticks), ticks
+
+
+def test_the_identification_error_legend_is_outside_the_points() -> None:
+    """A point at +1.1 % (the issue's energy point) sat on the '±1 %' legend."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.transforms import Bbox
+
+    from clearjoint.figures import identification_accuracy_figure
+
+    rng = np.random.default_rng(3)
+    accuracy = [
+        {
+            "clearance_error": 1e-4 * rng.standard_normal(),
+            "compression_stiffness_error": 1e-3 * rng.standard_normal(),
+            "tension_stiffness_error": 1e-3 * rng.standard_normal(),
+            "energy_error": 0.011 if k == 0 else 0.005 * rng.standard_normal(),
+        }
+        for k in range(30)
+    ]
+    fig = identification_accuracy_figure(accuracy)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    (ax,) = fig.axes
+    renderer = canvas.get_renderer()
+    legend = ax.get_legend().get_window_extent(renderer)
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["±1 %"]
+    # no marker of any point inside the legend's box
+    for line in ax.get_lines():
+        for x, y in ax.transData.transform(line.get_xydata()):
+            assert not legend.contains(x, y), (x, y)
+    assert not Bbox.intersection(legend, ax.get_window_extent(renderer))  # outside the axes
+
+
+def test_fig8_frequencies_apart_and_coinciding_lines_said() -> None:
+    """Five frequencies whose eq 19 lines lie within 0.1 % of each other: each its own
+    colour and style, and a note says the lines coincide (the law barely depends on w)."""
+    from clearjoint.figures import StiffnessPanel, stiffness_panels_figure
+
+    freqs = np.repeat([20.0, 40.0, 60.0, 80.0, 100.0], 4)
+    amp = np.tile(np.linspace(20e-6, 80e-6, 4), 5)
+    k = 5e6 + 2.5e11 * amp + 100.0 * freqs  # 0.008 MN/m across 80 Hz, 15 MN/m across A
+    grid = np.linspace(20e-6, 80e-6, 20)
+    lines = {f: (grid, 5e6 + 2.5e11 * grid + 100.0 * f) for f in np.unique(freqs)}
+    fig = stiffness_panels_figure(
+        [StiffnessPanel("joint-1, compression", freqs, amp, k, lines)], ylabel="k (MN/m)"
+    )
+    ax = fig.axes[0]
+    drawn = [line for line in ax.get_lines() if line.get_xdata().size == grid.size]
+    assert len(drawn) == 5
+    assert len({line.get_color() for line in drawn}) == 5
+    points = [line for line in ax.get_lines() if line.get_xdata().size == 4]
+    assert len({line.get_marker() for line in points}) == 5
+    assert {line.get_color() for line in points} == {line.get_color() for line in drawn}
+    notes = [t.get_text() for t in ax.texts]
+    assert len(notes) == 1
+    assert "5 frequencies' lines lie within 0.008 MN/m" in notes[0]
+    # lines far apart (the beam's panels): no note
+    apart = {f: (grid, law + 2e5 * f) for f, (grid, law) in lines.items()}
+    fig = stiffness_panels_figure(
+        [StiffnessPanel("beam, compression", freqs, amp, k + 2e5 * freqs, apart)],
+        ylabel="k (MN/m)",
+    )
+    assert not fig.axes[0].texts

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -232,3 +233,71 @@ def test_the_same_table_for_a_folder_of_records(
 def test_a_finding_has_one_of_two_sources() -> None:
     with pytest.raises(ValueError, match="source"):
         Finding("f", "p", True, "given", "e", "w")
+
+
+# ---- issue 28: each finding at a glance, its number named --------------------------------
+
+
+def test_at_a_glance_each_finding_has_its_verdict_and_its_number_named(
+    reproduction: Path,
+) -> None:
+    results = json.loads((reproduction / "results.json").read_text())
+    glance = results["at_a_glance"]
+    assert [g["finding"] for g in glance] == NAMES
+    for g, row in zip(glance, results["findings"], strict=True):
+        untestable = row["why"].startswith("Not testable with these data")
+        assert g["verdict"] == ("yes" if row["reproduced"] else "n/a" if untestable else "NO")
+        assert g["headline"]
+        assert "\n" not in g["headline"]
+        assert len(g["headline"]) < 130, g["headline"]  # one line of the table
+    # k_c > k_t names its quantity and gives the weakest joint's mean difference, rebuilt
+    # here from the tests in results.json (numpy, not findings.py)
+    tests = [t for t in results["tests"] if t["jointed"]]
+    margins = {}
+    for name in sorted({t["structure"] for t in tests}):
+        d = np.array(
+            [
+                t["compression_dynamic_stiffness_n_per_m"] - t["tension_dynamic_stiffness_n_per_m"]
+                for t in tests
+                if t["structure"] == name
+            ]
+        )
+        mean, se = d.mean(), d.std(ddof=1) / math.sqrt(d.size)
+        margins[name] = (mean / se, mean, se)
+    weakest = min(margins, key=lambda n: margins[n][0])
+    _, mean, se = margins[weakest]
+    headline = glance[0]["headline"]
+    assert headline.startswith("mean k_d,c - k_d,t = ")
+    assert f"({weakest}, weakest of {len(margins)})" in headline
+    number = re.match(r"mean k_d,c - k_d,t = (\S+) ± (\S+) MN/m", headline)
+    assert number is not None
+    assert float(number[1]) == pytest.approx(mean / 1e6, rel=5e-3)
+    assert float(number[2]) == pytest.approx(se / 1e6, rel=5e-3)
+    # the evidence names the quantity too, for the contact slopes as k_s,c - k_s,t
+    assert "mean k_d,c - k_d,t = " in results["findings"][0]["evidence"]
+    assert "Contact slopes: " in results["findings"][0]["evidence"]
+    assert "mean k_s,c - k_s,t = " in results["findings"][0]["evidence"]
+
+
+def test_a_finding_not_seen_says_why_in_its_own_numbers(reproduction: Path) -> None:
+    """A NO says how far its weakest number is from a trend, in standard errors, and
+    whether the data show the opposite; the margin is rebuilt from the headline's numbers."""
+    results = json.loads((reproduction / "results.json").read_text())
+    seen_no = False
+    for g, row in zip(results["at_a_glance"], results["findings"], strict=True):
+        if g["verdict"] != "NO":
+            continue
+        seen_no = True
+        assert row["why"].startswith("Not shown by these data at 2 standard errors: ")
+        value, error = (float(v) for v in re.findall(r"= (\S+) ± (\S+)", g["headline"])[0])
+        sign = -1 if "falls" in g["finding"] else 1
+        z = sign * value / error  # from the rounded numbers shown: to a few per cent
+        if z < -2:
+            said = re.search(r"the other way by (\S+) s\.e\.", g["headline"])
+            assert "these data show the opposite" in row["why"]
+        else:
+            said = re.search(r"is (\S+) standard errors from zero", row["why"])
+            assert "within the noise" in row["why"]
+        assert said is not None, row["why"]
+        assert float(said[1]) == pytest.approx(abs(z), rel=0.05, abs=0.06), g["headline"]
+    assert seen_no  # the small campaign has NO rows (stiffness rises with w)

@@ -441,7 +441,7 @@ def test_uneven_scientific_stamps_are_still_refused(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("text", "words"),
     [
-        ("Device;Rig A\nthis line is junk\ntime;force;displacement\ns;N;m\n", "line 2"),
+        ("Device;Rig A\nthis line is free text\n", "no column names above the numbers (line 2"),
         ("time;force;displacement\n", "has no unit"),
         ("time [s];force [N];displacement [m];velocity [m/s]\n", "names 4 columns"),
         ("time [s];force [(];displacement [m]\n", "unknown unit '('"),  # pint asserted here
@@ -454,6 +454,74 @@ def test_lab_csv_problems_are_named(tmp_path: Path, text: str, words: str) -> No
         read_record(path)
     assert words in str(info.value)
     assert str(path) in str(info.value)
+
+
+# ---- issue 28: any preamble above the column names is kept as the record's notes --------
+
+
+def lab_rows(delimiter: str = ",") -> list[str]:
+    """The 12 kHz lab signals, in s, kN and mm, rounded to 1 us as a DAQ writes them."""
+    return [delimiter.join(f.format(v) for f, v in zip(("{:.6f}", "{:.6f}", "{:.7f}"),
+            lab_signals(i), strict=True)) for i in range(N_LAB)]  # fmt: skip
+
+
+def test_lab_csv_with_a_free_text_title_line_as_acquisition_programs_write(
+    tmp_path: Path,
+) -> None:
+    """The issue's file: a title line of free text above the header was refused."""
+    lines = ["Clearance joint J1 - sine dwell 50 Hz", "time [s],force [kN],displacement [mm]"]
+    path = write_csv(tmp_path, "\n".join(lines + lab_rows()) + "\n")
+    r = read_record(path)
+    check_lab_record(r)
+    assert r.notes == "Clearance joint J1 - sine dwell 50 Hz"
+
+
+def test_lab_csv_preamble_of_several_kinds_of_lines_kept_in_order(tmp_path: Path) -> None:
+    lines = [
+        "LabVIEW Measurement",  # free text
+        "Operator;J. Smith;;",  # key and value in two cells, empty cells after
+        "Rig A, bay 3; second shift",  # free text with punctuation
+        "",
+        "# comment line",
+        "Time;Force;Displacement",
+        "s;kN;mm",
+    ]
+    rows = [row.replace(",", ";").replace(".", ",") for row in lab_rows()]
+    r = read_record(write_csv(tmp_path, "\n".join(lines + rows) + "\n"))
+    check_lab_record(r)
+    assert r.notes == (
+        "LabVIEW Measurement; Operator;J. Smith; Rig A, bay 3; second shift; comment line"
+    )
+
+
+def test_lab_csv_preamble_that_looks_numeric_is_not_the_data(tmp_path: Path) -> None:
+    """Numbers above the header (a date, a gain, a calibration table of five rows in the
+    columns of the data) are preamble: the data is the block the column names head."""
+    calibration = [f"{k},{2 * k}.5,{k * k}" for k in range(1, 6)]  # 5 rows of 3 numbers
+    lines = ["20261128", "12000", *calibration, "", "time [s],force [kN],displacement [mm]"]
+    r = read_record(write_csv(tmp_path, "\n".join(lines + lab_rows()) + "\n"))
+    check_lab_record(r)  # the calibration rows are not in the signals
+    assert r.notes == "20261128; 12000; " + "; ".join(calibration)
+
+
+@pytest.mark.parametrize(
+    ("preamble", "words"),
+    [
+        ([], "no column names above the numbers; name them like 'time [s]'"),
+        (["Sine dwell, J1, 50 Hz"], "no column names above the numbers (line 1: 'Sine dwell"),
+        (["Title", "a,b,c"], "(line 2: 'a,b,c')"),
+    ],
+)
+def test_lab_csv_without_column_names_is_one_clear_line(
+    tmp_path: Path, preamble: list[str], words: str
+) -> None:
+    path = write_csv(tmp_path, "\n".join(preamble + lab_rows()) + "\n")
+    with pytest.raises(RecordError) as info:
+        read_record(path)
+    message = str(info.value)
+    assert words in message
+    assert str(path) in message
+    assert "\n" not in message
 
 
 def test_lab_csv_in_utf16_as_excel_saves_unicode_text(tmp_path: Path) -> None:

@@ -343,13 +343,25 @@ def _points_and_lines(
     *,
     divisor: float = 1.0,
     error: NDArray[np.float64] | None = None,
+    unit: str = "",
 ) -> None:
     """Draw, per test frequency, the measured ``values`` (open markers, error bars when
-    given) and its law's line against amplitude in µm, all divided by ``divisor``."""
-    for n, f in enumerate(sorted(set(frequency.tolist()))):
+    given) and its law's line against amplitude in µm, all divided by ``divisor``.
+
+    Each frequency has its own marker, line style and colour (viridis: ordered by
+    frequency, and still ordered by lightness in grey print). When the laws' lines lie
+    closer together than the eye can part (within 2 % of the axis' span), a note in the
+    panel says so, with their spread in ``unit``: the law barely depends on frequency.
+    """
+    import matplotlib
+
+    freqs = sorted(set(frequency.tolist()))
+    cmap = matplotlib.colormaps["viridis"]
+    for n, f in enumerate(freqs):
         sel = frequency == f
         marker = _MARKERS[n % len(_MARKERS)]
-        style = {"color": "0.3", "mfc": "white", "ms": 5, "label": f"{f:g} Hz"}
+        colour = cmap(0.85 * n / max(len(freqs) - 1, 1))
+        style = {"color": colour, "mfc": "white", "ms": 5, "label": f"{f:g} Hz"}
         if error is not None:
             ax.errorbar(
                 amplitude[sel] * 1e6,
@@ -364,7 +376,24 @@ def _points_and_lines(
         if f in lines:
             grid, law = lines[f]
             ax.plot(
-                grid * 1e6, law / divisor, linestyle=_LINES[n % len(_LINES)], color="black", lw=1.0
+                grid * 1e6, law / divisor, linestyle=_LINES[n % len(_LINES)], color=colour, lw=1.2
+            )
+    drawn = [lines[f] for f in freqs if f in lines]
+    if len(drawn) > 1 and all(g.shape == drawn[0][0].shape for g, _ in drawn):
+        laws = np.array([law for _, law in drawn]) / divisor
+        spread = float(np.max(laws.max(axis=0) - laws.min(axis=0)))
+        low, high = ax.get_ylim()
+        if spread < 0.02 * (high - low):
+            ax.text(
+                0.98,
+                0.03,
+                f"the {len(drawn)} frequencies' lines lie within {spread:.2g} {unit}".rstrip()
+                + "\nof each other: the law barely depends on frequency",
+                transform=ax.transAxes,
+                ha="right",
+                va="bottom",
+                fontsize="small",
+                color="0.25",
             )
 
 
@@ -401,6 +430,7 @@ def stiffness_panels_figure(
             panel.lines,
             divisor=1e6,
             error=panel.error,
+            unit="MN/m",
         )
         ax.set_title(panel.title, fontsize="medium")
         ax.set_xlabel("amplitude A (µm)")
@@ -475,8 +505,9 @@ def law_versus_measured_figure(
     """Return Fig. 13: eq 22 (and the section-2 model) against the reference energy.
 
     ``reference`` names the x axis: "measured" for real records, "virtual rig" where
-    the energies were simulated. The 1:1 line is in the legend; tick labels are
-    thinned (1, 2, 5 per decade, minor ticks unlabelled) so they never overlap.
+    the energies were simulated. The 1:1 line is in the legend; the log axes carry
+    enough labelled ticks to read a value (1, 2, 3, 5 per decade over a decade or so,
+    1, 2, 5 up to three, decades beyond), written as plain numbers (0.05, 0.2).
     """
     from matplotlib.ticker import LogLocator, NullFormatter
 
@@ -509,8 +540,12 @@ def law_versus_measured_figure(
     ax.plot(span, span, color="0.6", lw=0.8, label="1:1")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    decades = float(np.log10(span[1] / span[0])) if span[0] > 0 else 3.0
+    # enough labelled ticks: 1-2-3-5 per decade over a decade or so, 1-2-5 to three decades
+    subs = (1.0, 2.0, 3.0, 5.0) if decades < 1.5 else (1.0, 2.0, 5.0) if decades < 3 else (1.0,)
     for axis in (ax.xaxis, ax.yaxis):
-        axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0), numticks=12))
+        axis.set_major_locator(LogLocator(base=10.0, subs=subs, numticks=15))
+        axis.set_major_formatter(_plain_numbers())
         axis.set_minor_formatter(NullFormatter())
     ax.tick_params(axis="x", labelrotation=35)
     ax.set_xlabel(f"{reference} energy per cycle (J)")
@@ -519,11 +554,27 @@ def law_versus_measured_figure(
     return fig
 
 
+def _plain_numbers() -> Any:
+    """A log axis' tick formatter: plain numbers (0.05, 2, 300), and no label for a tick
+    outside the axis' view (the locator returns some beyond it; they are never drawn)."""
+    from matplotlib.ticker import Formatter
+
+    class PlainNumbers(Formatter):
+        def __call__(self, value: float, pos: int | None = None) -> str:
+            if self.axis is not None:
+                low, high = sorted(self.axis.get_view_interval())
+                if not low * (1 - 1e-9) <= value <= high * (1 + 1e-9):
+                    return ""
+            return f"{value:g}"
+
+    return PlainNumbers()
+
+
 def identification_accuracy_figure(accuracy: Sequence[dict[str, Any]]) -> Figure:
     """Return the identification's relative error per test against the rig's truth, in %.
 
     One column of points per quantity (clearance, contact stiffness per side, energy
-    per cycle), with the +-1 % band shaded.
+    per cycle), with the +-1 % band shaded and named in a legend outside the axes.
     """
     keys = (
         ("clearance_error", "clearance"),
@@ -531,7 +582,7 @@ def identification_accuracy_figure(accuracy: Sequence[dict[str, Any]]) -> Figure
         ("tension_stiffness_error", "k_t (slope)"),
         ("energy_error", "energy per cycle"),
     )
-    fig = Figure(figsize=(6.0, 3.4), layout="constrained")
+    fig = Figure(figsize=(6.8, 3.4), layout="constrained")
     ax = fig.add_subplot()
     ax.axhspan(-1.0, 1.0, color="0.92", lw=0, label="±1 %")
     for n, (key, _) in enumerate(keys):
@@ -541,7 +592,8 @@ def identification_accuracy_figure(accuracy: Sequence[dict[str, Any]]) -> Figure
     ax.axhline(0.0, color="black", lw=0.6)
     ax.set_xticks(range(len(keys)), [label for _, label in keys])
     ax.set_ylabel("identified / true - 1 (%)")
-    ax.legend(frameon=False, fontsize="small", loc="upper right")
+    # the legend outside the axes, on the right: no data point can sit on it
+    ax.legend(frameon=False, fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return fig
 
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -42,7 +42,12 @@ class Finding:
     """One of the paper's findings, checked against the fitted numbers.
 
     ``source`` is "model" or "rig input"; ``evidence`` gives the numbers (slopes with
-    their standard errors, in engineering units); ``why`` says what makes it so.
+    their standard errors, in engineering units); ``why`` says what makes it so, or why
+    the data do not show it. ``headline`` is the one number the verdict rests on, with
+    the quantity and the joint named (``mean k_d,c - k_d,t = 0.231 ± 0.0791 MN/m (joint-2,
+    weakest of 2)``): the weakest joint and side, as every one of them must hold; for a
+    NO, with how far it is from a trend (``: 0.5 s.e., 2 needed``, ``: the other way by
+    4.0 s.e.``); for an n/a, what the data lack.
     """
 
     finding: str
@@ -51,14 +56,49 @@ class Finding:
     source: str
     evidence: str
     why: str
+    headline: str = ""
 
     def __post_init__(self) -> None:
         if self.source not in ("model", "rig input"):
             raise ParameterError(f"source must be 'model' or 'rig input', got {self.source!r}")
 
     def as_dict(self) -> dict[str, Any]:
-        """The row as results.json writes it (keys exactly the field names)."""
-        return asdict(self)
+        """The row as results.json's ``findings`` writes it: the six fields of the paper's
+        table (the headline goes to its ``at_a_glance``, see :meth:`glance`)."""
+        row = asdict(self)
+        del row["headline"]
+        return row
+
+    @property
+    def verdict(self) -> str:
+        """yes, NO (the data say otherwise or not clearly) or n/a (the data cannot test it)."""
+        return "yes" if self.reproduced else ("NO" if testable(self) else "n/a")
+
+    def glance(self) -> dict[str, str]:
+        """The row at a glance: the finding, its verdict and its headline number."""
+        return {"finding": self.finding, "verdict": self.verdict, "headline": self.headline}
+
+
+class _Number(NamedTuple):
+    """A check's number on one joint and side: whether it holds, in words, how many
+    standard errors it stands the paper's way (``z`` > 0) or the other (``z`` < 0), and
+    the deciding number alone when ``text`` gives more than one (else "")."""
+
+    holds: bool
+    text: str
+    z: float
+    short: str = ""
+
+
+@dataclass(frozen=True)
+class _Part:
+    """One joint and side of a check (``label``) with its :class:`_Number`."""
+
+    label: str
+    text: str
+    holds: bool
+    z: float
+    short: str = ""
 
 
 @dataclass(frozen=True)
@@ -68,6 +108,61 @@ class _Check:
     holds: bool
     evidence: str
     testable: bool = True  # False: the data cannot say (a law not fitted, too few tests)
+    parts: tuple[_Part, ...] = ()
+
+    @property
+    def weakest(self) -> _Part | None:
+        """The joint and side that holds least (all must hold): the verdict's number."""
+        if not self.parts:
+            return None
+        return min(self.parts, key=lambda p: p.z if math.isfinite(p.z) else -math.inf)
+
+    @property
+    def headline(self) -> str:
+        part = self.weakest
+        if part is None:
+            return f"not testable: {self.evidence}" if not self.testable else ""
+        where = f"{part.label}, weakest of {len(self.parts)}" if len(self.parts) > 1 else part.label
+        text = part.short or part.text
+        return f"{text} ({where})" if where else text
+
+    def margin(self) -> str:
+        """The weakest number's distance from a trend in standard errors (s.e.), short."""
+        part = self.weakest
+        if part is None:
+            return ""
+        z = part.z
+        if math.isnan(z):
+            return "no finite standard error"
+        if z < -Z:
+            return f"the other way by {-z:.1f} s.e." if z > -math.inf else "the other way"
+        if z > Z:
+            return f"{z:.1f} s.e." if z < math.inf else ""
+        if z < -0.05:
+            return f"{-z:.1f} s.e. the other way, within the noise"
+        return f"{max(z, 0.0):.1f} s.e., {Z:g} needed"
+
+    def why_not(self) -> str:
+        """Why a testable check does not hold, in words, from its weakest number."""
+        part = self.weakest
+        if part is None:
+            return ""
+        failing = [p.label for p in self.parts if not p.holds]
+        share = ""
+        if len(self.parts) > 1 and len(failing) < len(self.parts):
+            share = (
+                f"it holds for {len(self.parts) - len(failing)} of {len(self.parts)} joints and "
+                f"sides, not for {', '.join(failing)}; "
+            )
+        if part.z < -Z:
+            by = f" is {-part.z:.1f} standard errors the other way" if part.z > -math.inf else ""
+            return f"{share}these data show the opposite: {self.headline}{by}"
+        if math.isnan(part.z):
+            return f"{share}{self.headline} has no finite standard error"
+        return (
+            f"{share}within the noise: {self.headline} is {abs(part.z):.1f} standard errors "
+            f"from zero, and {Z:g} are needed to call it a trend"
+        )
 
 
 #: How a row's ``why`` begins when the data cannot test the finding (``reproduced`` is then
@@ -85,23 +180,36 @@ def _sig(value: float, error: float, sign: int) -> bool:
     return bool(math.isfinite(value) and math.isfinite(error) and sign * value > Z * error)
 
 
+def _z(value: float, error: float, sign: int) -> float:
+    """How many standard errors ``value`` stands on the side ``sign`` (negative: the other)."""
+    if not (math.isfinite(value) and math.isfinite(error)):
+        return math.nan
+    if error <= 0.0:
+        return math.copysign(math.inf, sign * value) if value else 0.0
+    return sign * value / error
+
+
 def _jointed_names(analysis: Analysis) -> list[str]:
     return sorted({r["structure"] for r in analysis.rows if r["jointed"]})
 
 
-def _per_side(
-    analysis: Analysis, test: Callable[[str, str], tuple[bool, str] | None], empty: str
-) -> _Check:
-    """Apply ``test`` to every jointed structure and side; all must hold."""
-    results = []
+def _per_side(analysis: Analysis, test: Callable[[str, str], _Number | None], empty: str) -> _Check:
+    """Apply ``test`` to every jointed structure and side; all must hold.
+
+    ``test`` returns its :class:`_Number`, or None when it cannot say.
+    """
+    parts = []
     for name in _jointed_names(analysis):
         for side in SIDES:
             outcome = test(name, side)
             if outcome is not None:
-                results.append((outcome[0], f"{name} {side}: {outcome[1]}"))
-    if not results:
+                parts.append(
+                    _Part(f"{name} {side}", outcome.text, outcome.holds, outcome.z, outcome.short)
+                )
+    if not parts:
         return _Check(False, empty, testable=False)
-    return _Check(all(r[0] for r in results), "; ".join(r[1] for r in results))
+    evidence = "; ".join(f"{p.label}: {p.text}" for p in parts)
+    return _Check(all(p.holds for p in parts), evidence, parts=tuple(parts))
 
 
 # ---- the stiffness findings -----------------------------------------------------------------
@@ -111,9 +219,20 @@ def _mn(value: float) -> str:
     return f"{value / 1e6:.3g}"
 
 
+#: The quantity k_c > k_t is read on, by column of the analysis rows.
+_ORDERED = {"dynamic_stiffness_n_per_m": "k_d,c - k_d,t", "stiffness_n_per_m": "k_s,c - k_s,t"}
+
+
 def _ordering(analysis: Analysis, column: str) -> _Check:
-    """k_c > k_t on ``column`` (k_d,s or the contact slopes): mean difference > 2 s.e."""
-    parts, holds = [], []
+    """k_c > k_t on ``column`` (k_d,s or the contact slopes): mean difference > 2 s.e.
+
+    The evidence names the quantity: the mean over a joint's tests of the compression
+    side's stiffness less the tension side's, in MN/m, with its standard error.
+    """
+    parts: list[_Part] = []
+    holds: list[bool] = []
+    sizes: list[int] = []
+    quantity = _ORDERED[column]
     for name in _jointed_names(analysis):
         tests = tests_of(analysis.rows, name)
         diff = np.array(
@@ -122,29 +241,35 @@ def _ordering(analysis: Analysis, column: str) -> _Check:
         diff = diff[np.isfinite(diff)]
         if diff.size < 2:
             continue
+        sizes.append(diff.size)
         mean, se = float(diff.mean()), float(diff.std(ddof=1) / math.sqrt(diff.size))
         holds.append(_sig(mean, se, 1))
-        parts.append(f"{name}: {_mn(mean)} ± {_mn(se)} MN/m (n = {diff.size})")
+        text = f"mean {quantity} = {_mn(mean)} ± {_mn(se)} MN/m"
+        parts.append(_Part(name, text, holds[-1], _z(mean, se, 1)))
     if not holds:
         return _Check(False, "no jointed structure with both sides identified", testable=False)
-    return _Check(all(holds), "; ".join(parts))
+    evidence = "; ".join(
+        f"{p.label}: {p.text} (n = {n})" for p, n in zip(parts, sizes, strict=True)
+    )
+    return _Check(all(holds), evidence, parts=tuple(parts))
 
 
 def _rises_with_frequency(analysis: Analysis) -> _Check:
-    def test(name: str, side: str) -> tuple[bool, str] | None:
+    def test(name: str, side: str) -> _Number | None:
         law = analysis.stiffness_laws.get(f"{name}, {side}")
         if law is None:
             return None
         a1, e1 = law.values[0], law.errors[0]
         per = 2 * math.pi * 100.0 / 1e6  # MN/m per 100 Hz
-        return _sig(a1, e1, 1), f"a1 = {a1 * per:.3g} ± {e1 * per:.2g} MN/m per 100 Hz"
+        text = f"a1 = {a1 * per:.3g} ± {e1 * per:.2g} MN/m per 100 Hz"
+        return _Number(_sig(a1, e1, 1), text, _z(a1, e1, 1))
 
     return _per_side(analysis, test, "eq 19 not fitted on k_d,s")
 
 
 def _rises_and_saturates(
     w: np.ndarray, a: np.ndarray, y: np.ndarray, scale: float, unit: str
-) -> tuple[bool, str] | None:
+) -> _Number | None:
     """y rises with A (eq 19's a2 > 2 s.e.) and its rate falls (quadratic q2 < -2 s.e.)."""
     try:
         linear = fit.stiffness_law(w, a, y)
@@ -155,14 +280,23 @@ def _rises_and_saturates(
     q2, eq2 = quadratic.values[2], quadratic.errors[2]
     per = 10e-6 * scale  # per 10 um
     holds = _sig(a2, e2, 1) and _sig(q2, eq2, -1)
-    return holds, (
-        f"a2 = {a2 * per:.3g} ± {e2 * per:.2g} {unit} per 10 µm, "
+    rise = f"a2 = {a2 * per:.3g} ± {e2 * per:.2g} {unit} per 10 µm".replace("  ", " ")
+    bend = (
         f"curvature q2 = {q2 * 1e-10 * scale:.3g} ± {eq2 * 1e-10 * scale:.2g} {unit} per (10 µm)^2"
+    ).replace("  ", " ")
+    z_rise, z_bend = _z(a2, e2, 1), _z(q2, eq2, -1)
+    bend_decides = not z_rise < z_bend  # the smaller margin decides (nan: the bend's)
+    return _Number(
+        holds,
+        f"a2 = {a2 * per:.3g} ± {e2 * per:.2g} {unit} per 10 µm, "
+        f"curvature q2 = {q2 * 1e-10 * scale:.3g} ± {eq2 * 1e-10 * scale:.2g} {unit} per (10 µm)^2",
+        z_bend if bend_decides else z_rise,
+        bend if bend_decides else rise,
     )
 
 
 def _stiffness_saturates(analysis: Analysis) -> _Check:
-    def test(name: str, side: str) -> tuple[bool, str] | None:
+    def test(name: str, side: str) -> _Number | None:
         w, a, k = side_data(tests_of(analysis.rows, name), side)
         return _rises_and_saturates(w, a, k, 1e-6, "MN/m")
 
@@ -170,7 +304,7 @@ def _stiffness_saturates(analysis: Analysis) -> _Check:
 
 
 def _coefficient_saturates(analysis: Analysis) -> _Check:
-    def test(name: str, side: str) -> tuple[bool, str] | None:
+    def test(name: str, side: str) -> _Number | None:
         w, a, c_d = side_data(tests_of(analysis.rows, name), side, "stiffness_coefficient")
         return _rises_and_saturates(w, a, c_d, 1.0, "")
 
@@ -186,7 +320,7 @@ def _joint_points(analysis: Analysis, name: str, side: str) -> tuple[np.ndarray,
 
 
 def _joint_rises_with_amplitude(analysis: Analysis) -> _Check:
-    def test(name: str, side: str) -> tuple[bool, str] | None:
+    def test(name: str, side: str) -> _Number | None:
         points = _joint_points(analysis, name, side)
         if points is None:
             return None
@@ -195,13 +329,14 @@ def _joint_rises_with_amplitude(analysis: Analysis) -> _Check:
         except fit.FitError:
             return None
         a2, e2 = law.values[1], law.errors[1]
-        return _sig(a2, e2, 1), f"dk_dj/dA = {a2 * 1e-11:.3g} ± {e2 * 1e-11:.2g} MN/m per 10 µm"
+        text = f"dk_dj/dA = {a2 * 1e-11:.3g} ± {e2 * 1e-11:.2g} MN/m per 10 µm"
+        return _Number(_sig(a2, e2, 1), text, _z(a2, e2, 1))
 
     return _per_side(analysis, test, _no_eq20(analysis))
 
 
 def _joint_first_falls_with_frequency(analysis: Analysis) -> _Check:
-    def test(name: str, side: str) -> tuple[bool, str] | None:
+    def test(name: str, side: str) -> _Number | None:
         points = _joint_points(analysis, name, side)
         if points is None:
             return None
@@ -213,9 +348,11 @@ def _joint_first_falls_with_frequency(analysis: Analysis) -> _Check:
         w_min = float(w.min())
         value, error = fit.slope(law, [0.0, 1.0, 2.0 * w_min, 0.0])
         per = 2 * math.pi * 100.0 / 1e6
-        return _sig(value, error, -1), (
+        return _Number(
+            _sig(value, error, -1),
             f"dk_dj/dw at {w_min / (2 * math.pi):.3g} Hz = {value * per:.3g} ± "
-            f"{error * per:.2g} MN/m per 100 Hz"
+            f"{error * per:.2g} MN/m per 100 Hz",
+            _z(value, error, -1),
         )
 
     return _per_side(analysis, test, _no_eq20(analysis))
@@ -267,8 +404,10 @@ def _energy_trend(analysis: Analysis, variable: str, sign: int, total: bool = Fa
     unit = {"w": ("per 100 Hz", 2 * math.pi * 100), "A": ("per 10 µm", 1e-5)}
     unit["c"] = ("per 0.1 mm", 1e-4)
     label, scale = unit[variable]
-    text = f"eq 22 ({name}): d ln E/d{variable} = {value * scale:.3g} ± {error * scale:.2g} {label}"
-    return _Check(_sig(value, error, sign), text)
+    number = f"d ln E/d{variable} = {value * scale:.3g} ± {error * scale:.2g} {label}"
+    holds = _sig(value, error, sign)
+    part = _Part(f"eq 22, {name}", number, holds, _z(value, error, sign))
+    return _Check(holds, f"eq 22 ({name}): {number}", parts=(part,))
 
 
 # ---- the table --------------------------------------------------------------------------------
@@ -287,11 +426,20 @@ def _speed(timing: Timing | None) -> _Check:
     if timing is None:
         return _Check(False, "not measured here: it needs the model's exact cycles", testable=False)
     ratio = timing.integration_s / timing.law_s
+    # no standard error (timed once, best of 5): above 1 it holds, below it is the opposite
+    faster = ratio > 1.0
+    headline = _Part(
+        "timed in this run",
+        f"eq 22 is {ratio:.3g} times faster",
+        faster,
+        math.inf if faster else -math.inf,
+    )
     return _Check(
         ratio > 1.0,
         f"eq 22 {timing.law_s * 1e9:.3g} ns per test, exact-cycle integration "
         f"{timing.integration_s * 1e3:.3g} ms per test: {ratio:.3g} times faster; "
         f"median error of eq 22 against the integration {timing.median_error:.1%}",
+        parts=(headline,),
     )
 
 
@@ -315,17 +463,28 @@ def _row(
         evidence += f". {control_name}: {theirs.evidence}"
     if input_check is not None:
         evidence += f". Contact slopes: {input_check.evidence}"
+    headline = ours.headline
     if not ours.testable:
         why = f"{NOT_TESTABLE}: {ours.evidence}. The model: {why_model}"
-        return Finding(finding, paper, False, "model", evidence, why)
+        return Finding(finding, paper, False, "model", evidence, why, headline)
     if not ours.holds:
-        why = f"Not shown by these data at {Z:g} standard errors. The model: {why_model}"
-        return Finding(finding, paper, False, "model", evidence, why)
+        headline = f"{headline}: {ours.margin()}"
+        inherited = ""
+        if input_check is not None and input_check.testable:
+            inherited = (
+                f" The contact slopes of these records, which k_d,s inherits its order from, "
+                f"give {input_check.headline}."
+            )
+        why = (
+            f"Not shown by these data at {Z:g} standard errors: {ours.why_not()}.{inherited} "
+            f"The model: {why_model}"
+        )
+        return Finding(finding, paper, False, "model", evidence, why, headline)
     if input_check is not None and input_check.holds:
-        return Finding(finding, paper, True, "rig input", evidence, given)
+        return Finding(finding, paper, True, "rig input", evidence, given, headline)
     if not survives:
-        return Finding(finding, paper, True, "rig input", evidence, given)
-    return Finding(finding, paper, True, "model", evidence, why_model)
+        return Finding(finding, paper, True, "rig input", evidence, given, headline)
+    return Finding(finding, paper, True, "model", evidence, why_model, headline)
 
 
 def findings_table(
@@ -502,6 +661,7 @@ def findings_table(
             rows[7].source,
             rows[7].evidence + ". " + _energy_trend(analysis, "c", -1).evidence,
             rows[7].why,
+            rows[7].headline,
         )
     return rows
 

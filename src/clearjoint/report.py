@@ -21,6 +21,7 @@ import io
 import json
 import math
 import os
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -203,17 +204,37 @@ _CLASS = {"yes": "yes", "NO": "no", "n/a": "na"}
 
 def _mark(f: Finding) -> str:
     """yes, NO (the data say otherwise or not clearly) or n/a (the data cannot test it)."""
-    return "yes" if f.reproduced else ("NO" if testable(f) else "n/a")
+    return f.verdict
+
+
+def _evidence_html(evidence: str) -> str:
+    """The evidence as a list: one item per run (this one, the control, the contact
+    slopes), each joint and side of it on its own line."""
+    runs = [run for run in re.split(r"\. (?=[A-Za-z])", evidence) if run]
+    return (
+        "<ul>"
+        + "".join(
+            "<li>" + "<br>".join(html.escape(part) for part in run.split("; ")) + "</li>"
+            for run in runs
+        )
+        + "</ul>"
+    )
 
 
 def findings_html(findings: Sequence[Finding]) -> str:
-    """The findings table: one row per paper finding, reproduced and source first."""
-    head = "<tr><th>paper finding</th><th>reproduced</th><th>source</th><th>evidence</th></tr>"
+    """The findings table at a glance: one line per paper finding (its verdict, the number
+    it rests on with the quantity and joint named, its source); the paper's words, every
+    number and the why one click away in a ``<details>``."""
+    head = (
+        "<tr><th>paper finding</th><th>verdict</th><th>the number it rests on</th>"
+        "<th>source</th><th>details</th></tr>"
+    )
     body = "".join(
-        f'<tr class="{_CLASS[_mark(f)]}"><td><b>{html.escape(f.finding)}</b><br>'
-        f"<small>{html.escape(f.paper)}</small></td>"
-        f"<td>{_mark(f)}</td><td>{html.escape(f.source)}</td>"
-        f"<td><small>{html.escape(f.evidence)}</small><br><i>{html.escape(f.why)}</i></td></tr>"
+        f'<tr class="{_CLASS[_mark(f)]}"><td class="finding"><b>{html.escape(f.finding)}</b></td>'
+        f'<td>{_mark(f)}</td><td class="headline">{html.escape(f.headline)}</td>'
+        f'<td>{html.escape(f.source)}</td><td class="more"><details><summary>why, numbers'
+        f"</summary><p>Paper: {html.escape(f.paper)}.</p>"
+        f"<p><i>{html.escape(f.why)}</i></p>{_evidence_html(f.evidence)}</details></td></tr>"
         for f in findings
     )
     return f'<table id="findings">{head}{body}</table>'
@@ -364,6 +385,10 @@ h1{{font-size:1.4em;margin:0.3em 0}}
 table{{border-collapse:collapse;font-size:0.85em;margin:0.5em 0;display:block;overflow-x:auto}}
 td,th{{border:1px solid #999;padding:0.15em 0.4em;vertical-align:top}}img{{max-width:100%}}
 #findings{{font-size:0.8em}}#findings tr.no td:nth-child(2){{font-weight:bold}}
+#findings td.finding,#findings td:nth-child(2){{white-space:nowrap}}
+#findings td.more{{max-width:36em}}
+#findings td.more summary{{font-weight:normal;white-space:nowrap}}
+#findings ul{{margin:0.2em 0;padding-left:1.2em}}#findings p{{margin:0.2em 0}}
 details{{margin:0.4em 0}}summary{{cursor:pointer;font-weight:bold}}</style>
 </head><body>
 <h1>{html.escape(study.title)}</h1>
@@ -372,7 +397,9 @@ doi:10.1155/2013/583030; equations as rebuilt in MODEL.md.</p>
 {_warnings_html(study.warnings)}<h2>Findings of the paper, against these data</h2>
 {findings_html(study.findings)}
 <p><small>Reproduced: the fitted slope has the paper's sign by more than two standard errors
-for every joint and side. Source "model": it also holds in the control ({
+(s.e.) for every joint and side; the number shown is the weakest of them, and for NO how far
+it is from a trend. "details" gives the paper's words, why, and every number. Source "model":
+it also holds in the control ({
         html.escape(study.control)
     }); "rig input": it was given to the test article. Every number is in
 results.json (key <code>findings</code>).</small></p>
@@ -444,6 +471,7 @@ def write_report(out_dir: Path, study: Study, *, force: bool = False) -> list[Pa
         "what_was_run": study.what_was_run,
         "warnings": study.warnings,
         "findings": [f.as_dict() for f in study.findings],
+        "at_a_glance": [f.glance() for f in study.findings],
         "control": study.control,
         "tests": rows,
         "fits": fits_rows,

@@ -85,7 +85,6 @@ def _metadata_from_toml(where: str, table: dict[str, Any]) -> dict[str, Any]:
 _DELIMITERS = ("\t", ";", ",")
 _UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 _COMMENT = re.compile(r"^\s*(#|//|;|%|!)")
-_KEY_VALUE = re.compile(r"^\s*(?P<key>[^:=,;\t]+?)\s*[:=,;\t]\s*(?P<value>.*)$")
 _NAME_UNIT = re.compile(
     r"^\s*(?P<name>[A-Za-z][A-Za-z _]*?)\s*(?:[\[(](?P<unit>[^\])]*)[\])])?\s*$"
 )
@@ -127,8 +126,14 @@ def _numbers(fields: list[str], decimal_comma: bool) -> bool:
 
 
 def _data_start(lines: list[str], delimiter: str) -> tuple[int, int] | None:
-    """Index of the first line of the numeric block under ``delimiter`` and its width."""
+    """Index of the first line of the numeric block under ``delimiter`` and its width.
+
+    The block a header names wins: numbers in the preamble (a calibration table, a
+    line of settings) come first in the file but have no channel names above them.
+    Without a named block, the first block of numbers (the caller says what is missing).
+    """
     comma = delimiter != ","
+    first: tuple[int, int] | None = None
     for i, line in enumerate(lines[:_PREAMBLE_LINES]):
         if delimiter not in line:
             continue
@@ -138,8 +143,51 @@ def _data_start(lines: list[str], delimiter: str) -> tuple[int, int] | None:
         following = [x for x in lines[i : i + 3 * _DATA_ROWS] if x.strip()][:_DATA_ROWS]
         rows = [_fields(x, delimiter) for x in following]
         if all(len(r) == len(fields) and _numbers(r, comma) for r in rows):
-            return i, len(fields)
+            if _header_above(lines, i, delimiter) is not None:
+                return i, len(fields)
+            first = first or (i, len(fields))
+    return first
+
+
+def _names_a_channel(line: str, delimiter: str) -> bool:
+    """True when a cell of ``line`` names a record channel (``time [s]``, ``Force``)."""
+    for cell in _fields(line, delimiter):
+        match = _NAME_UNIT.match(cell)
+        if match and match["name"].strip().lower().replace(" ", "_") in SI:
+            return True
+    return False
+
+
+def _blank(line: str, delimiter: str) -> bool:
+    """A blank line, or a row of delimiters alone (``;;``, a blank spreadsheet row)."""
+    return not line.strip().strip(delimiter).strip()
+
+
+def _header_above(lines: list[str], start: int, delimiter: str) -> tuple[int, int | None] | None:
+    """The lines of the column names and of the units row (or None) above the numbers.
+
+    The names are the last line above the numbers, or the one above it when that last
+    line is a row of units; None when neither names a channel (no header).
+    """
+    above = [i for i in range(start) if not _blank(lines[i], delimiter)][-2:]
+    if not above:
+        return None
+    last = above[-1]
+    if _names_a_channel(lines[last], delimiter):
+        return last, None
+    units = len(above) == 2 and _units_row(_fields(lines[last], delimiter))
+    if units and _names_a_channel(lines[above[0]], delimiter):
+        return above[0], last
     return None
+
+
+def _preamble_note(line: str, delimiter: str) -> str:
+    """One preamble line as a note: as written, less a comment's mark and the empty
+    cells a spreadsheet leaves at its end (``Device;Rig A;;`` is ``Device;Rig A``)."""
+    comment = _COMMENT.match(line)
+    if comment:
+        return line[comment.end() :].strip()
+    return line.strip().rstrip(delimiter).strip()
 
 
 def _units_row(fields: list[str]) -> bool:
@@ -192,9 +240,11 @@ def _read_csv(path: Path, resample_: bool) -> Record:
     """Read a CSV record: clearjoint's own layout or a lab file (docs/records.md).
 
     Tolerated: the delimiter (comma, semicolon, tab; sniffed), a decimal comma (with a
-    semicolon or tab delimiter), a preamble of comment or key-value lines above the
-    column names, units in the names (``time [s]``, ``Force (kN)``) or in a row under
-    them, and time stamps rounded to the clock's resolution.
+    semicolon or tab delimiter), any preamble above the column names (free text, key and
+    value, comments, numbers: kept as the record's notes, one "; " between lines), units
+    in the names (``time [s]``, ``Force (kN)``) or in a row under them, and time stamps
+    rounded to the clock's resolution. The column names are the line above the numbers
+    (or above their row of units) that names a channel; without one, one error line.
     """
     where = str(path)
     lines = _decode(where, path.read_bytes()).splitlines()
@@ -217,50 +267,43 @@ def _read_csv(path: Path, resample_: bool) -> Record:
             table = read_toml(sidecar, what="record metadata", error=RecordError)
             meta = _metadata_from_toml(str(sidecar), table.get("record", table))
     found = {d: _data_start(lines[body:], d) for d in _DELIMITERS}
-    candidates = [(hit[1], d) for d, hit in found.items() if hit is not None]
+    candidates = [  # a block under column names first, then the widest
+        (_header_above(lines[body:], hit[0], d) is not None, hit[1], d)
+        for d, hit in found.items()
+        if hit is not None
+    ]
     if not candidates:
         _no_numbers(where, lines[body:], body)
         raise RecordError(
             f"{where}: no block of numbers found; a CSV record has columns time, force and "
             "displacement separated by commas, semicolons or tabs"
         )
-    _, delimiter = max(candidates)
+    *_, delimiter = max(candidates)
     start, width = found[delimiter]  # type: ignore[misc]
     start += body
-    # a row of delimiters alone (";;", a blank spreadsheet row) is a blank line
-    above = [i for i in range(body, start) if lines[i].strip().strip(delimiter).strip()]
-    if not above:
+    header = _header_above(lines, start, delimiter)
+    if header is None or header[0] < body:
+        above = [i for i in range(body, start) if not _blank(lines[i], delimiter)]
+        shown = f" (line {above[-1] + 1}: {lines[above[-1]].strip()[:40]!r})" if above else ""
         raise RecordError(
-            f"{where}: no column names above the numbers; name them like "
-            "'time [s]', 'force [N]', 'displacement [mm]'"
+            f"{where}: no column names above the numbers{shown}; name them like "
+            "'time [s]', 'force [N]', 'displacement [mm]' on the line above the numbers"
         )
-    header_at = units_at = above.pop()
-    unit_fields: list[str] | None = None
-    if _units_row(_fields(lines[header_at], delimiter)) and above:
-        unit_fields = _fields(lines[header_at], delimiter)
-        header_at = above.pop()
+    header_at, units_at = header
+    unit_fields = None if units_at is None else _fields(lines[units_at], delimiter)
     names = _fields(lines[header_at], delimiter)
-    for line_at, what, row in (
-        (header_at, "names", names),
-        (units_at, "has units for", unit_fields),
-    ):
-        if row is not None and len(row) != width:
+    checks = [(header_at, "names", names)]
+    if units_at is not None and unit_fields is not None:
+        checks.append((units_at, "has units for", unit_fields))
+    for line_at, what, row in checks:
+        if len(row) != width:
             raise RecordError(
                 f"{where}: line {line_at + 1} {what} {len(row)} columns but the numbers under "
                 f"it have {width}; check the delimiter {delimiter!r} and the column names"
             )
-    notes = []
-    for i in above:
-        line = lines[i]
-        if _COMMENT.match(line):
-            continue
-        pair = _KEY_VALUE.match(line)
-        if not pair or not pair["value"].strip():
-            raise RecordError(
-                f"{where}: line {i + 1} ({line.strip()[:40]!r}) above the column names is "
-                "neither a comment (#, //) nor a key and value; remove it or comment it out"
-            )
-        notes.append(f"{pair['key'].strip()}: {pair['value'].strip().strip(chr(34))}")
+    # every line above the names (free text, key and value, comment) is kept as a note
+    notes = [_preamble_note(lines[i], delimiter) for i in range(body, header_at)]
+    notes = [note for note in notes if note]
     if notes:
         preamble = "; ".join(notes)
         meta["notes"] = f"{meta['notes']}; {preamble}" if meta.get("notes") else preamble
