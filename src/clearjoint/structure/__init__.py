@@ -5,11 +5,14 @@
 ``truss`` build one; ``time_response`` and ``free_decay`` give its exact event-driven
 motion with an energy ledger, and ``system_modes`` the linear modes of a contact pattern.
 Each of them takes a Structure or the :class:`~clearjoint.system.VibrationSystem` it
-produces (``Structure.to_system()``), or one built from matrices.
+produces (``Structure.to_system()``), or one built from matrices: ``from_matrices``
+takes a finite-element model's M, C, K with joints between its DOFs, and ``reduce`` is
+its Craig-Bampton reduction onto the joints (subpackage ``fe``).
 """
 
 from clearjoint.structure.backbone import Backbone, decay_backbone
 from clearjoint.structure.builders import chain, mast, truss
+from clearjoint.structure.fe import from_matrices, reduce
 from clearjoint.structure.model import Member, Modes, Structure, StructureError, system_modes
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
 
@@ -23,7 +26,9 @@ __all__ = [
     "chain",
     "decay_backbone",
     "free_decay",
+    "from_matrices",
     "mast",
+    "reduce",
     "system_modes",
     "time_response",
     "truss",

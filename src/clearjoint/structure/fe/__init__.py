@@ -1,0 +1,19 @@
+"""Your own finite-element model: matrices in, clearance joints between DOFs, reduction.
+
+``from_matrices`` (matrices.py) checks M, C, K and the joints and returns the
+:class:`~clearjoint.system.VibrationSystem` every solver takes; ``reduce``
+(reduction.py) is the Craig-Bampton reduction onto the joints, with ``expand`` back to
+every DOF and ``check`` of its modes against the full model's.
+"""
+
+from clearjoint.structure.fe.matrices import FEModelError, MatrixModel, from_matrices
+from clearjoint.structure.fe.reduction import ReducedSystem, ReductionCheck, reduce
+
+__all__ = [
+    "FEModelError",
+    "MatrixModel",
+    "ReducedSystem",
+    "ReductionCheck",
+    "from_matrices",
+    "reduce",
+]
