@@ -111,7 +111,9 @@ def _joint_row(index: int, spec: Any, names: Sequence[str]) -> tuple[FloatArray,
         )
     law = spec[-1]
     if not isinstance(law, ClearanceJoint):
-        raise ParameterTypeError(f"{what}: its law must be a clearjoint.ClearanceJoint, got {law!r}")
+        raise ParameterTypeError(
+            f"{what}: its law must be a clearjoint.ClearanceJoint, got {law!r}"
+        )
     row = np.zeros(len(names))
     if len(spec) == 3:
         a, b = spec[0], spec[1]
@@ -181,7 +183,9 @@ def _semidefinite(name: str, m: Matrix, *, definite: bool) -> None:
     low = float(eig[0])
     if low < -DEFINITE_TOLERANCE * top or (definite and low <= DEFINITE_TOLERANCE * top):
         kind = "positive definite" if definite else "positive semi-definite"
-        raise FEModelError(f"{name} is not {kind} (smallest eigenvalue {low:.3g}, largest {top:.3g})")
+        raise FEModelError(
+            f"{name} is not {kind} (smallest eigenvalue {low:.3g}, largest {top:.3g})"
+        )
 
 
 def from_matrices(

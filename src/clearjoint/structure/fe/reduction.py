@@ -247,7 +247,7 @@ class ReducedSystem(VibrationSystem):
         if count is None:
             top = float(np.max(self.interface_omega, initial=0.0))
             w_red = np.sqrt(np.clip(np.diag(self.closed_stiffness()), 0.0, None))
-            count = int(min(10, max(1, np.count_nonzero(w_red <= top))))
+            count = min(10, max(1, int(np.count_nonzero(w_red <= top))))
         if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= self.n_dof:
             raise ParameterTypeError(
                 f"count must be an integer from 1 to {self.n_dof} (the reduced DOFs), got {count!r}"
