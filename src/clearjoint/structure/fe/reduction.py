@@ -133,12 +133,12 @@ class ReductionCheck:
 
     @property
     def closed_error(self) -> FloatArray:
-        """|f_reduced - f_full| / f_full per closed mode."""
+        """abs(f_reduced - f_full) / f_full per closed mode."""
         return self._error(self.full_closed_hz, self.reduced_closed_hz)
 
     @property
     def open_error(self) -> FloatArray:
-        """|f_reduced - f_full| / f_full per open mode (0 Hz modes: to the highest)."""
+        """abs(f_reduced - f_full) / f_full per open mode (0 Hz modes: to the highest)."""
         return self._error(self.full_open_hz, self.reduced_open_hz)
 
     @property
