@@ -3,10 +3,14 @@
 ``from_matrices`` (matrices.py) checks M, C, K and the joints and returns the
 :class:`~clearjoint.system.VibrationSystem` every solver takes; ``reduce``
 (reduction.py) is the Craig-Bampton reduction onto the joints, with ``expand`` back to
-every DOF and ``check`` of its modes against the full model's.
+every DOF and ``check`` of its modes against the full model's; ``read_matrix``
+(readers.py) reads Matrix Market, MATLAB, Abaqus and OP4 files, and ``read_model``
+(model_file.py) a model TOML that names them.
 """
 
 from clearjoint.structure.fe.matrices import FEModelError, MatrixModel, from_matrices
+from clearjoint.structure.fe.model_file import read_model
+from clearjoint.structure.fe.readers import read_matrix
 from clearjoint.structure.fe.reduction import ReducedSystem, ReductionCheck, reduce
 
 __all__ = [
@@ -15,5 +19,7 @@ __all__ = [
     "ReducedSystem",
     "ReductionCheck",
     "from_matrices",
+    "read_matrix",
+    "read_model",
     "reduce",
 ]
