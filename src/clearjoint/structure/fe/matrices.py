@@ -175,17 +175,29 @@ def _semidefinite(name: str, m: Matrix, *, definite: bool) -> None:
             "positive semi-definite; check the sign convention of the file"
         )
     n = diagonal.size
+    off = m - scipy.sparse.diags(diagonal) if scipy.sparse.issparse(m) else m - np.diag(diagonal)
+    lumped = not (off.count_nonzero() if scipy.sparse.issparse(off) else np.count_nonzero(off))
+    kind = "positive definite" if definite else "positive semi-definite"
+    if lumped:  # a diagonal matrix: its eigenvalues are its diagonal
+        if definite and np.any(diagonal <= 0.0):
+            j = int(np.argmin(diagonal))
+            raise FEModelError(f"{name} is not {kind}: DOF {j} has {diagonal[j]!r} on the diagonal")
+        return
     if n > DENSE_CHECK_UP_TO:
         return
     dense = m.toarray() if scipy.sparse.issparse(m) else m
-    eig = scipy.linalg.eigvalsh(0.5 * (dense + dense.T))
-    top = max(float(np.max(np.abs(eig))), 1e-300)
-    low = float(eig[0])
-    if low < -DEFINITE_TOLERANCE * top or (definite and low <= DEFINITE_TOLERANCE * top):
-        kind = "positive definite" if definite else "positive semi-definite"
+    dense = 0.5 * (dense + dense.T)
+    # Cholesky of A shifted by the tolerance (down for definite, up for semi-definite)
+    # succeeds exactly when no eigenvalue is below it; the eigenvalue only for the message
+    top = max(float(np.max(np.sum(np.abs(dense), axis=1))), 1e-300)  # >= the largest
+    shift = (-1.0 if definite else 1.0) * DEFINITE_TOLERANCE * top
+    try:
+        scipy.linalg.cholesky(dense + shift * np.eye(n), lower=True, check_finite=False)
+    except np.linalg.LinAlgError:
+        low = float(scipy.linalg.eigvalsh(dense, subset_by_index=(0, 0))[0])
         raise FEModelError(
-            f"{name} is not {kind} (smallest eigenvalue {low:.3g}, largest {top:.3g})"
-        )
+            f"{name} is not {kind} (smallest eigenvalue {low:.3g}, largest at most {top:.3g})"
+        ) from None
 
 
 def from_matrices(
@@ -271,19 +283,20 @@ def from_matrices(
     )
     for name in ("mass", "stiffness", "damping"):
         _symmetric(name, getattr(system, name))
-    _semidefinite("the mass matrix", system.mass, definite=False)
-    if system.n_dof <= DENSE_CHECK_UP_TO and not np.any(system.mass.diagonal() == 0.0):
-        _semidefinite("the mass matrix", system.mass, definite=True)
+    # a DOF without mass (a rotation of a lumped-mass model) is allowed: reduce() takes it
+    massless = bool(np.any(np.asarray(system.mass.diagonal()) == 0.0))
+    _semidefinite("the mass matrix", system.mass, definite=not massless)
     closed = system.closed_stiffness()
     _semidefinite("the stiffness with the joints closed", closed, definite=False)
     c = system.damping
+    if damping is not None:
+        _semidefinite("the damping matrix", c, definite=False)
     if rayleigh is not None:
         if not isinstance(rayleigh, tuple | list) or len(rayleigh) != 2:
             raise FEModelError(f"rayleigh must be (alpha, beta) in (1/s, s), got {rayleigh!r}")
         alpha = _checks.non_negative("rayleigh alpha", rayleigh[0], unit="1/s")
         beta = _checks.non_negative("rayleigh beta", rayleigh[1], unit="s")
-        c = c + alpha * system.mass + beta * closed
-    _semidefinite("the damping matrix", c, definite=False)
+        c = c + alpha * system.mass + beta * closed  # a sum of semi-definite matrices
     joint_dofs = tuple(tuple(int(i) for i in np.flatnonzero(row)) for row in system.directions)
     xyz = None
     if coordinates is not None:

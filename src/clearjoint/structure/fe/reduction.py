@@ -45,7 +45,7 @@ from clearjoint.system import Matrix, VibrationSystem, as_system, force_amplitud
 FloatArray = NDArray[np.float64]
 
 #: Up to this many interior DOFs the fixed-interface modes are found by a dense eigh.
-DENSE_INTERIOR_UP_TO = 400
+DENSE_INTERIOR_UP_TO = 200
 
 
 def _csc(m: Matrix) -> scipy.sparse.csc_matrix:
