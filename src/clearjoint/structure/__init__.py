@@ -12,9 +12,10 @@ its Craig-Bampton reduction onto the joints (subpackage ``fe``).
 
 from clearjoint.structure.backbone import Backbone, decay_backbone
 from clearjoint.structure.builders import chain, mast, truss
-from clearjoint.structure.fe import from_matrices, from_opensees, read_model, reduce
+from clearjoint.structure.fe import from_matrices, from_opensees, reduce
 from clearjoint.structure.model import Member, Modes, Structure, StructureError, system_modes
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
+from clearjoint.structure.study import read_model
 
 __all__ = [
     "Backbone",

@@ -536,3 +536,23 @@ def _model_study(
         source=where,
         decay_mode=mode,
     )
+
+
+def read_model(path: str | Path) -> VibrationSystem:
+    """Return the system of a model TOML (a structure study with a ``[model]`` section).
+
+    The matrices read, the joints added, reduced if the file asks for it
+    (:mod:`clearjoint.structure.fe.model_file`); the study's other sections are checked too.
+
+    Raises
+    ------
+    StructureStudyError
+        The file, a matrix file, a joint or a value is bad (one line naming it).
+    """
+    study = load_structure_study(path)
+    if not isinstance(study.structure, VibrationSystem):
+        raise StructureStudyError(
+            f"{path}: read_model reads a [model] section (matrix files and joints); this file "
+            "builds a [structure]: use load_structure_study"
+        )
+    return study.structure

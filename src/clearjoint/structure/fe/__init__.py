@@ -4,13 +4,12 @@
 :class:`~clearjoint.system.VibrationSystem` every solver takes; ``reduce``
 (reduction.py) is the Craig-Bampton reduction onto the joints, with ``expand`` back to
 every DOF and ``check`` of its modes against the full model's; ``read_matrix``
-(readers.py) reads Matrix Market, MATLAB, Abaqus and OP4 files, and ``read_model``
-(model_file.py) a model TOML that names them; ``from_opensees`` (opensees.py) pulls
-the matrices of the model defined in OpenSees.
+(readers.py) reads Matrix Market, MATLAB, Abaqus and OP4 files, and a model TOML
+names them (model_file.py; ``clearjoint.structure.read_model`` reads one);
+``from_opensees`` (opensees.py) pulls the matrices of the model defined in OpenSees.
 """
 
 from clearjoint.structure.fe.matrices import FEModelError, MatrixModel, from_matrices
-from clearjoint.structure.fe.model_file import read_model
 from clearjoint.structure.fe.opensees import from_opensees
 from clearjoint.structure.fe.readers import read_matrix
 from clearjoint.structure.fe.reduction import ReducedSystem, ReductionCheck, reduce
@@ -23,6 +22,5 @@ __all__ = [
     "from_matrices",
     "from_opensees",
     "read_matrix",
-    "read_model",
     "reduce",
 ]

@@ -1,5 +1,9 @@
 """A model TOML: the structure study's ``[model]`` section names matrix files and joints.
 
+:func:`clearjoint.structure.read_model` (in :mod:`clearjoint.structure.study`, the
+study reader) returns the system of such a file; :func:`model_system` builds it from
+the section's values.
+
 Example (the matrices of a mast written by its finite-element program)::
 
     [model]
@@ -132,26 +136,4 @@ def model_system(
     return system
 
 
-def read_model(path: str | Path) -> VibrationSystem:
-    """Return the system of a model TOML (a structure study with a ``[model]`` section).
-
-    The matrices read, the joints added, reduced if the file asks for it
-    (module docstring); the study's other sections are checked too.
-
-    Raises
-    ------
-    StructureStudyError
-        The file, a matrix file, a joint or a value is bad (one line naming it).
-    """
-    from clearjoint.structure.study import StructureStudyError, load_structure_study
-
-    study = load_structure_study(path)
-    if not isinstance(study.structure, VibrationSystem):
-        raise StructureStudyError(
-            f"{path}: read_model reads a [model] section (matrix files and joints); this file "
-            "builds a [structure]: use load_structure_study"
-        )
-    return study.structure
-
-
-__all__ = ["MODEL_KEYS", "model_system", "read_model"]
+__all__ = ["MODEL_KEYS", "model_system"]
