@@ -8,7 +8,9 @@ motion with an energy ledger, and ``system_modes`` the linear modes of a contact
 (MODEL.md 5.1 on 5.2): periodic orbits by shooting with their Floquet multipliers, whole
 curves by continuation, and what the motion does where no orbit is stable.
 Each of them takes a Structure or the :class:`~clearjoint.system.VibrationSystem` it
-produces (``Structure.to_system()``), or one built from matrices.
+produces (``Structure.to_system()``), or one built from matrices: ``from_matrices``
+takes a finite-element model's M, C, K with joints between its DOFs, and ``reduce`` is
+its Craig-Bampton reduction onto the joints (subpackage ``fe``).
 """
 
 import importlib
@@ -16,10 +18,12 @@ from typing import Any
 
 from clearjoint.structure.backbone import Backbone, decay_backbone
 from clearjoint.structure.builders import chain, mast, truss
+from clearjoint.structure.fe import from_matrices, from_opensees, reduce
 from clearjoint.structure.model import Member, Modes, Structure, StructureError, system_modes
 from clearjoint.structure.motion import StructureMotion, free_decay, time_response
 from clearjoint.structure.poincare import OrbitError, StructureOrbit
 from clearjoint.structure.stepped import SteppedSine, SteppedSineError, stepped_sine
+from clearjoint.structure.study import read_model
 
 # periodic_orbit (seeded by harmonic balance) and frequency_response (its events found as
 # harmonic balance finds them) import clearjoint.harmonic, whose check of its own orbits
@@ -56,8 +60,12 @@ __all__ = [
     "decay_backbone",
     "free_decay",
     "frequency_response",
+    "from_matrices",
+    "from_opensees",
     "mast",
     "periodic_orbit",
+    "read_model",
+    "reduce",
     "stepped_sine",
     "system_modes",
     "time_response",

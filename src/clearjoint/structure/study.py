@@ -40,6 +40,11 @@ indices), ``supports``, ``member_stiffness``, ``masses`` (one per node, or one f
 and ``joints`` as a list of true/false (the [joint] on that link or none). A [joint]
 that no member carries is refused, as is friction in it (the structure solver does not
 carry Coulomb friction).
+
+A ``[model]`` section instead of ``[structure]`` reads a finite-element model's matrix
+files and joints (:mod:`clearjoint.structure.fe.model_file`); its DOF names are the
+model's, and a reduced model's forces, decays and watched DOFs are named on the full
+model's DOFs too.
 """
 
 from __future__ import annotations
@@ -55,7 +60,9 @@ from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import UNIT_SUFFIXES, quantity, read_toml
 from clearjoint.joint import ClearanceJoint
 from clearjoint.structure.builders import chain, mast, truss
-from clearjoint.structure.model import Member, Structure, StructureError
+from clearjoint.structure.fe.model_file import MODEL_KEYS, model_system
+from clearjoint.structure.model import Member, Structure, StructureError, system_modes
+from clearjoint.system import VibrationSystem
 
 KEYS: dict[str, dict[str, str]] = {
     "structure": {
@@ -106,6 +113,7 @@ KEYS: dict[str, dict[str, str]] = {
         "duration": "time",
     },
     "output": {"samples_per_period": "count"},
+    "model": MODEL_KEYS,
 }
 
 
@@ -144,7 +152,7 @@ class StructureStudyError(ClearjointError, ValueError):
 class StructureStudy:
     """A parsed structure study (SI; omega in rad/s)."""
 
-    structure: Structure
+    structure: Structure | VibrationSystem  # a [model]: its system, reduced if asked
     omega: float | None
     force: np.ndarray | None
     periods: int
@@ -194,6 +202,14 @@ def _value(name: str, kind: str, raw: Any, *, unit_in_key: bool) -> Any:
                 raise StructureStudyError(f"{name} must be pairs of node indices [start, end]")
             return [tuple(p) for p in raw]
         return [[_number(name, "length", v, unit_in_key) for v in p] for p in raw]
+    if kind == "joint list":  # checked with the model's DOF names (fe.model_file)
+        if not isinstance(raw, list):
+            raise StructureStudyError(f"{name} must be a list of joints, got {raw!r}")
+        return raw
+    if kind == "text list":
+        if not isinstance(raw, list) or not all(isinstance(v, str) for v in raw):
+            raise StructureStudyError(f"{name} must be a list of names, got {raw!r}")
+        return raw
     if kind == "index list":
         if not isinstance(raw, list) or not all(
             isinstance(i, int) and not isinstance(i, bool) for i in raw
@@ -237,6 +253,13 @@ def load_structure_study(path: str | Path) -> StructureStudy:
 
 def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
     joint = _joint(values.get("joint"), where)
+    if "model" in values:
+        if "structure" in values:
+            raise StructureStudyError(
+                f"{where}: give [structure] (a model built here) or [model] (matrix files), "
+                "not both"
+            )
+        return _model_study(values, joint, where)
     try:
         structure = _structure(values.get("structure", {}), joint, where)
     except (StructureError, ParameterError) as exc:  # the item and its fix, in the file's words
@@ -427,3 +450,109 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
         source=where,
         decay_mode=mode,
     )
+
+
+def _model_study(
+    values: dict[str, dict[str, Any]], joint: ClearanceJoint | None, where: str
+) -> StructureStudy:
+    """A study of a [model]: its system (reduced if asked), force and decay on its DOFs.
+
+    The DOFs named in [excitation] and [decay] are the full model's; on a reduced model
+    they are kept on the boundary, the force is projected (``project_force``) and the
+    decay starts along the reduced model's closed mode (its modal coordinate q_mode,
+    scaled so the named DOF moves by initial_amplitude).
+    """
+    from clearjoint.structure.fe.reduction import ReducedSystem
+
+    ex, de = values.get("excitation", {}), values.get("decay", {})
+    watched = tuple(d for d in (ex.get("force_dof"), de.get("dof")) if isinstance(d, str))
+    try:
+        system = model_system(values["model"], joint, Path(where).parent, keep=watched)
+    except (ClearjointError, ValueError) as exc:
+        raise StructureStudyError(f"{where}: {exc}") from None
+    full = system.full if isinstance(system, ReducedSystem) else system
+    assert full is not None
+    names = full.dof_names
+
+    def dof_index(section: str, name: str) -> int:
+        if name not in names:
+            raise StructureStudyError(
+                f"{where}: [{section}] names DOF {name!r}, which does not exist; "
+                f"DOFs are {', '.join(names[:3])} ... {names[-1]}"
+            )
+        return names.index(name)
+
+    omega = force = None
+    if ex:
+        for key in ("frequency", "force_dof", "force_amplitude"):
+            if key not in ex:
+                raise StructureStudyError(f"{where}: [excitation] {key} is required")
+        if not (math.isfinite(ex["frequency"]) and ex["frequency"] > 0.0):
+            raise StructureStudyError(
+                f"{where}: [excitation] frequency must be finite and > 0, got "
+                f'{ex["frequency"]:g} Hz; e.g. frequency = "15Hz"'
+            )
+        omega = 2.0 * math.pi * ex["frequency"]
+        force = np.zeros(full.n_dof)
+        force[dof_index("excitation", ex["force_dof"])] = ex["force_amplitude"]
+        if isinstance(system, ReducedSystem):
+            force = system.project_force(force)
+    decay_dof = initial = duration = mode = None
+    if de:
+        for key in ("dof", "initial_amplitude", "duration"):
+            if key not in de:
+                raise StructureStudyError(f"{where}: [decay] {key} is required")
+        dof = dof_index("decay", de["dof"])
+        closed = system_modes(system, "closed")
+        mode = de.get("mode", 1)
+        if not 1 <= mode <= closed.shapes.shape[1]:
+            raise StructureStudyError(
+                f"{where}: [decay] mode must be 1 to {closed.shapes.shape[1]}, got {mode}"
+            )
+        shape = closed.shapes[:, mode - 1]
+        moved = system.expand(shape)[dof] if isinstance(system, ReducedSystem) else shape[dof]
+        if moved == 0.0 or not math.isfinite(de["initial_amplitude"]):
+            raise StructureStudyError(
+                f"{where}: [decay] mode {mode} does not move {de['dof']}, or initial_amplitude "
+                "is not finite; choose another dof or mode"
+            )
+        initial = de["initial_amplitude"] * shape / moved
+        decay_dof = int(np.argmax(np.abs(shape))) if isinstance(system, ReducedSystem) else dof
+        duration = de["duration"]
+    samples = values.get("output", {}).get("samples_per_period", 64)
+    if samples < 8:
+        raise StructureStudyError(
+            f"{where}: [output] samples_per_period must be at least 8, got {samples}"
+        )
+    return StructureStudy(
+        structure=system,
+        omega=omega,
+        force=force,
+        periods=ex.get("periods", 20),
+        decay_dof=decay_dof,
+        decay_initial=initial,
+        decay_duration=duration,
+        samples_per_period=samples,
+        source=where,
+        decay_mode=mode,
+    )
+
+
+def read_model(path: str | Path) -> VibrationSystem:
+    """Return the system of a model TOML (a structure study with a ``[model]`` section).
+
+    The matrices read, the joints added, reduced if the file asks for it
+    (:mod:`clearjoint.structure.fe.model_file`); the study's other sections are checked too.
+
+    Raises
+    ------
+    StructureStudyError
+        The file, a matrix file, a joint or a value is bad (one line naming it).
+    """
+    study = load_structure_study(path)
+    if not isinstance(study.structure, VibrationSystem):
+        raise StructureStudyError(
+            f"{path}: read_model reads a [model] section (matrix files and joints); this file "
+            "builds a [structure]: use load_structure_study"
+        )
+    return study.structure

@@ -42,11 +42,13 @@ AnyStudy = Study | StructureStudy
 
 
 def load_any_study(path: str | Path, *, optional: Sequence[str] = ()) -> AnyStudy:
-    """Return the study in ``path``: a structure study if it has [structure], else a joint's.
+    """Return the study in ``path``: a structure study if it has [structure] or [model]
+    (a finite-element model's matrix files), else a joint's.
 
     ``optional`` is passed to :func:`load_study` for a joint study.
     """
-    if "structure" in read_toml(path, what="study", error=StudyError):
+    sections = read_toml(path, what="study", error=StudyError)
+    if "structure" in sections or "model" in sections:
         return load_structure_study(path)
     return load_study(path, optional=optional)
 

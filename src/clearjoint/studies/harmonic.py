@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from clearjoint.errors import ParameterError
+from clearjoint.structure.model import Structure
 from clearjoint.structure.study import StructureStudy
 from clearjoint.studies.joint_study import Study
 
@@ -68,9 +69,12 @@ def refuse_harmonic_structure(study: StructureStudy, command: str) -> None:
     ParameterError
         A joint with restitution below 1 (an impact).
     """
-    laws = study.structure.joint_laws
-    if any(law.restitution != 1.0 for law in laws):
-        value = next(law.restitution for law in laws if law.restitution != 1.0)
+    s = study.structure
+    restitution = (
+        [law.restitution for law in s.joint_laws] if isinstance(s, Structure) else s.restitution()
+    )
+    if any(e != 1.0 for e in restitution):
+        value = next(e for e in restitution if e != 1.0)
         raise ParameterError(
             f"{study.source}: [joint] restitution = {value:g} is an impact, which harmonic "
             f"balance ({command}) cannot carry; set restitution = 1, or use clearjoint "

@@ -248,6 +248,11 @@ def structure_at(study: StructureStudy, values: Values) -> StructureStudy:
         A joint index the structure does not have.
     """
     structure = study.structure
+    if not isinstance(structure, Structure):
+        raise ParameterError(
+            f"{study.source}: joint overrides and sweeps take a [structure] study; a [model] "
+            "(matrix files) is not swept yet"
+        )
     n_joints = len(structure.joint_members)
     common: dict[str, float] = {}
     each: dict[int, dict[str, float]] = {}

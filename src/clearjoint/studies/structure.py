@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from clearjoint.errors import ParameterError
+from clearjoint.structure.model import Structure, system_modes
 from clearjoint.structure.study import StructureStudy
 
 __all__ = [
@@ -68,7 +69,10 @@ def run_structure_task(
     summary: dict[str, Any] = {"structure": repr(s)}
     drawn: Any = None
     if task == "modes":
-        closed, opened = s.modes("closed"), s.modes("open")
+        if isinstance(s, Structure):
+            closed, opened = s.modes("closed"), s.modes("open")
+        else:  # a [model]'s system (reduced: its modal coordinates q1, q2, ...)
+            closed, opened = system_modes(s, "closed"), system_modes(s, "open")
         data = xr.concat(
             [closed.to_xarray(), opened.to_xarray()],
             dim=xr.DataArray(["closed", "open"], dims="pattern"),

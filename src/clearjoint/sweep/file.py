@@ -377,6 +377,7 @@ def _load_base(where: str, task: Task, raw: Any, folder: Path) -> Any:
             raise SweepError(f"{where}: base {raw!r} matches no file; check the folder and pattern")
         return RecordSet(tuple(files), source=raw)
     if task.base == "structure":
+        from clearjoint.structure.model import Structure
         from clearjoint.structure.study import StructureStudyError, load_structure_study
 
         if not isinstance(raw, str):
@@ -387,6 +388,11 @@ def _load_base(where: str, task: Task, raw: Any, folder: Path) -> Any:
             study = load_structure_study(folder / raw)
         except StructureStudyError as exc:
             raise SweepError(f"{where}: base: {exc}") from None
+        if not isinstance(study.structure, Structure):
+            raise SweepError(
+                f"{where}: base {raw!r} is a [model] (matrix files); a sweep takes a "
+                "[structure] study"
+            )
         if not study.structure.joint_members:
             raise SweepError(
                 f"{where}: base {raw!r} has no clearance joints; add a [joint] section to it"

@@ -514,8 +514,10 @@ def _structure_mode(
 ) -> dict[str, float]:
     from clearjoint.harmonic import nonlinear_modes
     from clearjoint.simulate import SimulationError
+    from clearjoint.structure.model import Structure
 
     structure = structure_at(base, values).structure
+    assert isinstance(structure, Structure)  # structure_at refuses a [model] study
     amplitude = values["task.amplitude"]
     start = values.get("task.start_amplitude", 0.0)
     steps = int(values["task.ladder_steps"])
