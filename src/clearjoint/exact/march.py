@@ -44,6 +44,9 @@ TERM_TOL = 1e-18
 ROOT_TOL = 1e-15
 #: Deepest Bernstein subdivision.
 MAX_DEPTH = 64
+#: A joint's reach over a step (sum of its series' sizes and tail) is widened by this
+#: factor, far beyond the round-off of that sum, before an edge farther away is skipped.
+REACH_MARGIN = 1.0 + 1e-9
 
 #: The law's contact states.
 OPEN, COMPRESSION, TENSION = clearance.OPEN, clearance.COMPRESSION, clearance.TENSION
@@ -362,6 +365,7 @@ def march(
     n_ev = 0
     m_diag = 1.0 / m_inv
     b_l1 = np.zeros(n_j)
+    reach = np.zeros(n_j)
     for j in range(n_j):
         for p in range(bp[j], bp[j + 1]):
             b_l1[j] += abs(bd[p])
@@ -431,13 +435,18 @@ def march(
                     NO_CONVERGENCE,
                 )
         tail = top_term * rho / (1.0 - rho) / omega_ref
-        # each joint's shortening delta_j(s h) = sum_i bu[j, i] s^i
+        # each joint's shortening delta_j(s h) = sum_i bu[j, i] s^i, and how far it can
+        # move over the whole step: reach_j = sum_(i>=1) abs(bu[j, i]) + its tail bound
         for j in range(n_j):
+            moved = 0.0
             for i in range(n_terms + 1):
                 acc = 0.0
                 for p in range(bp[j], bp[j + 1]):
                     acc += bd[p] * terms[i, bi[p]]
                 bu[j, i] = acc / omega_ref
+                if i > 0:
+                    moved += abs(bu[j, i])
+            reach[j] = (moved + tail * b_l1[j]) * REACH_MARGIN
         best = 2.0
         which = -1
         for j in range(n_j):
@@ -453,6 +462,9 @@ def march(
                         continue
                     sign = -1.0 if state == TENSION else 1.0
                     coef[0] = sign * (bu[j, 0] + g_t[j])
+                if coef[0] > reach[j]:
+                    # Q(s) >= coef[0] - reach_j > 0 on [0, 1]: no root, none to isolate
+                    continue
                 for i in range(1, n_terms + 1):
                     coef[i] = sign * bu[j, i]
                 coef[n_terms + 1] = -tail * b_l1[j]
