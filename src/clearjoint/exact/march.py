@@ -55,46 +55,6 @@ DONE, CHATTER, NO_CONVERGENCE = 0, 1, 2
 
 
 @njit(cache=True)
-def _velocity_rows(
-    n: int, ap: np.ndarray, ai: np.ndarray, a_u: np.ndarray, a_v: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The plain rows of the acceleration split by the columns they read, zeros dropped.
-
-    From one CSR pattern ``ap, ai`` holding a_u = M^-1 K_plain / omega_ref and
-    a_v = M^-1 C, returns (kp, ki, kv, dp, di, dv): row i of -a_u over the scaled
-    displacements and row i of a_v (the damping, kept apart: ``_series`` hands its
-    product M^-1 C v to the viscous loss integral) over the velocities.
-    """
-    kp = np.zeros(n + 1, dtype=np.int64)
-    dp = np.zeros(n + 1, dtype=np.int64)
-    for i in range(n):
-        kp[i + 1] = kp[i]
-        dp[i + 1] = dp[i]
-        for p in range(ap[i], ap[i + 1]):
-            if a_u[p] != 0.0:
-                kp[i + 1] += 1
-            if a_v[p] != 0.0:
-                dp[i + 1] += 1
-    ki = np.empty(kp[n], dtype=np.int64)
-    kv = np.empty(kp[n])
-    di = np.empty(dp[n], dtype=np.int64)
-    dv = np.empty(dp[n])
-    for i in range(n):
-        k = kp[i]
-        d = dp[i]
-        for p in range(ap[i], ap[i + 1]):
-            if a_u[p] != 0.0:
-                ki[k] = ai[p]
-                kv[k] = -a_u[p]
-                k += 1
-            if a_v[p] != 0.0:
-                di[d] = n + ai[p]
-                dv[d] = a_v[p]
-                d += 1
-    return kp, ki, kv, dp, di, dv
-
-
-@njit(cache=True)
 def _series(
     y: np.ndarray,
     out: np.ndarray,
@@ -104,12 +64,10 @@ def _series(
     omega: float,
     omega_ref: float,
     force_s: np.ndarray,
-    kp: np.ndarray,
-    ki: np.ndarray,
-    kv: np.ndarray,
-    dp: np.ndarray,
-    di: np.ndarray,
-    dv: np.ndarray,
+    ap: np.ndarray,
+    ai: np.ndarray,
+    a_u: np.ndarray,
+    a_v: np.ndarray,
     bp: np.ndarray,
     bi: np.ndarray,
     bd: np.ndarray,
@@ -120,8 +78,10 @@ def _series(
     """out = factor A_s y in scaled variables (sparse, matrix-free); returns abs(out)_inf.
 
     One Taylor term: y_(i+1) = (h / (i + 1)) A_s y_i is ``factor = h / (i + 1)``. Row i of
-    the acceleration is force_s[i] y_sin + sum(kv y_u) - damp[i] - the joints' forces along
-    bd_m = M^-1 b_j, with damp = M^-1 C y_v (stored, unscaled by ``factor``, for the
+    the acceleration is force_s[i] y_sin - sum_p a_u[p] y_u[ai[p]] - damp[i] - the joints'
+    forces along bd_m = M^-1 b_j over one CSR pattern ``ap, ai`` of the plain stiffness
+    (a_u = M^-1 K_plain / omega_ref) and the damping (a_v = M^-1 C), with
+    damp[i] = sum_p a_v[p] y_v[ai[p]] = (M^-1 C y_v)[i] (stored, unscaled by ``factor``, for the
     viscous loss integral), ``force_s`` = M^-1 F / v_ref, ``k_now`` the joints' stiffness
     over omega_ref (y holds omega_ref u) and ``r_s`` their offsets over v_ref.
     """
@@ -129,11 +89,11 @@ def _series(
     one = y[2 * n + 2]
     for i in range(n):
         acc = force_s[i] * sin_
-        for p in range(kp[i], kp[i + 1]):
-            acc += kv[p] * y[ki[p]]
         d = 0.0
-        for p in range(dp[i], dp[i + 1]):
-            d += dv[p] * y[di[p]]
+        for p in range(ap[i], ap[i + 1]):
+            q = ai[p]
+            acc -= a_u[p] * y[q]
+            d += a_v[p] * y[n + q]
         damp[i] = d
         out[n + i] = acc - d
     for j in range(k_now.shape[0]):
@@ -340,7 +300,6 @@ def march(
         k_now[j] = k_table[j, states[j] + 1] / omega_ref
         r_now[j] = r_table[j, states[j] + 1] / v_ref
     force_s = force * m_inv / v_ref
-    kp, ki, kv, dp, di, dv = _velocity_rows(n, ap, ai, a_u, a_v)
     damp = np.zeros((MAX_TERMS + 1, n))  # M^-1 C v_i of each term
     bd_m = np.empty_like(bd)
     for p in range(bd.shape[0]):
@@ -400,12 +359,10 @@ def march(
                     omega,
                     omega_ref,
                     force_s,
-                    kp,
-                    ki,
-                    kv,
-                    dp,
-                    di,
-                    dv,
+                    ap,
+                    ai,
+                    a_u,
+                    a_v,
                     bp,
                     bi,
                     bd,
@@ -506,8 +463,8 @@ def march(
             last_d = damp[n_terms]
             for q in range(n):
                 d = 0.0
-                for p in range(dp[q], dp[q + 1]):
-                    d += dv[p] * terms[n_terms, di[p]]
+                for p in range(ap[q], ap[q + 1]):
+                    d += a_v[p] * terms[n_terms, n + ai[p]]
                 last_d[q] = d
             for k in range(n_terms + 1):
                 if norm_v[k] <= floor:
