@@ -20,7 +20,13 @@ the Bernstein basis (a polynomial lies within the hull of its Bernstein coeffici
 [0, 1]; de Casteljau halving; a single sign change of the coefficients means a single
 root, then bisection to 1e-15 of the step): a grazing contact is seen however brief.
 The step goes to that root, where the event is declared (within 1e-15 of the step of
-Q's root; Q and g differ by round-off), or to h. Samples, the input work
+Q's root; Q and g differ by round-off), or to h. The step h is the base step h_base after
+an event and doubles after each step that met no edge, up to MAX_STEP_GROWTH h_base: a
+longer step only takes more terms (and is halved if it needs more than MAX_TERMS or
+rho >= 1/2), the tail bound and the root isolation hold for any h, so no edge is missed.
+Before an edge's polynomial is built, its distance is compared with the joint's reach
+over the step (the sum of abs(bu_i), i >= 1, and the tail bound): an edge beyond it has
+Q > 0 on the whole step and is skipped. Samples, the input work
 integral of F.v sin(w t) and the viscous loss integral of v^T C v over the step are
 exact polynomial operations on the same series.
 """
@@ -44,6 +50,8 @@ TERM_TOL = 1e-18
 ROOT_TOL = 1e-15
 #: Deepest Bernstein subdivision.
 MAX_DEPTH = 64
+#: After steps that met no edge the step doubles, up to this many base steps.
+MAX_STEP_GROWTH = 4.0
 #: A joint's reach over a step (sum of its series' sizes and tail) is widened by this
 #: factor, far beyond the round-off of that sum, before an edge farther away is skipped.
 REACH_MARGIN = 1.0 + 1e-9
@@ -330,6 +338,7 @@ def march(
             b_l1[j] += abs(bd[p])
     next_sample = 0
     t = 0.0
+    h_next = h_base
     status = DONE
     steps = 0
     while t < t_end:
@@ -338,7 +347,7 @@ def march(
         y[2 * n + 1] = v_ref * math.cos(omega * t)
         y[2 * n + 2] = v_ref
         remaining = t_end - t
-        h = min(h_base, remaining)
+        h = min(h_next, remaining)
         last = h >= remaining
         size = 0.0
         for q in range(n_aug):
@@ -504,7 +513,10 @@ def march(
             break
         t += h_step
         if not event:
+            # no edge met: the next step may be longer, up to MAX_STEP_GROWTH h_base
+            h_next = min(2.0 * h, MAX_STEP_GROWTH * h_base)
             continue
+        h_next = h_base  # after an event, start again from the base step
         joint = which // 2
         entering = states[joint] == OPEN
         if which % 2 == 0:
