@@ -11,11 +11,12 @@ resonance. Steps start at a base step H (an eighth of the shortest period of for
 structure and damping) after each event and double after each step that meets no edge,
 up to 4 H (``clearjoint.exact.march.MAX_STEP_GROWTH``), so abs(A_s tau) is of order one
 and the Taylor series of exp(A_s tau) y, summed until its terms fall below 1e-18 of y,
-is the exact flow to round-off. The same series carries the energy integrals exactly: the input power
-F.v sin(w t) and the viscous power v^T C v are polynomials in tau, integrated term by
-term. A_s y is applied matrix-free from sparse pieces (the plain members' stiffness, C,
-and each joint's direction b_j with its stiffness and offset in its present state), so
-a new contact pattern costs nothing to set up; the whole march runs compiled, in one
+is the exact flow to round-off. The same series carries the energy integrals exactly:
+the input power F.v sin(w t) and the viscous power v^T C v are polynomials in tau,
+integrated term by term. A_s y is applied matrix-free from sparse pieces (the plain
+members' stiffness, C, and each joint's direction b_j with its stiffness and offset in
+its present state), so a new contact pattern costs nothing to set up; the whole march
+runs compiled, in one
 call (``clearjoint.exact.march``).
 
 Events (a joint's shortening delta_j reaches a gap edge) are found without a miss: over
