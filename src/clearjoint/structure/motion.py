@@ -16,8 +16,7 @@ the input power F.v sin(w t) and the viscous power v^T C v are polynomials in ta
 integrated term by term. A_s y is applied matrix-free from sparse pieces (the plain
 members' stiffness, C, and each joint's direction b_j with its stiffness and offset in
 its present state), so a new contact pattern costs nothing to set up; the whole march
-runs compiled, in one
-call (``clearjoint.exact.march``).
+runs compiled, in one call (``clearjoint.exact.march``).
 
 Events (a joint's shortening delta_j reaches a gap edge) are found without a miss: over
 a step each edge distance g is the polynomial given by the step's Taylor series up to a
