@@ -124,7 +124,7 @@ def _series(
     out[2 * n] = a
     out[2 * n + 1] = b
     out[2 * n + 2] = 0.0
-    return max(top, abs(a), abs(b))
+    return float(max(top, abs(a), abs(b)))
 
 
 @njit(cache=True)
