@@ -15,7 +15,8 @@ wall clock of section 2 is printed beside them.
    ``--issue-rounds``) against solve_ivp (DOP853, rtol 1e-9, atol 1e-15, restarted at every
    gap-edge event) over the same span; then the issue's 5-mass chain (rattling) at 2, 20,
    39.66 and 60 Hz: CPU ms per forcing period and events per period, and from them an
-   estimate of its 300-frequency stepped-sine diagram. ``--issue24`` runs this alone::
+   estimate of its 300-frequency stepped-sine diagram. Only with ``--issue24``, alone (the
+   default run keeps sections 1-5, which ``side_by_side.py`` times across checkouts)::
 
        OPENBLAS_NUM_THREADS=1 python benchmarks/bench_structure.py --issue24
 
@@ -326,7 +327,7 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=5, help="old/new child pairs (--old-src)")
     parser.add_argument("--decay-periods", type=int, default=80, help="free decay (--old-src)")
     parser.add_argument(
-        "--issue24", action="store_true", help="only issue 24's mast.toml ratio and chain cost"
+        "--issue24", action="store_true", help="run section 0 alone (issue 24's ratio, chain)"
     )
     parser.add_argument("--issue-periods", type=int, default=10, help="mast.toml periods")
     parser.add_argument("--issue-rounds", type=int, default=3, help="exact runs, best taken")
@@ -341,9 +342,9 @@ def main() -> None:
     if args.old_src:
         against_old(args)
         return
-    print(f"0. examples/mast.toml (20 N, 15 Hz), {args.issue_periods} periods: exact vs solve_ivp")
-    issue24(args)
-    if args.issue24:
+    if args.issue24:  # on request only: side_by_side.py times the default sections
+        print(f"0. examples/mast.toml (20 N, 15 Hz), {args.issue_periods} periods: exact vs ivp")
+        issue24(args)
         return
 
     n = args.chain_periods
