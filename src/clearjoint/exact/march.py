@@ -18,7 +18,9 @@ that tail T_e, and Q_e(s) = P_e(s) - T_e s^(K+1) <= g_e(s) on the whole step: th
 root of Q_e is never after the first root of g_e. That first root is isolated exactly in
 the Bernstein basis (a polynomial lies within the hull of its Bernstein coefficients on
 [0, 1]; de Casteljau halving; a single sign change of the coefficients means a single
-root, then bisection to 1e-15 of the step): a grazing contact is seen however brief.
+root, then a bracket [lo, hi] with Q(lo) > 0 >= Q(hi) closed to 1e-15 of the step by
+regula falsi, Illinois variant, falling back to bisection): a grazing contact is seen
+however brief.
 The step goes to that root, where the event is declared (within 1e-15 of the step of
 Q's root; Q and g differ by round-off), or to h. The step h is the base step h_base after
 an event and doubles after each step that met no edge, up to MAX_STEP_GROWTH h_base: a
@@ -216,18 +218,38 @@ def first_root(
         if b - a <= ROOT_TOL * limit or top >= MAX_DEPTH:
             return float(a)
         if _variations(beta, d) == 1:
-            # exactly one root in (a, b]: bisect on the power form
+            # exactly one root in (a, b]: shrink the bracket [lo, hi] with Q(lo) > 0 and
+            # Q(hi) <= 0 on the power form, by the Illinois variant of regula falsi (the
+            # bracket closes from both sides, superlinearly) with a bisection whenever the
+            # secant point is not strictly inside or the end values do not bracket
             lo, hi = a, b
+            q_lo = _horner(c[start:], d, lo)
+            q_hi = _horner(c[start:], d, hi)
+            kept = 0  # +1: lo moved last, -1: hi moved last
             for _ in range(200):
                 if hi - lo <= ROOT_TOL * limit:
                     break
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
-                if _horner(c[start:], d, mid) > 0.0:
-                    lo = mid
+                x = mid
+                if q_lo > 0.0 and q_hi <= 0.0 and q_lo - q_hi > 0.0:
+                    x = lo + (hi - lo) * (q_lo / (q_lo - q_hi))
+                    if not lo < x < hi:
+                        x = mid
+                q_x = _horner(c[start:], d, x)
+                if q_x > 0.0:
+                    lo = x
+                    q_lo = q_x
+                    if kept == 1:
+                        q_hi *= 0.5
+                    kept = 1
                 else:
-                    hi = mid
+                    hi = x
+                    q_hi = q_x
+                    if kept == -1:
+                        q_lo *= 0.5
+                    kept = -1
             return float(lo)
         # de Casteljau at the midpoint: the left half goes on top of the stack (slot
         # top + 1, examined next), the right half below it (slot top)
