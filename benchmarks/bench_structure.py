@@ -10,6 +10,16 @@ Times are CPU seconds of this process (``time.process_time``; both solvers run o
 thread), which other jobs on a shared machine disturb far less than the wall clock; the
 wall clock of section 2 is printed beside them.
 
+0. Issue 24: examples/mast.toml (10 bays, 20 joints, 20 N at n21x, 15 Hz) over
+   ``--issue-periods`` (10, about 9,000 events): the exact solver (best of
+   ``--issue-rounds``) against solve_ivp (DOP853, rtol 1e-9, atol 1e-15, restarted at every
+   gap-edge event) over the same span; then the issue's 5-mass chain (rattling) at 2, 20,
+   39.66 and 60 Hz: CPU ms per forcing period and events per period, and from them an
+   estimate of its 300-frequency stepped-sine diagram. Only with ``--issue24``, alone (the
+   default run keeps sections 1-5, which ``side_by_side.py`` times across checkouts)::
+
+       OPENBLAS_NUM_THREADS=1 python benchmarks/bench_structure.py --issue24
+
 1. Accuracy: a 3-link chain with 2 joints (asymmetric, k0 > 0, off-centre gaps, restitution
    on the rigid link) against scipy's solve_ivp (DOP853, rtol 1e-12, an event on every gap
    edge), 20 forcing periods: largest difference relative to the largest motion.
@@ -29,8 +39,9 @@ wall clock of section 2 is printed beside them.
 
 ``--old-src DIR`` (issue 23: "within 5 % of before, side by side") runs none of that: it
 times the speed workloads, section 2's mast over ``--mast-periods``, section 3's masts of
-``--bays`` over ``--scaling-periods`` and section 4's free decay (default base step) over
-``--decay-periods``, with the clearjoint of another ``src`` tree and with this one, each in
+``--bays`` over ``--scaling-periods``, section 4's free decay (default base step) over
+``--decay-periods``, and section 0's mast.toml over 10 periods and chain over 100 periods at
+20 and 39.66 Hz, with the clearjoint of another ``src`` tree and with this one, each in
 a fresh child process (PYTHONPATH, OPENBLAS_NUM_THREADS=1) that warms up (imports, numba's
 compilation or cache) before it times, alternating old, new, ... ``--rounds`` times. Each
 child builds every case anew and reports CPU seconds (``time.process_time``) per workload;
@@ -67,6 +78,7 @@ from clearjoint.structure import (
 )
 from clearjoint.structure import motion as motion_module
 from clearjoint.structure.reference import reference_response
+from clearjoint.structure.study import load_structure_study
 
 
 def _three_links() -> Structure:
@@ -113,6 +125,88 @@ def _decay_case() -> tuple[Structure, np.ndarray, float, int]:
     tip = tower.dof_names.index("n21x")
     u0 = 3e-3 * closed.shapes[:, 0] / closed.shapes[tip, 0]
     return tower, u0, 2 * math.pi / float(closed.omega[0]), tip
+
+
+def _study_mast() -> tuple[Structure, np.ndarray, float]:
+    """examples/mast.toml as it stands: the 10-bay mast, 20 N at n21x, 15 Hz."""
+    study = load_structure_study(Path(__file__).resolve().parents[1] / "examples" / "mast.toml")
+    assert study.force is not None
+    assert study.omega is not None
+    return study.structure, study.force, study.omega
+
+
+def _rattling_chain() -> tuple[Structure, np.ndarray]:
+    """Issue 24's 5-mass chain: 0.5 kg, joints +-0.1 mm, 4e5 N/m, k0 2e4 N/m, 2 N s/m, 30 N."""
+    joint = ClearanceJoint(1e-4, 4e5, gap_stiffness=2e4)
+    s = chain([0.5] * 5, [math.inf] * 5, [joint] * 5, dampers=[2.0] * 5)
+    force = np.zeros(5)
+    force[-1] = 30.0
+    return s, force
+
+
+def _chain_cost(hz: float, periods: int, rounds: int) -> tuple[float, float]:
+    """CPU seconds per forcing period (best of ``rounds``) and events per period at ``hz``."""
+    s, force = _rattling_chain()
+    omega = 2.0 * math.pi * hz
+    time_response(s, force, omega, 0.1 / hz, samples_per_period=16)  # warm up
+    spent = math.inf
+    for _ in range(rounds):
+        start = time.process_time()
+        motion = time_response(s, force, omega, periods / hz, samples_per_period=16)
+        spent = min(spent, time.process_time() - start)
+    return spent / periods, motion.events / periods
+
+
+def issue24(args: argparse.Namespace) -> None:
+    """Issue 24, item 5: examples/mast.toml over 10 periods against solve_ivp (rtol 1e-9)."""
+    s, force, omega = _study_mast()
+    periods = args.issue_periods
+    duration = periods * 2.0 * math.pi / omega
+    time_response(s, force, omega, 0.05 * 2.0 * math.pi / omega)  # compile (cached), warm up
+    spent = []
+    for _ in range(args.issue_rounds):  # the best of a few: other jobs only ever add time
+        start = time.process_time()
+        motion = time_response(s, force, omega, duration, samples_per_period=16)
+        spent.append(time.process_time() - start)
+    t_mine = min(spent)
+    start = time.process_time()
+    u_ivp, _, events_ivp = reference_response(s, force, omega, motion.t, rtol=1e-9)
+    t_ivp = time.process_time() - start
+    print(
+        f"  exact: {t_mine:.3f} s (best of {args.issue_rounds}; median "
+        f"{statistics.median(spent):.3f} s), {motion.events} events, {motion.steps} steps "
+        f"({t_mine / motion.events * 1e6:.1f} us per event), ledger {motion.balance_error:.0e}"
+    )
+    print(
+        f"  solve_ivp DOP853 rtol 1e-9 (atol 1e-15), restarted at each of its {events_ivp} "
+        f"edge events: {t_ivp:.2f} s; ratio {t_ivp / t_mine:.0f}x "
+        f"(load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)"
+    )
+    scale = np.max(np.abs(motion.u))
+    apart = [np.max(np.abs(motion.u[16 * k] - u_ivp[16 * k])) / scale for k in (1, 2, periods - 1)]
+    print(
+        f"  exact vs solve_ivp, largest difference of u / largest motion after 1, 2 and "
+        f"{periods - 1} periods: {apart[0]:.0e}, {apart[1]:.0e}, {apart[2]:.0e} (a rattling "
+        "motion amplifies any difference; section 2 says whose error is whose)"
+    )
+    print("  the 5-mass chain of issue 24 (rattling): CPU per forcing period, best of the rounds")
+    cost = {}
+    for hz in (2.0, 20.0, 39.66, 60.0):
+        per, events = _chain_cost(hz, max(2, round(args.chain_seconds * hz)), args.issue_rounds)
+        cost[hz] = per * hz  # CPU s per second of motion
+        print(
+            f"    {hz:6.2f} Hz: {per * 1e3:7.3f} ms per period, {events:6.1f} events per "
+            f"period ({per / max(events, 1e-300) * 1e6:6.1f} us per event if events dominate)"
+        )
+    # the diagram (300 frequencies 2-60 Hz, 200 + 100 periods, up and down): CPU seconds per
+    # second of motion interpolated in frequency between the four measured, times its motion
+    freqs = np.linspace(2.0, 60.0, 300)
+    rate = np.interp(freqs, list(cost), list(cost.values()))
+    total = 2 * float(np.sum(300.0 / freqs * rate))
+    print(
+        f"  estimate for the diagram (300 frequencies, 200 + 100 periods, up and down): "
+        f"{total:.0f} CPU s, {total / 2 / 60:.1f} min on 2 workers (interpolated, not run)"
+    )
 
 
 def _decay_sensitivity() -> None:
@@ -170,6 +264,15 @@ def _workload_cpu(args: argparse.Namespace) -> dict[str, float]:
         tower, (u0, np.zeros(tower.n_dof)), args.decay_periods * period, samples_per_period=64
     )
     cpu["free decay"] = time.process_time() - start
+    s, force, omega = _study_mast()
+    start = time.process_time()
+    time_response(s, force, omega, 10 * 2 * math.pi / omega, samples_per_period=16)
+    cpu["mast.toml 10T"] = time.process_time() - start
+    chain5, force5 = _rattling_chain()
+    for hz in (20.0, 39.66):
+        start = time.process_time()
+        time_response(chain5, force5, 2 * math.pi * hz, 100 / hz, samples_per_period=16)
+        cpu[f"chain {hz:g}Hz 100T"] = time.process_time() - start
     return cpu
 
 
@@ -223,6 +326,14 @@ def main() -> None:
     parser.add_argument("--old-src", help="only time the speed workloads against this src tree")
     parser.add_argument("--rounds", type=int, default=5, help="old/new child pairs (--old-src)")
     parser.add_argument("--decay-periods", type=int, default=80, help="free decay (--old-src)")
+    parser.add_argument(
+        "--issue24", action="store_true", help="run section 0 alone (issue 24's ratio, chain)"
+    )
+    parser.add_argument("--issue-periods", type=int, default=10, help="mast.toml periods")
+    parser.add_argument("--issue-rounds", type=int, default=3, help="exact runs, best taken")
+    parser.add_argument(
+        "--chain-seconds", type=float, default=2.0, help="seconds of the chain's motion timed"
+    )
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
@@ -230,6 +341,10 @@ def main() -> None:
         return
     if args.old_src:
         against_old(args)
+        return
+    if args.issue24:  # on request only: side_by_side.py times the default sections
+        print(f"0. examples/mast.toml (20 N, 15 Hz), {args.issue_periods} periods: exact vs ivp")
+        issue24(args)
         return
 
     n = args.chain_periods

@@ -4,7 +4,10 @@ One njit call runs the whole motion; Python is not entered per step. In a contac
 the augmented state y = (omega_ref u, v, v_ref sin w t, v_ref cos w t, v_ref) obeys
 y' = A_s y, and A_s y is applied matrix-free from sparse pieces (plain members' K, C,
 each joint's row b_j and its stiffness and offset in its current state), so a new pattern
-costs nothing to set up: patterns differ only in the joints' table entries.
+costs nothing to set up: patterns differ only in the joints' table entries. The
+constant scales (M^-1, 1 / v_ref) are folded into those pieces once per run, and each
+term's damping product M^-1 C v_i is kept: the viscous loss integral reuses it instead of
+multiplying by C again.
 
 A step of length h is one Taylor expansion of the flow, y(s h) = sum_i y_i s^i on
 s in [0, 1], y_{i+1} = h A_s y_i / (i + 1), summed until the terms fall below 1e-18 of y
@@ -15,9 +18,17 @@ that tail T_e, and Q_e(s) = P_e(s) - T_e s^(K+1) <= g_e(s) on the whole step: th
 root of Q_e is never after the first root of g_e. That first root is isolated exactly in
 the Bernstein basis (a polynomial lies within the hull of its Bernstein coefficients on
 [0, 1]; de Casteljau halving; a single sign change of the coefficients means a single
-root, then bisection to 1e-15 of the step): a grazing contact is seen however brief.
+root, then a bracket [lo, hi] with Q(lo) > 0 >= Q(hi) closed to 1e-15 of the step by
+regula falsi, Illinois variant, falling back to bisection): a grazing contact is seen
+however brief.
 The step goes to that root, where the event is declared (within 1e-15 of the step of
-Q's root; Q and g differ by round-off), or to h. Samples, the input work
+Q's root; Q and g differ by round-off), or to h. The step h is the base step h_base after
+an event and doubles after each step that met no edge, up to MAX_STEP_GROWTH h_base: a
+longer step only takes more terms (and is halved if it needs more than MAX_TERMS or
+rho >= 1/2), the tail bound and the root isolation hold for any h, so no edge is missed.
+Before an edge's polynomial is built, its distance is compared with the joint's reach
+over the step (the sum of abs(bu_i), i >= 1, and the tail bound): an edge beyond it has
+Q > 0 on the whole step and is skipped. Samples, the input work
 integral of F.v sin(w t) and the viscous loss integral of v^T C v over the step are
 exact polynomial operations on the same series.
 """
@@ -41,6 +52,11 @@ TERM_TOL = 1e-18
 ROOT_TOL = 1e-15
 #: Deepest Bernstein subdivision.
 MAX_DEPTH = 64
+#: After steps that met no edge the step doubles, up to this many base steps.
+MAX_STEP_GROWTH = 4.0
+#: A joint's reach over a step (sum of its series' sizes and tail) is widened by this
+#: factor, far beyond the round-off of that sum, before an edge farther away is skipped.
+REACH_MARGIN = 1.0 + 1e-9
 
 #: The law's contact states.
 OPEN, COMPRESSION, TENSION = clearance.OPEN, clearance.COMPRESSION, clearance.TENSION
@@ -49,14 +65,15 @@ DONE, CHATTER, NO_CONVERGENCE = 0, 1, 2
 
 
 @njit(cache=True)
-def _apply(
+def _series(
     y: np.ndarray,
     out: np.ndarray,
+    damp: np.ndarray,
+    factor: float,
     n: int,
     omega: float,
     omega_ref: float,
-    v_ref: float,
-    force_m: np.ndarray,
+    force_s: np.ndarray,
     ap: np.ndarray,
     ai: np.ndarray,
     a_u: np.ndarray,
@@ -66,35 +83,50 @@ def _apply(
     bd: np.ndarray,
     bd_m: np.ndarray,
     k_now: np.ndarray,
-    r_now: np.ndarray,
-) -> None:
-    """out = A_s y in scaled variables (sparse, matrix-free).
+    r_s: np.ndarray,
+) -> float:
+    """out = factor A_s y in scaled variables (sparse, matrix-free); returns abs(out)_inf.
 
-    Row i of the acceleration: force_m[i] sin - sum_p (a_u[p] y_u + a_v[p] y_v)[ai[p]]
-    over the plain members' stiffness and the damping (one sparsity pattern, M^-1 and
-    the scaling folded in), then each joint's force along bd_m = M^-1 b_j (``k_now`` is
-    the joints' stiffness over omega_ref, as y holds omega_ref u).
+    One Taylor term: y_(i+1) = (h / (i + 1)) A_s y_i is ``factor = h / (i + 1)``. Row i of
+    the acceleration is force_s[i] y_sin - sum_p a_u[p] y_u[ai[p]] - damp[i] - the joints'
+    forces along bd_m = M^-1 b_j over one CSR pattern ``ap, ai`` of the plain stiffness
+    (a_u = M^-1 K_plain / omega_ref) and the damping (a_v = M^-1 C), with
+    damp[i] = sum_p a_v[p] y_v[ai[p]] = (M^-1 C y_v)[i] (stored, unscaled by ``factor``, for the
+    viscous loss integral), ``force_s`` = M^-1 F / v_ref, ``k_now`` the joints' stiffness
+    over omega_ref (y holds omega_ref u) and ``r_s`` their offsets over v_ref.
     """
-    sin_ = y[2 * n] / v_ref
-    cos_ = y[2 * n + 1] / v_ref
-    one = y[2 * n + 2] / v_ref
+    sin_ = y[2 * n]
+    one = y[2 * n + 2]
     for i in range(n):
-        out[i] = omega_ref * y[n + i]
-        acc = force_m[i] * sin_
+        acc = force_s[i] * sin_
+        d = 0.0
         for p in range(ap[i], ap[i + 1]):
             q = ai[p]
-            acc -= a_u[p] * y[q] + a_v[p] * y[n + q]
-        out[n + i] = acc
+            acc -= a_u[p] * y[q]
+            d += a_v[p] * y[n + q]
+        damp[i] = d
+        out[n + i] = acc - d
     for j in range(k_now.shape[0]):
         delta = 0.0
         for p in range(bp[j], bp[j + 1]):
             delta += bd[p] * y[bi[p]]
-        f = k_now[j] * delta - r_now[j] * one
+        f = k_now[j] * delta - r_s[j] * one
         for p in range(bp[j], bp[j + 1]):
             out[n + bi[p]] -= bd_m[p] * f
-    out[2 * n] = v_ref * omega * cos_
-    out[2 * n + 1] = -v_ref * omega * sin_
+    top = 0.0
+    scale_u = factor * omega_ref
+    for i in range(n):
+        a = scale_u * y[n + i]
+        b = factor * out[n + i]
+        out[i] = a
+        out[n + i] = b
+        top = max(top, abs(a), abs(b))
+    a = factor * omega * y[2 * n + 1]
+    b = -factor * omega * y[2 * n]
+    out[2 * n] = a
+    out[2 * n + 1] = b
     out[2 * n + 2] = 0.0
+    return float(max(top, abs(a), abs(b)))
 
 
 @njit(cache=True)
@@ -186,18 +218,38 @@ def first_root(
         if b - a <= ROOT_TOL * limit or top >= MAX_DEPTH:
             return float(a)
         if _variations(beta, d) == 1:
-            # exactly one root in (a, b]: bisect on the power form
+            # exactly one root in (a, b]: shrink the bracket [lo, hi] with Q(lo) > 0 and
+            # Q(hi) <= 0 on the power form, by the Illinois variant of regula falsi (the
+            # bracket closes from both sides, superlinearly) with a bisection whenever the
+            # secant point is not strictly inside or the end values do not bracket
             lo, hi = a, b
+            q_lo = _horner(c[start:], d, lo)
+            q_hi = _horner(c[start:], d, hi)
+            kept = 0  # +1: lo moved last, -1: hi moved last
             for _ in range(200):
                 if hi - lo <= ROOT_TOL * limit:
                     break
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
-                if _horner(c[start:], d, mid) > 0.0:
-                    lo = mid
+                x = mid
+                if q_lo > 0.0 and q_hi <= 0.0 and q_lo - q_hi > 0.0:
+                    x = lo + (hi - lo) * (q_lo / (q_lo - q_hi))
+                    if not lo < x < hi:
+                        x = mid
+                q_x = _horner(c[start:], d, x)
+                if q_x > 0.0:
+                    lo = x
+                    q_lo = q_x
+                    if kept == 1:
+                        q_hi *= 0.5
+                    kept = 1
                 else:
-                    hi = mid
+                    hi = x
+                    q_hi = q_x
+                    if kept == -1:
+                        q_lo *= 0.5
+                    kept = -1
             return float(lo)
         # de Casteljau at the midpoint: the left half goes on top of the stack (slot
         # top + 1, examined next), the right half below it (slot top)
@@ -276,8 +328,9 @@ def march(
     r_now = np.empty(n_j)
     for j in range(n_j):
         k_now[j] = k_table[j, states[j] + 1] / omega_ref
-        r_now[j] = r_table[j, states[j] + 1]
-    force_m = force * m_inv
+        r_now[j] = r_table[j, states[j] + 1] / v_ref
+    force_s = force * m_inv / v_ref
+    damp = np.zeros((MAX_TERMS + 1, n))  # M^-1 C v_i of each term
     bd_m = np.empty_like(bd)
     for p in range(bd.shape[0]):
         bd_m[p] = bd[p] * m_inv[bi[p]]
@@ -299,12 +352,15 @@ def march(
     ev_j = np.empty(64, dtype=np.int64)
     ev_s = np.empty(64, dtype=np.int8)
     n_ev = 0
+    m_diag = 1.0 / m_inv
     b_l1 = np.zeros(n_j)
+    reach = np.zeros(n_j)
     for j in range(n_j):
         for p in range(bp[j], bp[j + 1]):
             b_l1[j] += abs(bd[p])
     next_sample = 0
     t = 0.0
+    h_next = h_base
     status = DONE
     steps = 0
     while t < t_end:
@@ -313,7 +369,7 @@ def march(
         y[2 * n + 1] = v_ref * math.cos(omega * t)
         y[2 * n + 2] = v_ref
         remaining = t_end - t
-        h = min(h_base, remaining)
+        h = min(h_next, remaining)
         last = h >= remaining
         size = 0.0
         for q in range(n_aug):
@@ -325,14 +381,15 @@ def march(
             rho = 1.0
             top_term = 0.0
             for i in range(1, MAX_TERMS + 1):
-                _apply(
+                top_term = _series(
                     terms[i - 1],
                     terms[i],
+                    damp[i - 1],
+                    h / i,
                     n,
                     omega,
                     omega_ref,
-                    v_ref,
-                    force_m,
+                    force_s,
                     ap,
                     ai,
                     a_u,
@@ -344,10 +401,6 @@ def march(
                     k_now,
                     r_now,
                 )
-                top_term = 0.0
-                for q in range(n_aug):
-                    terms[i, q] *= h / i
-                    top_term = max(top_term, abs(terms[i, q]))
                 n_terms = i
                 rho = norm_a * h / (i + 1.0)
                 if top_term <= TERM_TOL * size and rho < 0.5:
@@ -370,13 +423,18 @@ def march(
                     NO_CONVERGENCE,
                 )
         tail = top_term * rho / (1.0 - rho) / omega_ref
-        # each joint's shortening delta_j(s h) = sum_i bu[j, i] s^i
+        # each joint's shortening delta_j(s h) = sum_i bu[j, i] s^i, and how far it can
+        # move over the whole step: reach_j = sum_(i>=1) abs(bu[j, i]) + its tail bound
         for j in range(n_j):
+            moved = 0.0
             for i in range(n_terms + 1):
                 acc = 0.0
                 for p in range(bp[j], bp[j + 1]):
                     acc += bd[p] * terms[i, bi[p]]
                 bu[j, i] = acc / omega_ref
+                if i > 0:
+                    moved += abs(bu[j, i])
+            reach[j] = (moved + tail * b_l1[j]) * REACH_MARGIN
         best = 2.0
         which = -1
         for j in range(n_j):
@@ -392,6 +450,9 @@ def march(
                         continue
                     sign = -1.0 if state == TENSION else 1.0
                     coef[0] = sign * (bu[j, 0] + g_t[j])
+                if coef[0] > reach[j]:
+                    # Q(s) >= coef[0] - reach_j > 0 on [0, 1]: no root, none to isolate
+                    continue
                 for i in range(1, n_terms + 1):
                     coef[i] = sign * bu[j, i]
                 coef[n_terms + 1] = -tail * b_l1[j]
@@ -429,14 +490,18 @@ def march(
                 norm_v[i] = math.sqrt(size_v)
                 top_v = max(top_v, norm_v[i])
             floor = 1e-19 * top_v
+            # C v_k = M (M^-1 C v_k), kept by the series for k < K; the last one here
+            last_d = damp[n_terms]
+            for q in range(n):
+                d = 0.0
+                for p in range(ap[q], ap[q + 1]):
+                    d += a_v[p] * terms[n_terms, n + ai[p]]
+                last_d[q] = d
             for k in range(n_terms + 1):
                 if norm_v[k] <= floor:
                     continue
                 for q in range(n):
-                    acc = 0.0
-                    for p in range(cp[q], cp[q + 1]):
-                        acc += cd[p] * terms[k, n + ci[p]]
-                    cv[k, q] = acc
+                    cv[k, q] = m_diag[q] * damp[k, q]
             for m in range(2 * n_terms + 1):
                 gram[m] = 0.0
                 prod[m] = 0.0
@@ -470,7 +535,10 @@ def march(
             break
         t += h_step
         if not event:
+            # no edge met: the next step may be longer, up to MAX_STEP_GROWTH h_base
+            h_next = min(2.0 * h, MAX_STEP_GROWTH * h_base)
             continue
+        h_next = h_base  # after an event, start again from the base step
         joint = which // 2
         entering = states[joint] == OPEN
         if which % 2 == 0:
@@ -478,7 +546,7 @@ def march(
         else:
             states[joint] = TENSION if entering else OPEN
         k_now[joint] = k_table[joint, states[joint] + 1] / omega_ref
-        r_now[joint] = r_table[joint, states[joint] + 1]
+        r_now[joint] = r_table[joint, states[joint] + 1] / v_ref
         e = restitution[joint]
         if entering and e < 1.0:
             speed = 0.0

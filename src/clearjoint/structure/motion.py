@@ -7,15 +7,16 @@ In one contact pattern s the structure is linear,
 and so is the augmented state y = (u, v, sin w t, cos w t, 1): y' = A_s y. Its flow
 exp(A_s tau) is therefore exact for the forcing and the joints' constant forces alike,
 with no special case for a singular K_s (an open joint with k0 = 0), a defective A_s or
-resonance. Steps never exceed a base step H (an eighth of the shortest period of forcing,
-structure and damping), so abs(A_s tau) is of order one and the Taylor series of
-exp(A_s tau) y, summed until its terms fall below 1e-18 of y, is the exact flow to
-round-off. The same series carries the energy integrals exactly: the input power
-F.v sin(w t) and the viscous power v^T C v are polynomials in tau, integrated term by
-term. A_s y is applied matrix-free from sparse pieces (the plain members' stiffness, C,
-and each joint's direction b_j with its stiffness and offset in its present state), so
-a new contact pattern costs nothing to set up; the whole march runs compiled, in one
-call (``clearjoint.exact.march``).
+resonance. Steps start at a base step H (an eighth of the shortest period of forcing,
+structure and damping) after each event and double after each step that meets no edge,
+up to 4 H (``clearjoint.exact.march.MAX_STEP_GROWTH``), so abs(A_s tau) is of order one
+and the Taylor series of exp(A_s tau) y, summed until its terms fall below 1e-18 of y,
+is the exact flow to round-off. The same series carries the energy integrals exactly:
+the input power F.v sin(w t) and the viscous power v^T C v are polynomials in tau,
+integrated term by term. A_s y is applied matrix-free from sparse pieces (the plain
+members' stiffness, C, and each joint's direction b_j with its stiffness and offset in
+its present state), so a new contact pattern costs nothing to set up; the whole march
+runs compiled, in one call (``clearjoint.exact.march``).
 
 Events (a joint's shortening delta_j reaches a gap edge) are found without a miss: over
 a step each edge distance g is the polynomial given by the step's Taylor series up to a
@@ -176,8 +177,8 @@ class StructureMotion:
     patterns_visited : int
         How many distinct contact patterns were met.
     steps : int
-        Steps of the exact flow taken (one ends at each event; the others are at most the
-        base step, an eighth of the shortest period).
+        Steps of the exact flow taken (one ends at each event; the others are at most four
+        base steps, a base step being an eighth of the shortest period).
     structure : Structure or None
         The structure moved (``system.source``); None for a system given as matrices.
     dof_names : tuple of str
