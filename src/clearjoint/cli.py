@@ -20,6 +20,7 @@ import logging
 import math
 import os
 import sys
+import time
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -485,6 +486,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         atexit.register(gc.freeze)
     parser = build_parser()
     args = parser.parse_args(argv)
+    started = time.time()
     runners = {
         "stiffness": _run_stiffness,
         "simulate": _run_simulate,
@@ -502,6 +504,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         with warnings.catch_warnings(), _harmonic_progress(args.command):
             warnings.showwarning = _warning_printer(args.command)
             return runners[args.command](args)
+    except KeyboardInterrupt:  # Ctrl-C: one line, exit 130, as a shell reports SIGINT
+        return _interrupted(args, started)
     except BrokenPipeError:  # the reader stopped early (| head): not an error of ours
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so the exit's flush does not raise again
@@ -519,3 +523,52 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_BAD_INPUT
+    except Exception as exc:  # Ctrl-C inside compiled code arrives wrapped (a SystemError)
+        if _caused_by_interrupt(exc):
+            return _interrupted(args, started)
+        raise
+
+
+#: What an interrupted command leaves, beyond its partial files (removed), by command.
+_LEFT_ON_INTERRUPT = {
+    "rig": "the finished records are kept in {out}: run the same command again to "
+    "simulate only the rest",
+    "reproduce": "the finished records are kept in {out}/records: run the same command "
+    "again to simulate only the rest",
+    "sweep": "finished chunks are in {out}: run again with --resume to compute only the rest",
+}
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether a KeyboardInterrupt is ``exc`` or in the chain of errors that led to it."""
+    seen: set[int] = set()
+    current: BaseException | None = exc
+    while current is not None and id(current) not in seen:
+        if isinstance(current, KeyboardInterrupt):
+            return True
+        seen.add(id(current))
+        current = current.__cause__ or current.__context__
+    return False
+
+
+def _interrupted(args: argparse.Namespace, started: float) -> int:
+    """Say in one line that the command was interrupted and what it left; return 130.
+
+    A file output (--out, --plot) written since the command started is incomplete: removed.
+    """
+    removed = []
+    for option in ("out", "plot"):
+        name = getattr(args, option, None)
+        path = Path(name) if isinstance(name, str) else None
+        if path is not None and path.is_file() and path.stat().st_mtime >= started - 1.0:
+            with contextlib.suppress(OSError):
+                path.unlink()
+                removed.append(str(path))
+    left = _LEFT_ON_INTERRUPT.get(args.command, "nothing written")
+    if removed:
+        left = f"removed the incomplete {' and '.join(removed)}"
+    print(
+        f"clearjoint {args.command}: interrupted; " + left.format(out=getattr(args, "out", "")),
+        file=sys.stderr,
+    )
+    return 130
