@@ -19,10 +19,12 @@ import json
 import logging
 import math
 import os
+import signal
 import sys
+import threading
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -133,18 +135,8 @@ def _run_rig(args: argparse.Namespace) -> int:
     jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
-    if args.quiet:
+    with _shown_progress(args, f"{total} tests on {jobs} processes"):
         manifest = run_campaign(campaign, args.out, jobs=args.jobs, force=args.force)
-    else:
-        with _progress_bar() as bar:
-            task = bar.add_task(f"{total} tests on {jobs} processes", total=total)
-            manifest = run_campaign(
-                campaign,
-                args.out,
-                jobs=args.jobs,
-                force=args.force,
-                progress=lambda done, _total: bar.update(task, completed=done),
-            )
     print(f"wrote {total} records and {manifest} in {time.perf_counter() - start:.1f} s")
     return 0
 
@@ -168,16 +160,8 @@ def _run_identify(args: argparse.Namespace) -> int:
 
     if args.figures:
         refuse_file_as_folder(args.figures, "--figures")
-    if args.quiet:
-        results, failures = identify_files(args.files, **options)
-    else:
-        with _progress_bar() as bar:
-            task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
-            results, failures = identify_files(
-                args.files,
-                **options,
-                progress=lambda done, _total: bar.update(task, completed=done),
-            )
+    with _shown_progress(args, f"identifying {len(args.files)} records") as shown:
+        results, failures = identify_files(args.files, **options, progress=shown)
     if not results and len(failures) == 1:
         raise ParameterError(f"no record could be used: {failures[0]}")  # one file, one line
     for line in failures:
@@ -212,20 +196,30 @@ def _run_reproduce(args: argparse.Namespace) -> int:
         )
     refuse_file_as_folder(args.out, "--out")
     start = time.perf_counter()
-    with optional_client(args.scheduler, args.workers) as client:  # None: the --jobs pool
+    with (
+        optional_client(args.scheduler, args.workers) as client,  # None: the --jobs pool
+        _shown_progress(args, "the virtual rig's campaign, then its analysis"),
+    ):
         written = reproduce(
             Path(args.out),
             force=args.force,
             jobs=args.jobs,
             executor=client,
             campaign_path=Path(args.campaign) if args.campaign else None,
-            progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+            progress=_stage_printer(args),
         )
     for path in written:
         print(f"wrote {path}")
     _print_findings(Path(args.out) / "results.json")
     print(f"done in {time.perf_counter() - start:.0f} s")
     return 0
+
+
+def _stage_printer(args: argparse.Namespace) -> Callable[[str], None]:
+    """Print each stage of a long job on stderr as ``- stage`` (nothing with --quiet)."""
+    if getattr(args, "quiet", False):
+        return lambda _message: None
+    return lambda message: print(f"- {message}", file=sys.stderr, flush=True)
 
 
 def _print_findings(results: Path) -> None:
@@ -255,7 +249,7 @@ def _run_report(args: argparse.Namespace) -> int:
         Path(args.records),
         Path(args.out),
         force=args.force,
-        progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+        progress=_stage_printer(args),
         warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
     )
     for path in written:
@@ -272,6 +266,102 @@ def _progress_bar(*columns: Any) -> Any:
     return Progress(
         *columns, console=Console(stderr=True), transient=True, disable=not sys.stderr.isatty()
     )
+
+
+#: Seconds between two progress lines when stderr is no terminal (a log file, a CI job).
+PROGRESS_EVERY_S = 10.0
+
+
+@contextlib.contextmanager
+def _shown_progress(
+    args: argparse.Namespace, what: str
+) -> Iterator[Callable[[float, float], None]]:
+    """Show how far the work inside has come; yield the listener ``(done, total)``.
+
+    On a terminal: a rich bar with the time left. Otherwise: one line when the work starts
+    (``what``), then one every :data:`PROGRESS_EVERY_S` seconds with the share done and the
+    time left. Nothing with ``--quiet``. The solvers' own reports (clearjoint.progress) go
+    to the same listener.
+    """
+    from clearjoint.progress import listening
+
+    if getattr(args, "quiet", False):
+        with listening(_stop_if_interrupted):
+            yield _stop_if_interrupted
+        return
+    if sys.stderr.isatty():
+        from rich.progress import Progress, TimeRemainingColumn
+
+        columns = (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
+        with _progress_bar(*columns) as bar:
+            task = bar.add_task(what, total=None)
+
+            def show(done: float, total: float) -> None:
+                _stop_if_interrupted(done, total)
+                bar.update(task, completed=done, total=total)
+
+            with listening(show):
+                yield show
+        return
+    print(f"clearjoint {args.command}: {what}", file=sys.stderr, flush=True)
+    start = last = time.perf_counter()
+
+    def line(done: float, total: float) -> None:
+        nonlocal last
+        _stop_if_interrupted(done, total)
+        now = time.perf_counter()
+        if now - last < PROGRESS_EVERY_S or done <= 0.0:
+            return
+        last = now
+        left = (now - start) * (total - done) / done
+        print(
+            f"clearjoint {args.command}: {100.0 * done / total:.0f} % done, "
+            f"about {_duration(left)} left",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    with listening(line):
+        yield line
+
+
+#: Set by Ctrl-C (see :func:`_on_interrupt`); stays set for the rest of the command.
+_CTRL_C = threading.Event()
+
+
+def _on_interrupt(_signum: int, _frame: Any) -> None:
+    """The command's SIGINT handler: note the Ctrl-C, then raise KeyboardInterrupt as Python does.
+
+    Raised inside a callback from compiled code (numba's compiler calls back into Python), the
+    KeyboardInterrupt is printed as "Exception ignored" and lost; the note makes the next
+    progress report (:func:`_stop_if_interrupted`), or the end of the command, stop it.
+    """
+    _CTRL_C.set()
+    raise KeyboardInterrupt
+
+
+def _unraisable(unraisable: Any) -> None:
+    """sys.unraisablehook: a Ctrl-C lost in a callback is noted (not printed as a traceback)."""
+    if isinstance(unraisable.exc_value, KeyboardInterrupt):
+        _CTRL_C.set()
+        return
+    sys.__unraisablehook__(unraisable)
+
+
+def _stop_if_interrupted(_done: float = 0.0, _total: float = 0.0) -> None:
+    """Raise KeyboardInterrupt if Ctrl-C was pressed (a progress listener, so it is checked
+    at every report of the solvers)."""
+    if _CTRL_C.is_set():
+        raise KeyboardInterrupt
+
+
+def _duration(seconds: float) -> str:
+    """A time span for a person: 40 s, 12 min, 3.5 h."""
+    if seconds < 120.0:
+        return f"{seconds:.0f} s"
+    if seconds < 7200.0:
+        return f"{seconds / 60.0:.0f} min"
+    return f"{seconds / 3600.0:.1f} h"
 
 
 @contextlib.contextmanager
@@ -321,23 +411,15 @@ def _run_sweep(args: argparse.Namespace) -> int:
             task = shown.add_task(f"{sweep.n_points} points", total=sweep.n_points)
             return lambda done, _total: shown.update(task, completed=done)
 
-        try:
-            results, kept = run_sweep_file(
-                args.sweep,
-                args.out,
-                scheduler=args.scheduler,
-                workers=args.workers,
-                resume=args.resume,
-                force=args.force,
-                progress=bar,
-            )
-        except KeyboardInterrupt:
-            print(
-                f"clearjoint sweep: interrupted; finished chunks are in {args.out}: "
-                f"run again with --resume to compute only the rest",
-                file=sys.stderr,
-            )
-            return 130
+        results, kept = run_sweep_file(  # Ctrl-C: main says what the store keeps
+            args.sweep,
+            args.out,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            resume=args.resume,
+            force=args.force,
+            progress=bar,
+        )
     failed = results.attrs["points_failed"]
     kept_text = f", {kept} of them kept from the store" if kept else ""
     print(
@@ -402,18 +484,19 @@ def _run_frf(args: argparse.Namespace) -> int:
         frequency = parse_quantity(args.frequency, "frequency", name="--frequency")
         if not (math.isfinite(frequency) and frequency > 0.0):
             raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
-    curve = frequency_response_of(
-        study,
-        start,
-        stop,
-        parameter=args.parameter,
-        frequency=frequency,
-        method=args.method,
-        harmonics=args.harmonics,
-        samples=args.samples,
-        max_points=args.max_points,
-        names=OPTION_NAMES,
-    )
+    with _shown_progress(args, f"following the curve from {args.start} to {args.stop}"):
+        curve = frequency_response_of(
+            study,
+            start,
+            stop,
+            parameter=args.parameter,
+            frequency=frequency,
+            method=args.method,
+            harmonics=args.harmonics,
+            samples=args.samples,
+            max_points=args.max_points,
+            names=OPTION_NAMES,
+        )
     write_curve(curve, args.out, study.source)
     _save_plot(curve, plot_path, quiet=True)
     for warning in curve_warnings(curve):
@@ -434,14 +517,15 @@ def _run_modes(args: argparse.Namespace) -> int:
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
     amplitudes = parse_amplitude_range(args.amplitude, args.points)
-    mode = nonlinear_modes_of(
-        study,
-        args.mode,
-        amplitudes,
-        harmonics=args.harmonics,
-        samples=args.samples,
-        names=OPTION_NAMES,
-    )
+    with _shown_progress(args, f"mode {args.mode} at {amplitudes.size} amplitudes"):
+        mode = nonlinear_modes_of(
+            study,
+            args.mode,
+            amplitudes,
+            harmonics=args.harmonics,
+            samples=args.samples,
+            names=OPTION_NAMES,
+        )
     write_curve(mode, args.out, study.source)
     _save_plot(mode, plot_path, quiet=True)
     for line in filter(None, mode.note.split("; ")):
@@ -461,7 +545,8 @@ def _run_structure(args: argparse.Namespace) -> int:
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
-    result = run_structure_task(study, args.task, figure=plot_path is not None)
+    with _shown_progress(args, f"{args.task} of {study.source}"):
+        result = run_structure_task(study, args.task, figure=plot_path is not None)
     write_structure_result(result, out)
     _save_plot(result.drawn, plot_path, quiet=True)
     if args.json:
@@ -484,6 +569,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         # at the end, skip the interpreter's collections over every object left (numpy's
         # modules: about 10 ms of each run); Python never promised their __del__ at exit
         atexit.register(gc.freeze)
+        signal.signal(signal.SIGINT, _on_interrupt)  # Ctrl-C noted, not only raised
+        sys.unraisablehook = _unraisable
     parser = build_parser()
     args = parser.parse_args(argv)
     started = time.time()
@@ -503,9 +590,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with warnings.catch_warnings(), _harmonic_progress(args.command):
             warnings.showwarning = _warning_printer(args.command)
-            return runners[args.command](args)
+            code = runners[args.command](args)
+            _stop_if_interrupted()  # a Ctrl-C that compiled code swallowed
+            return code
     except KeyboardInterrupt:  # Ctrl-C: one line, exit 130, as a shell reports SIGINT
-        return _interrupted(args, started)
+        return _interrupted(args, started, end=argv is None)
     except BrokenPipeError:  # the reader stopped early (| head): not an error of ours
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so the exit's flush does not raise again
@@ -525,7 +614,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     except Exception as exc:  # Ctrl-C inside compiled code arrives wrapped (a SystemError)
         if _caused_by_interrupt(exc):
-            return _interrupted(args, started)
+            return _interrupted(args, started, end=argv is None)
         raise
 
 
@@ -551,10 +640,14 @@ def _caused_by_interrupt(exc: BaseException) -> bool:
     return False
 
 
-def _interrupted(args: argparse.Namespace, started: float) -> int:
+def _interrupted(args: argparse.Namespace, started: float, *, end: bool = False) -> int:
     """Say in one line that the command was interrupted and what it left; return 130.
 
     A file output (--out, --plot) written since the command started is incomplete: removed.
+    With ``end`` (the command itself, not a caller of main) the process ends here with 130:
+    the work was stopped and its pools and clusters closed on the way out, and the
+    interpreter's own shutdown, whose signal handlers are the default ones again, would
+    otherwise die of a Ctrl-C pressed twice (exit -2, a traceback from a library's atexit).
     """
     removed = []
     for option in ("out", "plot"):
@@ -571,4 +664,9 @@ def _interrupted(args: argparse.Namespace, started: float) -> int:
         f"clearjoint {args.command}: interrupted; " + left.format(out=getattr(args, "out", "")),
         file=sys.stderr,
     )
+    if end:
+        with contextlib.suppress(OSError, ValueError):
+            sys.stdout.flush()
+            sys.stderr.flush()
+        os._exit(130)
     return 130

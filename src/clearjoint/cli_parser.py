@@ -74,6 +74,7 @@ def _stiffness_parser(sub: Any) -> None:
 
 _JSON_TABLE = "print one JSON object instead of a table"
 _JOBS = "processes (default: every core)"
+_QUIET = "no progress bar or progress lines on stderr"
 
 
 def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
@@ -153,7 +154,7 @@ def _reproduce_parser(sub: Any) -> None:
         "(its workers must see --out)",
     )
     p.add_argument("--workers", type=int, help="run them on a local Dask cluster of N workers")
-    _flags(p, force="overwrite existing output files")
+    _flags(p, force="overwrite existing output files", quiet=_QUIET)
 
 
 def _report_parser(sub: Any) -> None:
@@ -167,7 +168,7 @@ def _report_parser(sub: Any) -> None:
     )
     p.add_argument("--records", required=True, help="folder of record files")
     p.add_argument("--out", default="clearjoint-report", help="output folder")
-    _flags(p, force="overwrite existing output files")
+    _flags(p, force="overwrite existing output files", quiet=_QUIET)
 
 
 def _simulate_parser(sub: Any) -> None:
@@ -266,7 +267,7 @@ def _frf_parser(sub: Any) -> None:
     )
     _options(p, frequency="fixed frequency with --parameter force, e.g. 400Hz")
     p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
-    _flags(p, force="overwrite --out / --plot if they exist")
+    _flags(p, force="overwrite --out / --plot if they exist", quiet=_QUIET)
     p.add_argument(
         "--method",
         choices=["shooting", "harmonic"],
@@ -348,6 +349,7 @@ def _modes_parser(sub: Any) -> None:
         p,
         json="print the mode as one JSON object",
         force="overwrite --out / --plot if they exist",
+        quiet=_QUIET,
     )
 
 
@@ -365,7 +367,7 @@ def _structure_parser(sub: Any) -> None:
     p.add_argument("task", choices=("modes", "respond", "decay"), help="what to compute")
     p.add_argument("--out", required=True, help="netCDF results file (.nc)")
     _add_plot_option(p, force=False)
-    _flags(p, json="print a JSON summary", force="overwrite existing output")
+    _flags(p, json="print a JSON summary", force="overwrite existing output", quiet=_QUIET)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -38,6 +38,7 @@ from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import quantity, read_toml
 from clearjoint.joint import Friction, Joint, Losses, Pin
 from clearjoint.parallel import process_pool, run_unordered
+from clearjoint.progress import report
 from clearjoint.records import Record, record_suffixes, write_record
 from clearjoint.simulate import SimulationError, steady_state, time_response
 
@@ -560,6 +561,7 @@ def run_campaign(
     force: bool = False,
     progress: Callable[[int, int], None] | None = None,
     executor: Any = None,
+    keep_journal: bool = False,
 ) -> Path:
     """Run every test of ``campaign`` and write its records and ``manifest.csv`` to ``out_dir``.
 
@@ -570,10 +572,12 @@ def run_campaign(
     whatever the order the workers finish in. ``progress(done, total)`` is called
     after each test. Returns the manifest's path.
 
-    Each finished test is noted in ``out_dir/campaign-progress.jsonl`` (removed once the
-    manifest is written): a run of the same campaign into a folder that an interrupted
-    run left keeps its finished records and simulates only the rest (the manifest is the
-    same as an uninterrupted run's); ``force`` starts afresh.
+    Each finished test is noted in ``out_dir/campaign-progress.jsonl``: a run of the same
+    campaign into a folder that an interrupted run left keeps its finished records and
+    simulates only the rest (the manifest is the same as an uninterrupted run's);
+    ``force`` starts afresh. The note is removed once the manifest is written, unless
+    ``keep_journal`` (a caller with more to do after the campaign removes it when that is
+    done, so that a rerun after an interruption there still finds every record).
 
     Raises
     ------
@@ -609,11 +613,13 @@ def run_campaign(
                 log.flush()
                 if progress:
                     progress(len(rows), len(tasks))
+                report(len(rows), len(tasks))  # to a listening progress bar (clearjoint.progress)
     manifest = out_dir / "manifest.csv"
     with manifest.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=MANIFEST_COLUMNS)
         writer.writeheader()
         for index in sorted(rows):
             writer.writerow({key: rows[index][key] for key in MANIFEST_COLUMNS})
-    journal.unlink()
+    if not keep_journal:
+        journal.unlink()
     return manifest
