@@ -66,7 +66,9 @@ def _run_stiffness(args: argparse.Namespace) -> int:
     from clearjoint.studies import joint_at
     from clearjoint.studies.text import json_value, stiffness_lines, stiffness_table
 
-    joint = joint_at(None, study_values(args), OPTION_NAMES)
+    given = study_values(args)
+    _warn_unusual(args.command, given)
+    joint = joint_at(None, given, OPTION_NAMES)
     amplitudes = amplitude_values(args)
     plot = _plot_target(args)
     _save_plot(stiffness.stiffness_curve(joint, amplitudes), plot, quiet=args.json)
@@ -86,6 +88,7 @@ def _run_dissipation(args: argparse.Namespace) -> int:
 
     base = load_study(args.study) if args.study else None
     given = study_values(args)
+    _warn_unusual(args.command, given)
     joint = joint_at(base.joint if base is not None else None, given, OPTION_NAMES)
     losses = losses_at(base, joint, given, OPTION_NAMES)
     amplitudes = amplitude_values(args)
@@ -100,6 +103,14 @@ def _run_dissipation(args: argparse.Namespace) -> int:
     else:
         print("\n".join(dissipation_lines(joint, losses, amplitudes, values)))
     return 0
+
+
+def _warn_unusual(command: str, given: dict[str, Any]) -> None:
+    """One warning line for each value legal but unusual for a pin joint (clearjoint.plausible)."""
+    from clearjoint.plausible import unusual_values
+
+    for note in unusual_values(given, OPTION_NAMES):
+        print(f"clearjoint {command}: warning: {note}", file=sys.stderr)
 
 
 def _run_simulate(args: argparse.Namespace) -> int:
@@ -198,7 +209,7 @@ def _run_reproduce(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     with (
         optional_client(args.scheduler, args.workers) as client,  # None: the --jobs pool
-        _shown_progress(args, "the virtual rig's campaign, then its analysis"),
+        _shown_progress(args, "the virtual rig's campaign", announce=False),
     ):
         written = reproduce(
             Path(args.out),
@@ -274,55 +285,62 @@ PROGRESS_EVERY_S = 10.0
 
 @contextlib.contextmanager
 def _shown_progress(
-    args: argparse.Namespace, what: str
+    args: argparse.Namespace, what: str, *, announce: bool = True
 ) -> Iterator[Callable[[float, float], None]]:
     """Show how far the work inside has come; yield the listener ``(done, total)``.
 
     On a terminal: a rich bar with the time left. Otherwise: one line when the work starts
-    (``what``), then one every :data:`PROGRESS_EVERY_S` seconds with the share done and the
-    time left. Nothing with ``--quiet``. The solvers' own reports (clearjoint.progress) go
-    to the same listener.
+    (``what``; with ``announce`` False, at the first report instead, for work that may still
+    refuse its input in one line), then one every :data:`PROGRESS_EVERY_S` seconds with the
+    share done and the time left. Nothing with ``--quiet``. The solvers' own reports
+    (clearjoint.progress) go to the same listener; the first series of reports to finish
+    (done = total) ends the display, so that the smaller loops of the work that follows
+    (a study's analysis after its campaign) do not restart it.
     """
     from clearjoint.progress import listening
 
-    if getattr(args, "quiet", False):
-        with listening(_stop_if_interrupted):
-            yield _stop_if_interrupted
-        return
-    if sys.stderr.isatty():
-        from rich.progress import Progress, TimeRemainingColumn
+    quiet = getattr(args, "quiet", False)
+    terminal = not quiet and sys.stderr.isatty()
+    seen = {"done": 0.0, "finished": False, "announced": announce or quiet, "at": 0.0}
+    start = time.perf_counter()
 
-        columns = (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
-        with _progress_bar(*columns) as bar:
-            task = bar.add_task(what, total=None)
+    def say(text: str) -> None:
+        print(f"clearjoint {args.command}: {text}", file=sys.stderr, flush=True)
 
-            def show(done: float, total: float) -> None:
-                _stop_if_interrupted(done, total)
+    if announce and not quiet and not terminal:
+        say(what)
+    with contextlib.ExitStack() as stack:
+        bar = stack.enter_context(_progress_bar(*_bar_columns())) if terminal else None
+        task = bar.add_task(what, total=None) if bar is not None else None
+
+        def listener(done: float, total: float) -> None:
+            _stop_if_interrupted()
+            if quiet or seen["finished"]:
+                return
+            seen["done"] = done = max(done, float(seen["done"]))  # a fold may step back
+            seen["finished"] = done >= total
+            if bar is not None:
                 bar.update(task, completed=done, total=total)
+                return
+            if not seen["announced"]:
+                seen["announced"] = True
+                say(what)
+            now = time.perf_counter()
+            if now - max(start, float(seen["at"])) < PROGRESS_EVERY_S or done <= 0.0:
+                return
+            seen["at"] = now
+            left = (now - start) * (total - done) / done
+            say(f"{100.0 * done / total:.0f} % done, about {_duration(left)} left")
 
-            with listening(show):
-                yield show
-        return
-    print(f"clearjoint {args.command}: {what}", file=sys.stderr, flush=True)
-    start = last = time.perf_counter()
+        stack.enter_context(listening(listener))
+        yield listener
 
-    def line(done: float, total: float) -> None:
-        nonlocal last
-        _stop_if_interrupted(done, total)
-        now = time.perf_counter()
-        if now - last < PROGRESS_EVERY_S or done <= 0.0:
-            return
-        last = now
-        left = (now - start) * (total - done) / done
-        print(
-            f"clearjoint {args.command}: {100.0 * done / total:.0f} % done, "
-            f"about {_duration(left)} left",
-            file=sys.stderr,
-            flush=True,
-        )
 
-    with listening(line):
-        yield line
+def _bar_columns() -> tuple[Any, ...]:
+    """The progress bar's columns: rich's default ones, the time left last."""
+    from rich.progress import Progress, TimeRemainingColumn
+
+    return (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
 
 
 #: Set by Ctrl-C (see :func:`_on_interrupt`); stays set for the rest of the command.
@@ -443,6 +461,7 @@ def _plot_sweep(args: argparse.Namespace) -> int:
 
 
 def _run_frf(args: argparse.Namespace) -> int:
+    from clearjoint.budget import check_budget
     from clearjoint.structure.study import StructureStudy
     from clearjoint.studies import (
         curve_summary,
@@ -466,6 +485,8 @@ def _run_frf(args: argparse.Namespace) -> int:
     for option, text, value in (("--from", args.start, start), ("--to", args.stop, stop)):
         if not (math.isfinite(value) and value > 0.0):
             raise ParameterError(f"{option} must be finite and > 0, got {text!r}")
+        if kind == "frequency":
+            _warn_rpm(args.command, option, text, value)
     if start == stop:
         raise ParameterError(
             f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
@@ -474,6 +495,9 @@ def _run_frf(args: argparse.Namespace) -> int:
     if args.max_points < 2:
         raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
     structure = isinstance(study, StructureStudy)
+    if not args.allow_long:
+        kind_of_point = "structure curve point" if structure else "joint curve point"
+        check_budget(args.max_points, kind_of_point, option="--max-points")
     for option, given in (("--harmonics", args.harmonics), ("--samples", args.samples)):
         if args.method != "harmonic" and given is not None and not structure:
             raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")
@@ -484,6 +508,7 @@ def _run_frf(args: argparse.Namespace) -> int:
         frequency = parse_quantity(args.frequency, "frequency", name="--frequency")
         if not (math.isfinite(frequency) and frequency > 0.0):
             raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
+        _warn_rpm(args.command, "--frequency", args.frequency, frequency)
     with _shown_progress(args, f"following the curve from {args.start} to {args.stop}"):
         curve = frequency_response_of(
             study,
@@ -509,13 +534,28 @@ def _run_frf(args: argparse.Namespace) -> int:
     return 0
 
 
+def _warn_rpm(command: str, option: str, text: str, hz: float) -> None:
+    """Warn in one line when a frequency option was written in rpm (clearjoint.plausible)."""
+    from clearjoint.plausible import rpm_note
+
+    note = rpm_note(text, hz, option)
+    if note is not None:
+        print(f"clearjoint {command}: warning: {note}", file=sys.stderr)
+
+
 def _run_modes(args: argparse.Namespace) -> int:
+    from clearjoint.budget import check_budget
+    from clearjoint.structure.study import StructureStudy
     from clearjoint.studies import load_any_study, mode_summary, nonlinear_modes_of, write_curve
     from clearjoint.units import parse_amplitude_range
 
     study = load_any_study(args.study)
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
+    if not args.allow_long and ".." in args.amplitude:  # before the amplitudes are made
+        structure = isinstance(study, StructureStudy)
+        kind = "structure mode amplitude" if structure else "joint mode amplitude"
+        check_budget(args.points, kind, option="--points")
     amplitudes = parse_amplitude_range(args.amplitude, args.points)
     with _shown_progress(args, f"mode {args.mode} at {amplitudes.size} amplitudes"):
         mode = nonlinear_modes_of(
@@ -545,7 +585,7 @@ def _run_structure(args: argparse.Namespace) -> int:
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
-    with _shown_progress(args, f"{args.task} of {study.source}"):
+    with _shown_progress(args, f"{args.task} of {study.source}", announce=False):
         result = run_structure_task(study, args.task, figure=plot_path is not None)
     write_structure_result(result, out)
     _save_plot(result.drawn, plot_path, quiet=True)

@@ -75,6 +75,7 @@ def _stiffness_parser(sub: Any) -> None:
 _JSON_TABLE = "print one JSON object instead of a table"
 _JOBS = "processes (default: every core)"
 _QUIET = "no progress bar or progress lines on stderr"
+_ALLOW_LONG = "run a request estimated above an hour (refused otherwise, with the estimate)"
 
 
 def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
@@ -267,6 +268,7 @@ def _frf_parser(sub: Any) -> None:
     )
     _options(p, frequency="fixed frequency with --parameter force, e.g. 400Hz")
     p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
+    _flags(p, allow_long=_ALLOW_LONG)
     _flags(p, force="overwrite --out / --plot if they exist", quiet=_QUIET)
     p.add_argument(
         "--method",
@@ -342,6 +344,7 @@ def _modes_parser(sub: Any) -> None:
         "--amplitude", required=True, help="modal amplitude range, e.g. 1um..1mm (or one value)"
     )
     p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
+    _flags(p, allow_long=_ALLOW_LONG)
     _add_harmonic_options(p, "H")
     p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
     _add_plot_option(p, force=False)
