@@ -7,7 +7,10 @@ long commands show progress, as lines every few seconds when stderr is no termin
 
 from __future__ import annotations
 
+import argparse
+import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -150,3 +153,70 @@ def test_progress_without_a_terminal_is_a_line_now_and_then(
     code, _, err = _run([*args, "--out", str(tmp_path / "b.nc"), "--quiet"], capsys)
     assert code == 0
     assert [line for line in err.splitlines() if "warning" not in line] == []
+
+
+def _subcommands() -> dict[str, argparse.ArgumentParser]:
+    from clearjoint.cli_parser import build_parser
+
+    parser = build_parser()
+    (sub,) = (a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return dict(sub.choices)
+
+
+def test_every_default_is_shown_in_help() -> None:
+    """Each option with a default value names it in its --help text (none forgotten)."""
+    missing = []
+    for name, sub in _subcommands().items():
+        for action in sub._actions:
+            shown = action.default not in (None, False, argparse.SUPPRESS)
+            if not action.option_strings or not shown:
+                continue
+            if "default" not in sub._get_formatter()._expand_help(action):  # as --help prints
+                missing.append(f"{name} {action.option_strings[-1]}")
+    assert missing == []
+    help_text = " ".join(_subcommands()["reproduce"].format_help().split())
+    assert "(default clearjoint-reproduction)" in help_text  # one argparse did not show
+
+
+def test_options_mean_one_thing_with_one_default_everywhere() -> None:
+    commands = _subcommands()
+    for name in ("rig", "reproduce", "identify"):
+        (jobs,) = (a for a in commands[name]._actions if "--jobs" in a.option_strings)
+        assert jobs.default is None, name  # every core, in each
+        assert "every core" in (jobs.help or ""), name
+    for name in ("rig", "identify", "sweep", "reproduce", "report", "frf", "modes", "structure"):
+        assert any("--quiet" in a.option_strings for a in commands[name]._actions), name
+    (region,) = (a for a in commands["dissipation"]._actions if a.dest == "friction_region")
+    assert "free-play stroke only" in (region.help or "")
+    for name in ("stiffness", "dissipation", "modes"):
+        (amplitude,) = (a for a in commands[name]._actions if a.dest == "amplitude")
+        assert "one (5um), a list (1um,5um,20um) or a range (1um..1mm" in (amplitude.help or "")
+
+
+def test_an_amplitude_range_reads_the_same_in_stiffness_as_in_modes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """1um..100um with 3 points is 1, 10 and 100 um (log spacing), as the list says them."""
+    joint = ["--mass", "2kg", "--stiffness", "8e7N/m", "--clearance", "0.106mm", "--json"]
+    code, ranged, _ = _run(
+        ["stiffness", *joint, "--amplitude", "1um..100um", "--points", "3"], capsys
+    )
+    assert code == 0
+    code, listed, _ = _run(["stiffness", *joint, "--amplitude", "1um,10um,100um"], capsys)
+    assert code == 0
+    assert json.loads(ranged)["amplitude_m"] == pytest.approx([1e-6, 1e-5, 1e-4], rel=1e-12)
+    assert json.loads(ranged) == pytest.approx(json.loads(listed), rel=1e-12)
+
+    seen: list[list[float]] = []
+
+    def solver(_study: object, _mode: int, amplitudes: Any, **_: object) -> None:
+        seen.append(list(amplitudes))
+        raise ParameterError("stopped")
+
+    monkeypatch.setattr(studies, "nonlinear_modes_of", solver)
+    out = ["--out", str(tmp_path / "m.nc"), "--quiet"]
+    assert cli.main(["modes", FRF, "--amplitude", "1um,10um,100um", *out]) == 2
+    assert len(seen) == 1
+    assert seen[0] == pytest.approx([1e-6, 1e-5, 1e-4], rel=1e-12)
+    assert cli.main(["modes", FRF, "--amplitude", "10um,1um", *out]) == 2
+    assert "must be above zero and ascending" in capsys.readouterr().err

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import itertools
 import json
 import logging
 import math
@@ -162,12 +163,13 @@ def _run_identify(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .csv or .nc, got {out.name!r}")
     if not 0.0 < args.tolerance < 1.0:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
-    if args.jobs < 1:
+    if args.jobs is not None and args.jobs < 1:
         raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    jobs = args.jobs or os.cpu_count() or 1  # every core by default, as rig and reproduce
     plot = _plot_target(args)  # a figure suffix, not overwritten unless --force
     refuse_to_overwrite([out], force=args.force)
     out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
-    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
+    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": jobs}
 
     if args.figures:
         refuse_file_as_folder(args.figures, "--figures")
@@ -547,7 +549,6 @@ def _run_modes(args: argparse.Namespace) -> int:
     from clearjoint.budget import check_budget
     from clearjoint.structure.study import StructureStudy
     from clearjoint.studies import load_any_study, mode_summary, nonlinear_modes_of, write_curve
-    from clearjoint.units import parse_amplitude_range
 
     study = load_any_study(args.study)
     _netcdf_target(args)  # before the run, not after
@@ -556,7 +557,13 @@ def _run_modes(args: argparse.Namespace) -> int:
         structure = isinstance(study, StructureStudy)
         kind = "structure mode amplitude" if structure else "joint mode amplitude"
         check_budget(args.points, kind, option="--points")
-    amplitudes = parse_amplitude_range(args.amplitude, args.points)
+    amplitudes = (amplitude_values if "," in args.amplitude else _amplitude_range)(args)
+    listed = amplitudes.tolist()
+    if min(listed) <= 0.0 or any(b <= a for a, b in itertools.pairwise(listed)):
+        raise ParameterError(
+            f"--amplitude {args.amplitude}: a mode's amplitudes must be above zero and "
+            "ascending, e.g. 1um,5um,20um or 1um..1mm"
+        )
     with _shown_progress(args, f"mode {args.mode} at {amplitudes.size} amplitudes"):
         mode = nonlinear_modes_of(
             study,
@@ -576,6 +583,13 @@ def _run_modes(args: argparse.Namespace) -> int:
     wrote = f"wrote {args.out}" + (f" and {args.plot}" if args.plot else "")
     print("\n".join([f"study: {study.source}", repr(mode), wrote]))
     return 0
+
+
+def _amplitude_range(args: argparse.Namespace) -> Any:
+    """A mode's --amplitude as one value or a range (clearjoint.units.parse_amplitude_range)."""
+    from clearjoint.units import parse_amplitude_range
+
+    return parse_amplitude_range(args.amplitude, args.points)
 
 
 def _run_structure(args: argparse.Namespace) -> int:
