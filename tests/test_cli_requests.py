@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 
-from clearjoint import cli, studies
+from clearjoint import cli, cli_progress, studies
 from clearjoint.errors import ParameterError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -141,7 +141,10 @@ def test_progress_without_a_terminal_is_a_line_now_and_then(
 ) -> None:
     """stderr is no terminal under pytest: a first line, then the share done and the time
     left (every report here, the interval set to 0); --quiet: none of it."""
-    monkeypatch.setattr(cli, "PROGRESS_EVERY_S", 0.0)
+    monkeypatch.setattr(cli_progress, "PROGRESS_EVERY_S", 0.0)
+    monkeypatch.setattr(
+        cli_progress, "PROGRESS_LINES_IN_PROCESS", True
+    )  # as the command prints them
     args = ["modes", FRF, "--amplitude", "10um..100um", "--points", "4", "--harmonics", "3"]
     code, _, err = _run([*args, "--out", str(tmp_path / "a.nc")], capsys)
     assert code == 0, err

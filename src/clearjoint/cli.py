@@ -22,13 +22,13 @@ import math
 import os
 import signal
 import sys
-import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from clearjoint import cli_progress
 from clearjoint.checks import figure_target, netcdf_target, refuse_file_as_folder
 from clearjoint.cli_parser import (
     EXIT_BAD_INPUT,
@@ -147,7 +147,7 @@ def _run_rig(args: argparse.Namespace) -> int:
     jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
-    with _shown_progress(args, f"{total} tests on {jobs} processes"):
+    with cli_progress.shown_progress(args, f"{total} tests on {jobs} processes"):
         manifest = run_campaign(campaign, args.out, jobs=args.jobs, force=args.force)
     print(f"wrote {total} records and {manifest} in {time.perf_counter() - start:.1f} s")
     return 0
@@ -173,7 +173,7 @@ def _run_identify(args: argparse.Namespace) -> int:
 
     if args.figures:
         refuse_file_as_folder(args.figures, "--figures")
-    with _shown_progress(args, f"identifying {len(args.files)} records") as shown:
+    with cli_progress.shown_progress(args, f"identifying {len(args.files)} records") as shown:
         results, failures = identify_files(args.files, **options, progress=shown)
     if not results and len(failures) == 1:
         raise ParameterError(f"no record could be used: {failures[0]}")  # one file, one line
@@ -211,7 +211,7 @@ def _run_reproduce(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     with (
         optional_client(args.scheduler, args.workers) as client,  # None: the --jobs pool
-        _shown_progress(args, "the virtual rig's campaign", announce=False),
+        cli_progress.shown_progress(args, "the virtual rig's campaign"),
     ):
         written = reproduce(
             Path(args.out),
@@ -271,119 +271,6 @@ def _run_report(args: argparse.Namespace) -> int:
     return 0
 
 
-def _progress_bar(*columns: Any) -> Any:
-    """A rich progress bar on stderr, drawn only on a terminal (stdout stays the output)."""
-    from rich.console import Console
-    from rich.progress import Progress
-
-    return Progress(
-        *columns, console=Console(stderr=True), transient=True, disable=not sys.stderr.isatty()
-    )
-
-
-#: Seconds between two progress lines when stderr is no terminal (a log file, a CI job).
-PROGRESS_EVERY_S = 10.0
-
-
-@contextlib.contextmanager
-def _shown_progress(
-    args: argparse.Namespace, what: str, *, announce: bool = True
-) -> Iterator[Callable[[float, float], None]]:
-    """Show how far the work inside has come; yield the listener ``(done, total)``.
-
-    On a terminal: a rich bar with the time left. Otherwise: one line when the work starts
-    (``what``; with ``announce`` False, at the first report instead, for work that may still
-    refuse its input in one line), then one every :data:`PROGRESS_EVERY_S` seconds with the
-    share done and the time left. Nothing with ``--quiet``. The solvers' own reports
-    (clearjoint.progress) go to the same listener; the first series of reports to finish
-    (done = total) ends the display, so that the smaller loops of the work that follows
-    (a study's analysis after its campaign) do not restart it.
-    """
-    from clearjoint.progress import listening
-
-    quiet = getattr(args, "quiet", False)
-    terminal = not quiet and sys.stderr.isatty()
-    seen = {"done": 0.0, "finished": False, "announced": announce or quiet, "at": 0.0}
-    start = time.perf_counter()
-
-    def say(text: str) -> None:
-        print(f"clearjoint {args.command}: {text}", file=sys.stderr, flush=True)
-
-    if announce and not quiet and not terminal:
-        say(what)
-    with contextlib.ExitStack() as stack:
-        bar = stack.enter_context(_progress_bar(*_bar_columns())) if terminal else None
-        task = bar.add_task(what, total=None) if bar is not None else None
-
-        def listener(done: float, total: float) -> None:
-            _stop_if_interrupted()
-            if quiet or seen["finished"]:
-                return
-            seen["done"] = done = max(done, float(seen["done"]))  # a fold may step back
-            seen["finished"] = done >= total
-            if bar is not None:
-                bar.update(task, completed=done, total=total)
-                return
-            if not seen["announced"]:
-                seen["announced"] = True
-                say(what)
-            now = time.perf_counter()
-            if now - max(start, float(seen["at"])) < PROGRESS_EVERY_S or done <= 0.0:
-                return
-            seen["at"] = now
-            left = (now - start) * (total - done) / done
-            say(f"{100.0 * done / total:.0f} % done, about {_duration(left)} left")
-
-        stack.enter_context(listening(listener))
-        yield listener
-
-
-def _bar_columns() -> tuple[Any, ...]:
-    """The progress bar's columns: rich's default ones, the time left last."""
-    from rich.progress import Progress, TimeRemainingColumn
-
-    return (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
-
-
-#: Set by Ctrl-C (see :func:`_on_interrupt`); stays set for the rest of the command.
-_CTRL_C = threading.Event()
-
-
-def _on_interrupt(_signum: int, _frame: Any) -> None:
-    """The command's SIGINT handler: note the Ctrl-C, then raise KeyboardInterrupt as Python does.
-
-    Raised inside a callback from compiled code (numba's compiler calls back into Python), the
-    KeyboardInterrupt is printed as "Exception ignored" and lost; the note makes the next
-    progress report (:func:`_stop_if_interrupted`), or the end of the command, stop it.
-    """
-    _CTRL_C.set()
-    raise KeyboardInterrupt
-
-
-def _unraisable(unraisable: Any) -> None:
-    """sys.unraisablehook: a Ctrl-C lost in a callback is noted (not printed as a traceback)."""
-    if isinstance(unraisable.exc_value, KeyboardInterrupt):
-        _CTRL_C.set()
-        return
-    sys.__unraisablehook__(unraisable)
-
-
-def _stop_if_interrupted(_done: float = 0.0, _total: float = 0.0) -> None:
-    """Raise KeyboardInterrupt if Ctrl-C was pressed (a progress listener, so it is checked
-    at every report of the solvers)."""
-    if _CTRL_C.is_set():
-        raise KeyboardInterrupt
-
-
-def _duration(seconds: float) -> str:
-    """A time span for a person: 40 s, 12 min, 3.5 h."""
-    if seconds < 120.0:
-        return f"{seconds:.0f} s"
-    if seconds < 7200.0:
-        return f"{seconds / 60.0:.0f} min"
-    return f"{seconds / 3600.0:.1f} h"
-
-
 @contextlib.contextmanager
 def _harmonic_progress(command: str) -> Any:
     """Print clearjoint.harmonic's progress lines (its slow start) on stderr, one line each."""
@@ -427,7 +314,7 @@ def _run_sweep(args: argparse.Namespace) -> int:
             from rich.progress import Progress, TimeRemainingColumn
 
             columns = (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
-            shown = stack.enter_context(_progress_bar(*columns))
+            shown = stack.enter_context(cli_progress.progress_bar(*columns))
             task = shown.add_task(f"{sweep.n_points} points", total=sweep.n_points)
             return lambda done, _total: shown.update(task, completed=done)
 
@@ -511,7 +398,7 @@ def _run_frf(args: argparse.Namespace) -> int:
         if not (math.isfinite(frequency) and frequency > 0.0):
             raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
         _warn_rpm(args.command, "--frequency", args.frequency, frequency)
-    with _shown_progress(args, f"following the curve from {args.start} to {args.stop}"):
+    with cli_progress.shown_progress(args, f"following the curve from {args.start} to {args.stop}"):
         curve = frequency_response_of(
             study,
             start,
@@ -564,7 +451,7 @@ def _run_modes(args: argparse.Namespace) -> int:
             f"--amplitude {args.amplitude}: a mode's amplitudes must be above zero and "
             "ascending, e.g. 1um,5um,20um or 1um..1mm"
         )
-    with _shown_progress(args, f"mode {args.mode} at {amplitudes.size} amplitudes"):
+    with cli_progress.shown_progress(args, f"mode {args.mode} at {amplitudes.size} amplitudes"):
         mode = nonlinear_modes_of(
             study,
             args.mode,
@@ -599,7 +486,7 @@ def _run_structure(args: argparse.Namespace) -> int:
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
-    with _shown_progress(args, f"{args.task} of {study.source}", announce=False):
+    with cli_progress.shown_progress(args, f"{args.task} of {study.source}"):
         result = run_structure_task(study, args.task, figure=plot_path is not None)
     write_structure_result(result, out)
     _save_plot(result.drawn, plot_path, quiet=True)
@@ -623,10 +510,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         # at the end, skip the interpreter's collections over every object left (numpy's
         # modules: about 10 ms of each run); Python never promised their __del__ at exit
         atexit.register(gc.freeze)
-        signal.signal(signal.SIGINT, _on_interrupt)  # Ctrl-C noted, not only raised
-        sys.unraisablehook = _unraisable
+        signal.signal(signal.SIGINT, cli_progress.on_interrupt)  # Ctrl-C noted, not only raised
+        sys.unraisablehook = cli_progress.unraisable
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.progress_lines = argv is None or cli_progress.PROGRESS_LINES_IN_PROCESS
     started = time.time()
     runners = {
         "stiffness": _run_stiffness,
@@ -645,10 +533,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         with warnings.catch_warnings(), _harmonic_progress(args.command):
             warnings.showwarning = _warning_printer(args.command)
             code = runners[args.command](args)
-            _stop_if_interrupted()  # a Ctrl-C that compiled code swallowed
+            cli_progress.stop_if_interrupted()  # a Ctrl-C that compiled code swallowed
             return code
     except KeyboardInterrupt:  # Ctrl-C: one line, exit 130, as a shell reports SIGINT
-        return _interrupted(args, started, end=argv is None)
+        return cli_progress.interrupted(args, started, end=argv is None)
     except BrokenPipeError:  # the reader stopped early (| head): not an error of ours
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so the exit's flush does not raise again
@@ -667,60 +555,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         return EXIT_BAD_INPUT
     except Exception as exc:  # Ctrl-C inside compiled code arrives wrapped (a SystemError)
-        if _caused_by_interrupt(exc):
-            return _interrupted(args, started, end=argv is None)
+        if cli_progress.caused_by_interrupt(exc):
+            return cli_progress.interrupted(args, started, end=argv is None)
         raise
-
-
-#: What an interrupted command leaves, beyond its partial files (removed), by command.
-_LEFT_ON_INTERRUPT = {
-    "rig": "the finished records are kept in {out}: run the same command again to "
-    "simulate only the rest",
-    "reproduce": "the finished records are kept in {out}/records: run the same command "
-    "again to simulate only the rest",
-    "sweep": "finished chunks are in {out}: run again with --resume to compute only the rest",
-}
-
-
-def _caused_by_interrupt(exc: BaseException) -> bool:
-    """Whether a KeyboardInterrupt is ``exc`` or in the chain of errors that led to it."""
-    seen: set[int] = set()
-    current: BaseException | None = exc
-    while current is not None and id(current) not in seen:
-        if isinstance(current, KeyboardInterrupt):
-            return True
-        seen.add(id(current))
-        current = current.__cause__ or current.__context__
-    return False
-
-
-def _interrupted(args: argparse.Namespace, started: float, *, end: bool = False) -> int:
-    """Say in one line that the command was interrupted and what it left; return 130.
-
-    A file output (--out, --plot) written since the command started is incomplete: removed.
-    With ``end`` (the command itself, not a caller of main) the process ends here with 130:
-    the work was stopped and its pools and clusters closed on the way out, and the
-    interpreter's own shutdown, whose signal handlers are the default ones again, would
-    otherwise die of a Ctrl-C pressed twice (exit -2, a traceback from a library's atexit).
-    """
-    removed = []
-    for option in ("out", "plot"):
-        name = getattr(args, option, None)
-        path = Path(name) if isinstance(name, str) else None
-        if path is not None and path.is_file() and path.stat().st_mtime >= started - 1.0:
-            with contextlib.suppress(OSError):
-                path.unlink()
-                removed.append(str(path))
-    left = _LEFT_ON_INTERRUPT.get(args.command, "nothing written")
-    if removed:
-        left = f"removed the incomplete {' and '.join(removed)}"
-    print(
-        f"clearjoint {args.command}: interrupted; " + left.format(out=getattr(args, "out", "")),
-        file=sys.stderr,
-    )
-    if end:
-        with contextlib.suppress(OSError, ValueError):
-            sys.stdout.flush()
-            sys.stderr.flush()
-        os._exit(130)
-    return 130
