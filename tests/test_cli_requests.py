@@ -151,7 +151,9 @@ def test_progress_without_a_terminal_is_a_line_now_and_then(
     lines = [line for line in err.splitlines() if "warning" not in line]
     assert lines[0] == "clearjoint modes: mode 1 at 4 amplitudes"
     shares = [line.split(": ")[1].split(" %")[0] for line in lines[1:]]
-    assert shares == ["25", "50", "75", "100"]  # one amplitude of 4 at a time
+    # one amplitude of 4 at a time; the first report starts the clock the time left is
+    # estimated from (a compile may come before it), so the first share said is 50 %
+    assert shares == ["50", "75", "100"]
     assert all(line.endswith(" left") for line in lines[1:])
     code, _, err = _run([*args, "--out", str(tmp_path / "b.nc"), "--quiet"], capsys)
     assert code == 0

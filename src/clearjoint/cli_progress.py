@@ -61,7 +61,12 @@ def shown_progress(
     quiet = getattr(args, "quiet", False)
     terminal = not quiet and sys.stderr.isatty()
     quiet = quiet or not (terminal or getattr(args, "progress_lines", False))
-    seen = {"done": 0.0, "finished": False, "announced": announce or quiet, "at": 0.0}
+    seen: dict[str, float | bool] = {
+        "done": 0.0,
+        "finished": False,
+        "announced": announce or quiet,
+        "at": 0.0,
+    }
     start = time.perf_counter()
 
     def say(text: str) -> None:
@@ -82,18 +87,51 @@ def shown_progress(
             if bar is not None:
                 bar.update(task, completed=done, total=total)
                 return
+            now = time.perf_counter()
             if not seen["announced"]:
                 seen["announced"] = True
                 say(what)
-            now = time.perf_counter()
-            if now - max(start, float(seen["at"])) < PROGRESS_EVERY_S or done <= 0.0:
+            if "first" not in seen:  # the rate is taken from here: a compile came before
+                seen["first"], seen["from"] = now, done
+            ran, went = now - float(seen["first"]), done - float(seen["from"])
+            if now - max(start, float(seen["at"])) < PROGRESS_EVERY_S or went <= 0.0:
                 return
             seen["at"] = now
-            left = (now - start) * (total - done) / done
+            left = ran * (total - done) / went
             say(f"{100.0 * done / total:.0f} % done, about {for_people(left)} left")
 
         stack.enter_context(listening(listener))
+        if not quiet:
+            stack.enter_context(compile_notice(say))
         yield listener
+
+
+@contextlib.contextmanager
+def compile_notice(say: Callable[[str], None]) -> Iterator[None]:
+    """Say once, when numba starts compiling inside the block, that this is a first run.
+
+    A compile happens when the on-disk cache of compiled solvers is empty or stale (a
+    fresh install, an upgrade, a changed NUMBA_CACHE_DIR); a cached kernel only loads.
+    """
+    from numba.core import event
+
+    told: list[bool] = []
+
+    class Notice(event.Listener):
+        def on_start(self, _event: Any) -> None:
+            if not told:
+                told.append(True)
+                say("compiling the solvers, first run only")
+
+        def on_end(self, _event: Any) -> None:
+            pass
+
+    notice = Notice()
+    event.register("numba:compile", notice)  # type: ignore[no-untyped-call]
+    try:
+        yield
+    finally:
+        event.unregister("numba:compile", notice)  # type: ignore[no-untyped-call]
 
 
 def bar_columns() -> tuple[Any, ...]:
