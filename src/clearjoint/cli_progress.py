@@ -198,9 +198,10 @@ def interrupted(args: argparse.Namespace, started: float, *, end: bool = False) 
 
     A file output (--out, --plot) written since the command started is incomplete: removed.
     With ``end`` (the command itself, not a caller of main) the process ends here with 130:
-    the work was stopped and its pools and clusters closed on the way out, and the
-    interpreter's own shutdown, whose signal handlers are the default ones again, would
-    otherwise die of a Ctrl-C pressed twice (exit -2, a traceback from a library's atexit).
+    the work was stopped and its pools and clusters closed on the way out, while the
+    interpreter's own shutdown after a Ctrl-C sometimes ended the process by SIGINT
+    instead (exit -2, seen about one run in four of tests/test_interrupt.py's modes case;
+    the cause was not traced).
     """
     removed = []
     for option in ("out", "plot"):
