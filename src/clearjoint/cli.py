@@ -15,16 +15,20 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import itertools
 import json
 import logging
 import math
 import os
+import signal
 import sys
+import time
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from clearjoint import cli_progress
 from clearjoint.checks import figure_target, netcdf_target, refuse_file_as_folder
 from clearjoint.cli_parser import (
     EXIT_BAD_INPUT,
@@ -63,7 +67,9 @@ def _run_stiffness(args: argparse.Namespace) -> int:
     from clearjoint.studies import joint_at
     from clearjoint.studies.text import json_value, stiffness_lines, stiffness_table
 
-    joint = joint_at(None, study_values(args), OPTION_NAMES)
+    given = study_values(args)
+    _warn_unusual(args.command, given)
+    joint = joint_at(None, given, OPTION_NAMES)
     amplitudes = amplitude_values(args)
     plot = _plot_target(args)
     _save_plot(stiffness.stiffness_curve(joint, amplitudes), plot, quiet=args.json)
@@ -83,6 +89,7 @@ def _run_dissipation(args: argparse.Namespace) -> int:
 
     base = load_study(args.study) if args.study else None
     given = study_values(args)
+    _warn_unusual(args.command, given)
     joint = joint_at(base.joint if base is not None else None, given, OPTION_NAMES)
     losses = losses_at(base, joint, given, OPTION_NAMES)
     amplitudes = amplitude_values(args)
@@ -97,6 +104,14 @@ def _run_dissipation(args: argparse.Namespace) -> int:
     else:
         print("\n".join(dissipation_lines(joint, losses, amplitudes, values)))
     return 0
+
+
+def _warn_unusual(command: str, given: dict[str, Any]) -> None:
+    """One warning line for each value legal but unusual for a pin joint (clearjoint.plausible)."""
+    from clearjoint.plausible import unusual_values
+
+    for note in unusual_values(given, OPTION_NAMES):
+        print(f"clearjoint {command}: warning: {note}", file=sys.stderr)
 
 
 def _run_simulate(args: argparse.Namespace) -> int:
@@ -132,18 +147,8 @@ def _run_rig(args: argparse.Namespace) -> int:
     jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
-    if args.quiet:
+    with cli_progress.shown_progress(args, f"{total} tests on {jobs} processes"):
         manifest = run_campaign(campaign, args.out, jobs=args.jobs, force=args.force)
-    else:
-        with _progress_bar() as bar:
-            task = bar.add_task(f"{total} tests on {jobs} processes", total=total)
-            manifest = run_campaign(
-                campaign,
-                args.out,
-                jobs=args.jobs,
-                force=args.force,
-                progress=lambda done, _total: bar.update(task, completed=done),
-            )
     print(f"wrote {total} records and {manifest} in {time.perf_counter() - start:.1f} s")
     return 0
 
@@ -158,25 +163,18 @@ def _run_identify(args: argparse.Namespace) -> int:
         raise ParameterError(f"--out must end in .csv or .nc, got {out.name!r}")
     if not 0.0 < args.tolerance < 1.0:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
-    if args.jobs < 1:
+    if args.jobs is not None and args.jobs < 1:
         raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    jobs = args.jobs or os.cpu_count() or 1  # every core by default, as rig and reproduce
     plot = _plot_target(args)  # a figure suffix, not overwritten unless --force
     refuse_to_overwrite([out], force=args.force)
     out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
-    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": args.jobs}
+    options = {"resample": args.resample, "tolerance": args.tolerance, "jobs": jobs}
 
     if args.figures:
         refuse_file_as_folder(args.figures, "--figures")
-    if args.quiet:
-        results, failures = identify_files(args.files, **options)
-    else:
-        with _progress_bar() as bar:
-            task = bar.add_task(f"{len(args.files)} records", total=len(args.files))
-            results, failures = identify_files(
-                args.files,
-                **options,
-                progress=lambda done, _total: bar.update(task, completed=done),
-            )
+    with cli_progress.shown_progress(args, f"identifying {len(args.files)} records") as shown:
+        results, failures = identify_files(args.files, **options, progress=shown)
     if not results and len(failures) == 1:
         raise ParameterError(f"no record could be used: {failures[0]}")  # one file, one line
     for line in failures:
@@ -211,20 +209,30 @@ def _run_reproduce(args: argparse.Namespace) -> int:
         )
     refuse_file_as_folder(args.out, "--out")
     start = time.perf_counter()
-    with optional_client(args.scheduler, args.workers) as client:  # None: the --jobs pool
+    with (
+        optional_client(args.scheduler, args.workers) as client,  # None: the --jobs pool
+        cli_progress.shown_progress(args, "the virtual rig's campaign"),
+    ):
         written = reproduce(
             Path(args.out),
             force=args.force,
             jobs=args.jobs,
             executor=client,
             campaign_path=Path(args.campaign) if args.campaign else None,
-            progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+            progress=_stage_printer(args),
         )
     for path in written:
         print(f"wrote {path}")
     _print_findings(Path(args.out) / "results.json")
     print(f"done in {time.perf_counter() - start:.0f} s")
     return 0
+
+
+def _stage_printer(args: argparse.Namespace) -> Callable[[str], None]:
+    """Print each stage of a long job on stderr as ``- stage`` (nothing with --quiet)."""
+    if getattr(args, "quiet", False):
+        return lambda _message: None
+    return lambda message: print(f"- {message}", file=sys.stderr, flush=True)
 
 
 def _print_findings(results: Path) -> None:
@@ -254,23 +262,13 @@ def _run_report(args: argparse.Namespace) -> int:
         Path(args.records),
         Path(args.out),
         force=args.force,
-        progress=lambda m: print(f"- {m}", file=sys.stderr, flush=True),
+        progress=_stage_printer(args),
         warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
     )
     for path in written:
         print(f"wrote {path}")
     _print_findings(Path(args.out) / "results.json")
     return 0
-
-
-def _progress_bar(*columns: Any) -> Any:
-    """A rich progress bar on stderr, drawn only on a terminal (stdout stays the output)."""
-    from rich.console import Console
-    from rich.progress import Progress
-
-    return Progress(
-        *columns, console=Console(stderr=True), transient=True, disable=not sys.stderr.isatty()
-    )
 
 
 @contextlib.contextmanager
@@ -316,27 +314,19 @@ def _run_sweep(args: argparse.Namespace) -> int:
             from rich.progress import Progress, TimeRemainingColumn
 
             columns = (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
-            shown = stack.enter_context(_progress_bar(*columns))
+            shown = stack.enter_context(cli_progress.progress_bar(*columns))
             task = shown.add_task(f"{sweep.n_points} points", total=sweep.n_points)
             return lambda done, _total: shown.update(task, completed=done)
 
-        try:
-            results, kept = run_sweep_file(
-                args.sweep,
-                args.out,
-                scheduler=args.scheduler,
-                workers=args.workers,
-                resume=args.resume,
-                force=args.force,
-                progress=bar,
-            )
-        except KeyboardInterrupt:
-            print(
-                f"clearjoint sweep: interrupted; finished chunks are in {args.out}: "
-                f"run again with --resume to compute only the rest",
-                file=sys.stderr,
-            )
-            return 130
+        results, kept = run_sweep_file(  # Ctrl-C: main says what the store keeps
+            args.sweep,
+            args.out,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            resume=args.resume,
+            force=args.force,
+            progress=bar,
+        )
     failed = results.attrs["points_failed"]
     kept_text = f", {kept} of them kept from the store" if kept else ""
     print(
@@ -360,6 +350,8 @@ def _plot_sweep(args: argparse.Namespace) -> int:
 
 
 def _run_frf(args: argparse.Namespace) -> int:
+    from clearjoint.budget import check_budget
+    from clearjoint.structure.study import StructureStudy
     from clearjoint.studies import (
         curve_summary,
         frequency_response_of,
@@ -382,6 +374,8 @@ def _run_frf(args: argparse.Namespace) -> int:
     for option, text, value in (("--from", args.start, start), ("--to", args.stop, stop)):
         if not (math.isfinite(value) and value > 0.0):
             raise ParameterError(f"{option} must be finite and > 0, got {text!r}")
+        if kind == "frequency":
+            _warn_rpm(args.command, option, text, value)
     if start == stop:
         raise ParameterError(
             f"--from and --to give a range of zero width ({args.start} to {args.stop}); "
@@ -389,6 +383,10 @@ def _run_frf(args: argparse.Namespace) -> int:
         )
     if args.max_points < 2:
         raise ParameterError(f"--max-points must be >= 2, got {args.max_points}; e.g. 2000")
+    structure = isinstance(study, StructureStudy)
+    if not args.allow_long:
+        kind_of_point = "structure curve point" if structure else "joint curve point"
+        check_budget(args.max_points, kind_of_point, option="--max-points")
     for option, given in (("--harmonics", args.harmonics), ("--samples", args.samples)):
         if args.method != "harmonic" and given is not None:
             raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")
@@ -399,18 +397,20 @@ def _run_frf(args: argparse.Namespace) -> int:
         frequency = parse_quantity(args.frequency, "frequency", name="--frequency")
         if not (math.isfinite(frequency) and frequency > 0.0):
             raise ParameterError(f"--frequency must be finite and > 0, got {args.frequency!r}")
-    curve = frequency_response_of(
-        study,
-        start,
-        stop,
-        parameter=args.parameter,
-        frequency=frequency,
-        method=args.method,
-        harmonics=args.harmonics,
-        samples=args.samples,
-        max_points=args.max_points,
-        names=OPTION_NAMES,
-    )
+        _warn_rpm(args.command, "--frequency", args.frequency, frequency)
+    with cli_progress.shown_progress(args, f"following the curve from {args.start} to {args.stop}"):
+        curve = frequency_response_of(
+            study,
+            start,
+            stop,
+            parameter=args.parameter,
+            frequency=frequency,
+            method=args.method,
+            harmonics=args.harmonics,
+            samples=args.samples,
+            max_points=args.max_points,
+            names=OPTION_NAMES,
+        )
     write_curve(curve, args.out, study.source)
     _save_plot(curve, plot_path, quiet=True)
     for warning in curve_warnings(curve):
@@ -423,22 +423,43 @@ def _run_frf(args: argparse.Namespace) -> int:
     return 0
 
 
+def _warn_rpm(command: str, option: str, text: str, hz: float) -> None:
+    """Warn in one line when a frequency option was written in rpm (clearjoint.plausible)."""
+    from clearjoint.plausible import rpm_note
+
+    note = rpm_note(text, hz, option)
+    if note is not None:
+        print(f"clearjoint {command}: warning: {note}", file=sys.stderr)
+
+
 def _run_modes(args: argparse.Namespace) -> int:
+    from clearjoint.budget import check_budget
+    from clearjoint.structure.study import StructureStudy
     from clearjoint.studies import load_any_study, mode_summary, nonlinear_modes_of, write_curve
-    from clearjoint.units import parse_amplitude_range
 
     study = load_any_study(args.study)
     _netcdf_target(args)  # before the run, not after
     plot_path = _plot_target(args)
-    amplitudes = parse_amplitude_range(args.amplitude, args.points)
-    mode = nonlinear_modes_of(
-        study,
-        args.mode,
-        amplitudes,
-        harmonics=args.harmonics,
-        samples=args.samples,
-        names=OPTION_NAMES,
-    )
+    if not args.allow_long and ".." in args.amplitude:  # before the amplitudes are made
+        structure = isinstance(study, StructureStudy)
+        kind = "structure mode amplitude" if structure else "joint mode amplitude"
+        check_budget(args.points, kind, option="--points")
+    amplitudes = (amplitude_values if "," in args.amplitude else _amplitude_range)(args)
+    listed = amplitudes.tolist()
+    if min(listed) <= 0.0 or any(b <= a for a, b in itertools.pairwise(listed)):
+        raise ParameterError(
+            f"--amplitude {args.amplitude}: a mode's amplitudes must be above zero and "
+            "ascending, e.g. 1um,5um,20um or 1um..1mm"
+        )
+    with cli_progress.shown_progress(args, f"mode {args.mode} at {amplitudes.size} amplitudes"):
+        mode = nonlinear_modes_of(
+            study,
+            args.mode,
+            amplitudes,
+            harmonics=args.harmonics,
+            samples=args.samples,
+            names=OPTION_NAMES,
+        )
     write_curve(mode, args.out, study.source)
     _save_plot(mode, plot_path, quiet=True)
     for line in filter(None, mode.note.split("; ")):
@@ -464,6 +485,13 @@ _STEPPED_ONLY = (
 )
 
 
+def _amplitude_range(args: argparse.Namespace) -> Any:
+    """A mode's --amplitude as one value or a range (clearjoint.units.parse_amplitude_range)."""
+    from clearjoint.units import parse_amplitude_range
+
+    return parse_amplitude_range(args.amplitude, args.points)
+
+
 def _run_structure(args: argparse.Namespace) -> int:
     from clearjoint.structure.study import load_structure_study
     from clearjoint.studies import run_structure_task, write_structure_result
@@ -477,26 +505,29 @@ def _run_structure(args: argparse.Namespace) -> int:
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
-    if stepped:
-        from clearjoint.parallel import optional_client
-        from clearjoint.studies import stepped_sine_of
-        from clearjoint.units import parse_quantity
+    with cli_progress.shown_progress(args, f"{args.task} of {study.source}"):
+        if stepped:
+            from clearjoint.parallel import optional_client
+            from clearjoint.studies import stepped_sine_of
+            from clearjoint.units import parse_quantity
 
-        start = parse_quantity(args.start, "frequency", name="--from")
-        stop = parse_quantity(args.stop, "frequency", name="--to")
-        with optional_client(args.scheduler, args.workers) as client:
-            result = stepped_sine_of(
-                study,
-                start,
-                stop,
-                points=args.points,
-                direction=args.direction,
-                settle_periods=args.settle_periods,
-                record_periods=args.record_periods,
-                runner=client,
-            )
-    else:
-        result = run_structure_task(study, args.task, figure=plot_path is not None)
+            start = parse_quantity(args.start, "frequency", name="--from")
+            stop = parse_quantity(args.stop, "frequency", name="--to")
+            _warn_rpm(args.command, "--from", args.start, start)
+            _warn_rpm(args.command, "--to", args.stop, stop)
+            with optional_client(args.scheduler, args.workers) as client:
+                result = stepped_sine_of(
+                    study,
+                    start,
+                    stop,
+                    points=args.points,
+                    direction=args.direction,
+                    settle_periods=args.settle_periods,
+                    record_periods=args.record_periods,
+                    runner=client,
+                )
+        else:
+            result = run_structure_task(study, args.task, figure=plot_path is not None)
     write_structure_result(result, out)
     _save_plot(result.drawn, plot_path, quiet=True)
     if args.json:
@@ -519,8 +550,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         # at the end, skip the interpreter's collections over every object left (numpy's
         # modules: about 10 ms of each run); Python never promised their __del__ at exit
         atexit.register(gc.freeze)
+        signal.signal(signal.SIGINT, cli_progress.on_interrupt)  # Ctrl-C noted, not only raised
+        sys.unraisablehook = cli_progress.unraisable
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.progress_lines = argv is None or cli_progress.PROGRESS_LINES_IN_PROCESS
+    started = time.time()
     runners = {
         "stiffness": _run_stiffness,
         "simulate": _run_simulate,
@@ -537,7 +572,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with warnings.catch_warnings(), _harmonic_progress(args.command):
             warnings.showwarning = _warning_printer(args.command)
-            return runners[args.command](args)
+            code = runners[args.command](args)
+            cli_progress.stop_if_interrupted()  # a Ctrl-C that compiled code swallowed
+            return code
+    except KeyboardInterrupt:  # Ctrl-C: one line, exit 130, as a shell reports SIGINT
+        return cli_progress.interrupted(args, started, end=argv is None)
     except BrokenPipeError:  # the reader stopped early (| head): not an error of ours
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so the exit's flush does not raise again
@@ -555,3 +594,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_BAD_INPUT
+    except Exception as exc:  # Ctrl-C inside compiled code arrives wrapped (a SystemError)
+        if cli_progress.caused_by_interrupt(exc):
+            return cli_progress.interrupted(args, started, end=argv is None)
+        raise

@@ -27,8 +27,32 @@ __all__ = [
 EXIT_BAD_INPUT = 2
 
 
+class _Help(argparse.HelpFormatter):
+    """Help that shows every option's default: ``(default X)`` added where the text has none.
+
+    An option without a default (None) or an on/off flag (False) shows none.
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        default = action.default
+        if (
+            "default" in text
+            or not action.option_strings
+            or default is None
+            or default is False
+            or default == argparse.SUPPRESS
+        ):
+            return action.help
+        return f"{text} (default %(default)s)"
+
+
 class _Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are one line and exit code 2."""
+    """An ArgumentParser whose errors are one line and exit code 2, its help with defaults."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", _Help)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         if message.endswith("expected one argument"):  # also "--gap-offset -0.01mm"
@@ -74,6 +98,10 @@ def _stiffness_parser(sub: Any) -> None:
 
 _JSON_TABLE = "print one JSON object instead of a table"
 _JOBS = "processes (default: every core)"
+_QUIET = "no progress bar or progress lines on stderr"
+_AMPLITUDES = "one (5um), a list (1um,5um,20um) or a range (1um..1mm, see --points)"
+_POINTS = "amplitudes in an --amplitude range, spaced logarithmically (default 40)"
+_ALLOW_LONG = "run a request estimated above an hour (refused otherwise, with the estimate)"
 
 
 def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
@@ -91,8 +119,11 @@ def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
     p.add_argument("--clearance", required=required, help="total axial clearance, e.g. 0.106mm")
     _options(p, gap_offset=f"offset of the gap centre {_default(Joint, 'gap_offset')}")
     p.add_argument(
-        "--amplitude", required=True, help="penetration(s) beyond the gap edge, e.g. 1um,5um,20um"
+        "--amplitude",
+        required=True,
+        help="penetration(s) beyond the gap edge: " + _AMPLITUDES,
     )
+    p.add_argument("--points", type=int, default=40, help=_POINTS)
 
 
 def _dissipation_parser(sub: Any) -> None:
@@ -112,21 +143,28 @@ def _dissipation_parser(sub: Any) -> None:
     _add_joint_options(p, required=False)
     _options(
         p,
-        friction_coefficient="sliding-friction coefficient mu_s",
-        lateral_load="lateral load P, e.g. 300N",
+        friction_coefficient="sliding-friction coefficient mu_s (default: the study's, else 0)",
+        lateral_load="lateral load P, e.g. 300N (default: the study's, else 0)",
     )
-    p.add_argument("--friction-region", choices=["everywhere", "free-play"])
+    p.add_argument(
+        "--friction-region",
+        choices=["everywhere", "free-play"],
+        help="where sliding friction acts: over the whole path (a bearing's load) or over the "
+        "free-play stroke only (the joint's faces, which stop slipping once the pin bears) "
+        "(default: the study's, else everywhere)",
+    )
     _options(
         p,
         restitution=f"coefficient of restitution e {_default(Losses, 'restitution')}",
-        damping_ratio="viscous damping ratio of the linear part",
+        damping_ratio="viscous damping ratio of the linear part (default: the study's, else 0)",
         pin_radius="pin radius, e.g. 5mm (gives a pin)",
         pin_length="pin contact length, e.g. 25mm",
         hole_radius="hole radius (default: pin radius + clearance/2)",
         youngs_modulus="Young's modulus of pin and hole "
         + _default(Pin, "youngs_modulus", 1e9, "GPa"),
         poisson_ratio=f"Poisson's ratio of pin and hole {_default(Pin, 'poisson_ratio')}",
-        contact_friction_coefficient="friction coefficient on the pin mu_c",
+        contact_friction_coefficient="friction coefficient on the pin mu_c "
+        "(default: the study's, else 0)",
     )
     _flags(p, json=_JSON_TABLE)
     _add_plot_option(p, force=True)
@@ -153,7 +191,7 @@ def _reproduce_parser(sub: Any) -> None:
         "(its workers must see --out)",
     )
     p.add_argument("--workers", type=int, help="run them on a local Dask cluster of N workers")
-    _flags(p, force="overwrite existing output files")
+    _flags(p, force="overwrite existing output files", quiet=_QUIET)
 
 
 def _report_parser(sub: Any) -> None:
@@ -167,7 +205,7 @@ def _report_parser(sub: Any) -> None:
     )
     p.add_argument("--records", required=True, help="folder of record files")
     p.add_argument("--out", default="clearjoint-report", help="output folder")
-    _flags(p, force="overwrite existing output files")
+    _flags(p, force="overwrite existing output files", quiet=_QUIET)
 
 
 def _simulate_parser(sub: Any) -> None:
@@ -227,7 +265,10 @@ def _identify_parser(sub: Any) -> None:
         help="draw every identified loop with its flag into one figure (.png, .pdf or .svg)",
     )
     p.add_argument(
-        "--jobs", type=int, default=1, help="processes over the files (default 1; same results)"
+        "--jobs",
+        type=int,
+        default=None,
+        help="processes over the files (default: every core; the results do not depend on it)",
     )
     _flags(p, resample="interpolate records that are not uniformly sampled")
     p.add_argument(
@@ -265,9 +306,12 @@ def _frf_parser(sub: Any) -> None:
         default="frequency",
         help="what varies along the curve (default frequency)",
     )
-    _options(p, frequency="fixed frequency with --parameter force, e.g. 400Hz")
+    _options(
+        p, frequency="fixed frequency with --parameter force, e.g. 400Hz (default: the study's)"
+    )
     p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
-    _flags(p, force="overwrite --out / --plot if they exist")
+    _flags(p, allow_long=_ALLOW_LONG)
+    _flags(p, force="overwrite --out / --plot if they exist", quiet=_QUIET)
     p.add_argument(
         "--method",
         choices=["shooting", "harmonic"],
@@ -338,10 +382,9 @@ def _modes_parser(sub: Any) -> None:
     )
     p.add_argument("study", help="study file (TOML), as for clearjoint simulate")
     p.add_argument("--mode", type=int, default=1, help="mode number (default 1)")
-    p.add_argument(
-        "--amplitude", required=True, help="modal amplitude range, e.g. 1um..1mm (or one value)"
-    )
-    p.add_argument("--points", type=int, default=40, help="amplitudes in the range (default 40)")
+    p.add_argument("--amplitude", required=True, help="modal amplitude(s): " + _AMPLITUDES)
+    p.add_argument("--points", type=int, default=40, help=_POINTS)
+    _flags(p, allow_long=_ALLOW_LONG)
     _add_harmonic_options(p, "H")
     p.add_argument("--out", required=True, help="write the mode to this netCDF file (.nc)")
     _add_plot_option(p, force=False)
@@ -349,6 +392,7 @@ def _modes_parser(sub: Any) -> None:
         p,
         json="print the mode as one JSON object",
         force="overwrite --out / --plot if they exist",
+        quiet=_QUIET,
     )
 
 
@@ -371,7 +415,7 @@ def _structure_parser(sub: Any) -> None:
     )
     p.add_argument("--out", required=True, help="netCDF results file (.nc)")
     _add_plot_option(p, force=False)
-    _flags(p, json="print a JSON summary", force="overwrite existing output")
+    _flags(p, json="print a JSON summary", force="overwrite existing output", quiet=_QUIET)
     g = p.add_argument_group("stepped-sine")
     g.add_argument("--from", dest="start", help="first frequency, e.g. 2Hz")
     g.add_argument("--to", dest="stop", help="last frequency, e.g. 60Hz")
@@ -458,8 +502,14 @@ def study_values(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def amplitude_values(args: argparse.Namespace) -> Any:
-    """The --amplitude values (one or several, comma-separated) in m, as an array."""
-    from clearjoint.units import parse_quantity_list
+    """The --amplitude values in m, as an array: one, a list or a range, as every command reads it.
 
+    One value (``5um``), a comma-separated list (``1um,5um,20um``) or a range (``1um..1mm``:
+    ``--points`` values spaced logarithmically), the same in stiffness, dissipation and modes.
+    """
+    from clearjoint.units import parse_amplitude_range, parse_quantity_list
+
+    if ".." in args.amplitude:
+        return parse_amplitude_range(args.amplitude, args.points)
     values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
     return np.array(values)

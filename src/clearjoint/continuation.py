@@ -50,6 +50,7 @@ from numpy.typing import NDArray
 from clearjoint import checks as _checks
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
+from clearjoint.progress import report
 
 __all__ = [
     "Branch",
@@ -634,6 +635,7 @@ def continue_branch(
         ts.append(t)
         datas.append(data_new)
         iters.append(its)
+        report(direction * (y[-1] * scale[-1] - lam0), abs(lam_stop - lam0))  # for a bar
         if joined(y, data_new):
             reason = "joined"
             break

@@ -27,7 +27,7 @@ from clearjoint.findings import findings_table, law_timing
 from clearjoint.identify import identify_files
 from clearjoint.records import RecordError, is_record_file, record_suffixes
 from clearjoint.report import Study, write_report
-from clearjoint.rig import Campaign, load_campaign, run_campaign
+from clearjoint.rig import JOURNAL_NAME, Campaign, load_campaign, run_campaign
 from clearjoint.verification import identification_accuracy, model_checks, stiffness_study
 
 Progress = Callable[[str], None]
@@ -133,15 +133,18 @@ def reproduce(
     dissipation model of section 2 set against the exact cycles. The rig's tests run
     over ``jobs`` processes, or on ``executor`` (an Executor or a Dask client whose
     workers see ``out_dir``: clearjoint.parallel; the control run's records then go to
-    a temporary folder inside ``out_dir``, removed after).
+    a temporary folder inside ``out_dir``, removed after). A run interrupted before the
+    report is written leaves its finished records: the next run into ``out_dir`` keeps
+    them and simulates only the rest (``rig.run_campaign``).
     """
     say = progress or (lambda _m: None)
     out_dir = Path(out_dir)
     refuse_to_overwrite([out_dir / n for n in ("report.html", "results.json")], force=force)
     campaign = load_campaign(campaign_path)
     say(f"virtual rig: {len(campaign.tests)} tests")
+    # an interrupted run's records are kept (resumed, not refused) until the report is written
     manifest = run_campaign(
-        campaign, out_dir / "records", jobs=jobs, force=force, executor=executor
+        campaign, out_dir / "records", jobs=jobs, force=force, executor=executor, keep_journal=True
     )
     with manifest.open() as handle:
         truth = {row["file"]: row for row in csv.DictReader(handle)}
@@ -209,4 +212,6 @@ def reproduce(
         control_analysis=control,
         timing=timing,
     )
-    return write_report(out_dir, study, force=force)
+    written = write_report(out_dir, study, force=force)
+    (out_dir / "records" / JOURNAL_NAME).unlink(missing_ok=True)
+    return written

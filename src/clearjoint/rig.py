@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import hashlib
+import json
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -35,7 +37,8 @@ from clearjoint.checks import refuse_to_overwrite
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.io_toml import quantity, read_toml
 from clearjoint.joint import Friction, Joint, Losses, Pin
-from clearjoint.parallel import process_pool, run_ordered
+from clearjoint.parallel import process_pool, run_unordered
+from clearjoint.progress import report
 from clearjoint.records import Record, record_suffixes, write_record
 from clearjoint.simulate import SimulationError, steady_state, time_response
 
@@ -506,6 +509,50 @@ def _tasks(
         yield campaign.rig, spec, campaign.periods, seed, str(path), force
 
 
+#: The finished tests of a campaign still running or interrupted, one JSON line each (after
+#: a first line naming the campaign): a rerun into the same folder keeps those records.
+JOURNAL_NAME = "campaign-progress.jsonl"
+
+
+def _fingerprint(campaign: Campaign) -> str:
+    """A digest of everything that decides a campaign's records (rig, grid, seed, format)."""
+    return hashlib.sha256(repr(campaign).encode()).hexdigest()
+
+
+def _journal_lines(campaign: Campaign, journal: Path) -> list[str]:
+    """The journal's lines, or [] when there is none or it belongs to another campaign."""
+    try:
+        lines = journal.read_text(encoding="utf-8").splitlines()
+        if json.loads(lines[0]).get("campaign") == _fingerprint(campaign):
+            return lines
+    except (OSError, IndexError, ValueError, AttributeError):
+        pass
+    return []
+
+
+def finished_tests(campaign: Campaign, out_dir: str | Path) -> dict[int, dict[str, Any]]:
+    """The tests of ``campaign`` an interrupted run into ``out_dir`` finished: index -> truth.
+
+    Read from ``out_dir/campaign-progress.jsonl``; empty when there is none, when it was
+    written for another campaign, or when nothing in it is usable. A test counts only if
+    its record file is still there (the journal line is written after the record).
+    """
+    out_dir = Path(out_dir)
+    lines = _journal_lines(campaign, out_dir / JOURNAL_NAME)
+    stems = {spec.index: spec.file_stem for spec in campaign.tests}
+    kept: dict[int, dict[str, Any]] = {}
+    for line in lines[1:]:
+        try:
+            entry = json.loads(line)
+            index, truth = int(entry["index"]), dict(entry["truth"])
+        except (ValueError, KeyError, TypeError):
+            continue  # a line cut short by the interruption
+        name = f"{stems.get(index)}.{campaign.format}"
+        if index in stems and truth.get("file") == name and (out_dir / name).is_file():
+            kept[index] = truth
+    return kept
+
+
 def run_campaign(
     campaign: Campaign,
     out_dir: str | Path,
@@ -514,6 +561,7 @@ def run_campaign(
     force: bool = False,
     progress: Callable[[int, int], None] | None = None,
     executor: Any = None,
+    keep_journal: bool = False,
 ) -> Path:
     """Run every test of ``campaign`` and write its records and ``manifest.csv`` to ``out_dir``.
 
@@ -524,25 +572,54 @@ def run_campaign(
     whatever the order the workers finish in. ``progress(done, total)`` is called
     after each test. Returns the manifest's path.
 
+    Each finished test is noted in ``out_dir/campaign-progress.jsonl``: a run of the same
+    campaign into a folder that an interrupted run left keeps its finished records and
+    simulates only the rest (the manifest is the same as an uninterrupted run's);
+    ``force`` starts afresh. The note is removed once the manifest is written, unless
+    ``keep_journal`` (a caller with more to do after the campaign removes it when that is
+    done, so that a rerun after an interruption there still finds every record).
+
     Raises
     ------
     OutputExistsError
-        A record or the manifest exists in ``out_dir`` and ``force`` is False.
+        A record or the manifest exists in ``out_dir``, ``force`` is False and the folder
+        holds no interrupted run of this campaign.
     """
     if jobs is not None and jobs < 1:
         raise ParameterError(f"jobs must be >= 1 (--jobs), got {jobs}")
     out_dir = Path(out_dir)
-    tasks = list(_tasks(campaign, out_dir, force))
-    refuse_to_overwrite([out_dir / "manifest.csv", *(Path(t[4]) for t in tasks)], force=force)
+    journal = out_dir / JOURNAL_NAME
+    resuming = not force and bool(_journal_lines(campaign, journal))
+    kept = finished_tests(campaign, out_dir) if resuming else {}
+    tasks = list(_tasks(campaign, out_dir, force or resuming))
+    if not resuming:
+        refuse_to_overwrite([out_dir / "manifest.csv", *(Path(t[4]) for t in tasks)], force=force)
+    todo = [task for task in tasks if task[1].index not in kept]
     out_dir.mkdir(parents=True, exist_ok=True)
+    if not resuming:
+        journal.write_text(json.dumps({"campaign": _fingerprint(campaign)}) + "\n", "utf-8")
+    rows = dict(kept)
+    if progress and kept:
+        progress(len(rows), len(tasks))
     with contextlib.ExitStack() as stack:
         runner = executor if executor is not None else stack.enter_context(process_pool(jobs))
-        truths = run_ordered(_run_one, tasks, runner, progress=progress)
-    rows = {task[1].index: truth for task, truth in zip(tasks, truths, strict=True)}
+        with journal.open("a", encoding="utf-8") as log:
+            for done in run_unordered(_run_one, todo, runner):
+                if done.error is not None:
+                    raise done.error
+                index = todo[done.index][1].index
+                rows[index] = done.result  # type: ignore[assignment]
+                log.write(json.dumps({"index": index, "truth": done.result}) + "\n")
+                log.flush()
+                if progress:
+                    progress(len(rows), len(tasks))
+                report(len(rows), len(tasks))  # to a listening progress bar (clearjoint.progress)
     manifest = out_dir / "manifest.csv"
     with manifest.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=MANIFEST_COLUMNS)
         writer.writeheader()
         for index in sorted(rows):
             writer.writerow({key: rows[index][key] for key in MANIFEST_COLUMNS})
+    if not keep_journal:
+        journal.unlink()
     return manifest

@@ -45,6 +45,7 @@ from clearjoint.harmonic.system import (
     scale_length,
 )
 from clearjoint.joint import Losses, takes_losses
+from clearjoint.progress import report
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -583,6 +584,7 @@ def _march(
             results[i] = path[-1][1]
         else:
             reasons[i] = _NEWTON
+        report(amps.size - i, amps.size)  # for a progress bar
     return results, reasons
 
 

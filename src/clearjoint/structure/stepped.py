@@ -44,6 +44,7 @@ differ from a serial one where several attractors coexist at a run's first frequ
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -54,6 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint.errors import ParameterError
 from clearjoint.parallel import run_ordered
+from clearjoint.progress import report
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.motion import _Flow, _run, _system, _vector
 from clearjoint.structure.poincare import OrbitError, ShootingMap, newton_orbit, turning_extremes
@@ -98,6 +100,8 @@ class _Chunk:
     settle_periods: int
     record_periods: int
     first_settle: int
+    done_before: int = 0
+    total: int = 0
 
 
 @dataclass(frozen=True)
@@ -193,6 +197,7 @@ def _run_chunk(chunk: _Chunk) -> list[_Point]:
             )
         )
         u, v = recorded.final_state
+        report(chunk.done_before + i + 1, chunk.total)  # heard in this process only
     return out
 
 
@@ -523,13 +528,20 @@ def stepped_sine(
     bounds = np.linspace(0, w.size, n_runs + 1).round().astype(int)
     tasks: list[_Chunk] = []
     starts: list[tuple[int, ...]] = []
-    for name in names:
+    total = len(names) * w.size
+    for d, name in enumerate(names):
         order = w if name == "up" else w[::-1]
         starts.append(tuple(int(b) for b in bounds[:-1]))
         for a, b in itertools.pairwise(bounds):
-            tasks.append(_Chunk(system, f, order[a:b].copy(), settle, record, 2 * settle))
+            chunk = _Chunk(system, f, order[a:b].copy(), settle, record, 2 * settle)
+            tasks.append(dataclasses.replace(chunk, done_before=d * w.size + a, total=total))
+    sizes = [task.omegas.size for task in tasks]
+
+    def chunks_done(done: int, _: int) -> None:  # with a runner: whole chunks
+        report(sum(sorted(sizes)[:done]), total)
+
     try:
-        results = run_ordered(_run_chunk, tasks, runner)
+        results = run_ordered(_run_chunk, tasks, runner, progress=chunks_done)
     except (SimulationError, OrbitError) as exc:
         raise SimulationError(f"stepped sine: {exc}") from None
     per_dir: list[list[_Point]] = []

@@ -1,0 +1,68 @@
+"""A documented command's first run (empty compiled-code cache) against its later runs.
+
+Run on demand: ``python benchmarks/bench_cold.py [--rounds N] [-- COMMAND...]``; by default
+the command is ``clearjoint frf examples/frf.toml --from 10Hz --to 360Hz`` (issue 28: at most
+3x its warm run). Each round runs the command twice as a user does, side by side in this
+one run: cold, with NUMBA_CACHE_DIR a fresh empty folder (numba compiles every kernel and
+stores it there), then warm, with the same folder (every kernel loads). Wall times, and
+their ratio cold / warm, are printed per round and as medians. Other sessions may load the
+machine: compare the ratio, measured in one run, not the seconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT = ["frf", "examples/frf.toml", "--from", "10Hz", "--to", "360Hz"]
+
+
+def _timed(command: list[str], cache: Path, out: Path) -> float:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    start = time.perf_counter()
+    subprocess.run(
+        [sys.executable, "-m", "clearjoint", *command, "--out", str(out), "--force", "--quiet"],
+        cwd=ROOT,
+        env=env,
+        check=True,
+        stdout=subprocess.DEVNULL,
+    )
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=1, help="cold + warm pairs (default 1)")
+    parser.add_argument("command", nargs="*", help="clearjoint arguments (default: the frf)")
+    args = parser.parse_args()
+    command = args.command or DEFAULT
+    ratios, colds, warms = [], [], []
+    with tempfile.TemporaryDirectory(prefix="bench-cold-") as folder:
+        for round_ in range(args.rounds):
+            cache = Path(folder) / f"cache-{round_}"
+            cache.mkdir()
+            out = Path(folder) / "out.nc"
+            cold = _timed(command, cache, out)
+            warm = _timed(command, cache, out)
+            colds.append(cold)
+            warms.append(warm)
+            ratios.append(cold / warm)
+            print(
+                f"round {round_ + 1}: cold {cold:.1f} s, warm {warm:.1f} s, ratio {cold / warm:.1f}"
+            )
+    print(
+        f"clearjoint {' '.join(command)}: median cold {statistics.median(colds):.1f} s, "
+        f"warm {statistics.median(warms):.1f} s, cold / warm {statistics.median(ratios):.1f} "
+        "(target: at most 3)"
+    )
+
+
+if __name__ == "__main__":
+    main()
