@@ -9,11 +9,9 @@ Reproducibility does not depend on where a task runs: a point's random numbers
 come from :func:`point_seed`, ``SeedSequence(seed).spawn(n)[index]`` made from the
 point's index alone, and every task is a pure function of its frozen argument.
 
-:class:`ResultStore` keeps a sweep's results on disk as a zarr group with one
-array per variable along ``point`` (a zarr chunk per task chunk) and a
-``chunk_done`` flag written after each chunk's values, so a run stopped at any
-moment resumes by computing only the chunks not flagged. A store records the
-fingerprint of the sweep that made it; resuming from another sweep is refused.
+:class:`ResultStore` (clearjoint.store, re-exported here) keeps a sweep's results on
+disk, checked chunk by chunk, so a run stopped at any moment resumes by computing only
+the chunks not done or damaged.
 """
 
 from __future__ import annotations
@@ -21,18 +19,16 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-import shutil
 import socket
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 import numpy as np
-from numpy.typing import NDArray
 
-from clearjoint.errors import ClearjointError, OutputExistsError, ParameterError
+from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.store import ResultStore, StoreError, Variable
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -75,10 +71,6 @@ DEFAULT_SCHEDULER_PORT = 8786
 
 class SchedulerError(ClearjointError, ConnectionError):
     """The Dask scheduler cannot be reached; the message names the address."""
-
-
-class StoreError(ClearjointError, ValueError):
-    """A result store cannot be used: it belongs to another sweep, or is not a sweep store."""
 
 
 class ChunkFailedError(ClearjointError, RuntimeError):
@@ -333,158 +325,3 @@ def optional_client(
             yield client
     else:
         yield None
-
-
-# ---- the result store ------------------------------------------------------------------------
-
-_FINGERPRINT = "clearjoint_sweep_fingerprint"
-_DONE = "chunk_done"
-
-
-@dataclass(frozen=True)
-class Variable:
-    """One array of a store: its name, numpy dtype ('f8', 'i8' or 'str') and attributes.
-
-    ``shape`` is what each point holds beyond the ``point`` dimension: () for one
-    value, (n,) for n values (a per-joint draw: dimension ``joint``).
-    """
-
-    name: str
-    dtype: str
-    attrs: Mapping[str, Any]
-    shape: tuple[int, ...] = ()
-
-
-class ResultStore:
-    """A zarr group of point-wise results written chunk by chunk (see the module docstring)."""
-
-    def __init__(self, path: Path, group: Any, chunk_size: int, n_points: int) -> None:
-        self.path = path
-        self._group = group
-        self.chunk_size = chunk_size
-        self.n_points = n_points
-
-    def __repr__(self) -> str:
-        done = len(self.done_chunks())
-        total = len(chunk_bounds(self.n_points, self.chunk_size))
-        return f"ResultStore({str(self.path)!r}, {self.n_points} points, {done}/{total} chunks)"
-
-    @classmethod
-    def create(
-        cls,
-        path: str | Path,
-        *,
-        fingerprint: str,
-        n_points: int,
-        chunk_size: int,
-        variables: Sequence[Variable],
-        attrs: Mapping[str, Any],
-        force: bool = False,
-    ) -> ResultStore:
-        """Create an empty store; an existing one is replaced only with ``force``.
-
-        Raises
-        ------
-        OutputExistsError
-            ``path`` exists and ``force`` is False.
-        StoreError
-            ``path`` exists and is not a sweep store (it is never deleted, even with force).
-        """
-        import zarr
-
-        path = Path(path)
-        if path.exists():
-            if not force:
-                raise OutputExistsError(
-                    f"will not overwrite {path}; pass resume=True to finish it, force=True "
-                    f"to start again, or choose another out"
-                )
-            cls.open(path)  # a StoreError unless it is a sweep store: never delete anything else
-            shutil.rmtree(path)
-        group: Any = zarr.open_group(str(path), mode="w-", zarr_format=3)
-        n_chunks = len(chunk_bounds(n_points, chunk_size))
-        for var in variables:
-            kind: Any = str if var.dtype == "str" else var.dtype
-            fill: Any = "" if var.dtype == "str" else (np.nan if var.dtype == "f8" else 0)
-            array = group.create_array(
-                var.name,
-                shape=(n_points, *var.shape),
-                chunks=(chunk_size, *var.shape),
-                dtype=kind,
-                fill_value=fill,
-                dimension_names=["point", *("joint",) * len(var.shape)],
-            )
-            array.attrs.update(dict(var.attrs))
-        group.create_array(
-            _DONE,
-            shape=(n_chunks,),
-            chunks=(1,),
-            dtype="bool",
-            fill_value=False,
-            dimension_names=["chunk"],
-        )
-        group.attrs.update({**dict(attrs), _FINGERPRINT: fingerprint, "chunk_size": chunk_size})
-        return cls(path, group, chunk_size, n_points)
-
-    @classmethod
-    def open(cls, path: str | Path, *, fingerprint: str | None = None) -> ResultStore:
-        """Open an existing store; with ``fingerprint``, refuse one made by another sweep.
-
-        Raises
-        ------
-        StoreError
-            ``path`` is not a sweep store, or its fingerprint differs.
-        """
-        import zarr
-
-        path = Path(path)
-        if not path.exists():
-            raise StoreError(f"{path}: no such result store; check the path")
-        if not (path / "zarr.json").is_file():  # a file, a folder of something else
-            raise StoreError(f"{path}: not a clearjoint sweep store (no zarr.json); left as it is")
-        try:
-            group: Any = zarr.open_group(str(path), mode="r+")
-            stored = group.attrs[_FINGERPRINT]
-            chunk_size = int(group.attrs["chunk_size"])
-        except (KeyError, OSError, ValueError, TypeError) as exc:
-            raise StoreError(
-                f"{path}: not a clearjoint sweep store ({type(exc).__name__}: {exc}); "
-                f"choose another --out"
-            ) from None
-        if fingerprint is not None and stored != fingerprint:
-            raise StoreError(
-                f"{path} was made from a different sweep file (hash {stored[:12]} here, "
-                f"{fingerprint[:12]} now); use --force to start again or another --out"
-            )
-        points = [int(group[n].shape[0]) for n in group.array_keys() if n != _DONE]
-        return cls(path, group, chunk_size, points[0] if points else 0)
-
-    @property
-    def attrs(self) -> dict[str, Any]:
-        """The store's attributes (the sweep's description)."""
-        return dict(self._group.attrs)
-
-    def done_chunks(self) -> set[int]:
-        """Indices of the chunks whose values are all written."""
-        flags = np.asarray(self._group[_DONE][:], dtype=bool)
-        return {int(i) for i in np.flatnonzero(flags)}
-
-    def write(self, chunk: int, values: Mapping[str, NDArray[Any]]) -> None:
-        """Write one chunk's values, then flag the chunk done (so a cut never leaves half)."""
-        start = chunk * self.chunk_size
-        for name, array in values.items():
-            self._group[name][start : start + len(array)] = array
-        self._group[_DONE][chunk] = True
-
-    def read(self) -> dict[str, tuple[NDArray[Any], dict[str, Any]]]:
-        """Every variable along ``point`` with its attributes (not yet computed: NaN / '')."""
-        out: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
-        for name in sorted(self._group.array_keys()):
-            if name == _DONE:
-                continue
-            array = self._group[name]
-            values = np.asarray(array[:])
-            if values.dtype.kind in "OTU":
-                values = np.array(values.tolist(), dtype=str)
-            out[name] = (values, dict(array.attrs))
-        return out

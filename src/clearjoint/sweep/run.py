@@ -32,6 +32,7 @@ from clearjoint.parallel import (
     point_seed,
     run_unordered,
 )
+from clearjoint.store import StoreWarning
 from clearjoint.sweep.file import Sweep
 from clearjoint.sweep.tasks import Task
 
@@ -211,6 +212,7 @@ def run_sweep(
         path = Path(out)
         if resume and path.exists():
             store = ResultStore.open(path, fingerprint=sweep.fingerprint)
+            _repair(store)
             done = store.done_chunks()
             todo = [i for i in todo if i not in done]
         else:
@@ -281,6 +283,24 @@ def run_sweep(
             array = np.concatenate([in_memory[i][var.name] for i in range(len(bounds))])
         flat[var.name] = (array, dict(var.attrs))
     return _dataset(flat, {**_attrs(sweep), "clearjoint_sweep_fingerprint": sweep.fingerprint})
+
+
+def _repair(store: ResultStore) -> None:
+    """Unflag the store's damaged chunks, so that they are computed again; say so in one line."""
+    damaged = store.check()
+    if not damaged:
+        return
+    store.discard(sorted(damaged))
+    bounds = chunk_bounds(store.n_points, store.chunk_size)
+    points = sum(bounds[i][1] - bounds[i][0] for i in damaged)
+    first = min(damaged)
+    warnings.warn(
+        StoreWarning(
+            f"{store.path}: recomputing {points} points of {len(damaged)} damaged chunks "
+            f"(first: {store.describe(first)}: {damaged[first]})"
+        ),
+        stacklevel=3,
+    )
 
 
 def run_sweep_file(
