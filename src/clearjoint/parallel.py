@@ -20,6 +20,7 @@ import contextlib
 import logging
 import os
 import socket
+import sys
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -35,6 +36,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "CONNECT_TIMEOUT_S",
+    "DASK_WINDOW",
     "DEFAULT_SCHEDULER_PORT",
     "PROBE_TIMEOUT_S",
     "ChunkFailedError",
@@ -49,6 +51,7 @@ __all__ = [
     "point_seed",
     "probe_scheduler",
     "process_pool",
+    "run_batches",
     "run_ordered",
     "run_unordered",
 ]
@@ -103,7 +106,90 @@ class Finished(Generic[R]):
 
 
 def _is_dask_client(runner: Any) -> bool:
-    return type(runner).__name__ == "Client" and hasattr(runner, "scheduler_info")
+    """True for a distributed.Client or any subclass of it (never imports distributed)."""
+    distributed = sys.modules.get("distributed")
+    return distributed is not None and isinstance(runner, distributed.Client)
+
+
+#: Most tasks a Dask client keeps submitted at once (more are submitted as these end).
+DASK_WINDOW = 20_000
+
+
+def run_batches(
+    function: Callable[[A], R],
+    arguments: Sequence[A],
+    runner: Runner = None,
+    *,
+    retries: int = 0,
+    window: int = DASK_WINDOW,
+) -> Iterator[list[Finished[R]]]:
+    """Yield the tasks' :class:`Finished` outcomes in batches, as they end.
+
+    As :func:`run_unordered`, but on a Dask client every task that has ended since the
+    last batch comes at once (the client fetches results in the background meanwhile),
+    tasks are submitted ``window`` at a time in one message each (``client.map``), and
+    the client lets go of a task's future once its batch is yielded: the scheduler then
+    forgets its result, so a worker lost later has nothing of it to recompute.
+
+    Parameters
+    ----------
+    function, arguments, runner
+        As for :func:`run_unordered`.
+    retries : int
+        On a Dask client: times a task is run again after its worker is lost or it
+        raises (``client.map(retries=...)``). Ignored elsewhere.
+    window : int
+        On a Dask client: most tasks submitted and not yet yielded.
+    """
+    if retries < 0:
+        raise ParameterError(f"retries must be >= 0 (--retries), got {retries}")
+    if window < 1:
+        raise ParameterError(f"window must be >= 1, got {window}")
+    if not _is_dask_client(runner):
+        for outcome in run_unordered(function, arguments, runner):
+            yield [outcome]
+        return
+    from distributed import as_completed as dask_as_completed
+
+    where: dict[str, int] = {}  # key -> index, of the futures submitted and not yet yielded
+    submitted = 0
+
+    def submit(count: int) -> list[Any]:
+        nonlocal submitted
+        part = arguments[submitted : submitted + count]
+        futures = runner.map(function, part, pure=False, retries=retries or None)
+        for i, future in enumerate(futures):
+            where[future.key] = submitted + i
+        submitted += len(part)
+        return list(futures)
+
+    queue = dask_as_completed(
+        submit(min(window, len(arguments))), with_results=True, raise_errors=False
+    )  # type: ignore[no-untyped-call]
+    try:
+        for batch in queue.batches():  # type: ignore[no-untyped-call]
+            outcomes = [
+                _dask_outcome(where.pop(future.key), future, result) for future, result in batch
+            ]
+            del batch  # the futures: released once their results are here
+            if submitted < len(arguments) and len(where) < window // 2 + 1:
+                queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
+            yield outcomes
+    finally:  # on Ctrl-C or an early stop: nothing left running for us
+        with queue.lock:
+            left = list(queue.futures)
+        if left:
+            with contextlib.suppress(Exception):
+                runner.cancel(left)
+        queue.clear()  # type: ignore[no-untyped-call]
+
+
+def _dask_outcome(index: int, future: Any, result: Any) -> Finished[Any]:
+    if future.status == "error":
+        return Finished(index, None, result[1])
+    if future.status == "cancelled" or isinstance(result, BaseException):
+        return Finished(index, None, result if isinstance(result, BaseException) else None)
+    return Finished(index, result)
 
 
 def run_unordered(
@@ -134,16 +220,8 @@ def run_unordered(
                 yield Finished(index, None, exc)
         return
     if _is_dask_client(runner):
-        from distributed import as_completed as dask_as_completed
-
-        futures = [runner.submit(function, a, pure=False) for a in arguments]
-        where = {future.key: i for i, future in enumerate(futures)}
-        try:
-            for future in dask_as_completed(futures):  # type: ignore[no-untyped-call]
-                yield _outcome(where[future.key], future)
-        finally:
-            for future in futures:  # on Ctrl-C or an early stop: nothing left running for us
-                future.cancel()
+        for batch in run_batches(function, arguments, runner):
+            yield from batch
         return
     if not isinstance(runner, Executor):
         raise ParameterError(

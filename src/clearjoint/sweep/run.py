@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.errors import OutputExistsError, ParameterError
+from clearjoint.lock import LOCK_TIMEOUT_S, StoreLock
 from clearjoint.parallel import (
     ChunkFailedError,
     ResultStore,
@@ -30,7 +31,7 @@ from clearjoint.parallel import (
     chunk_bounds,
     dask_client,
     point_seed,
-    run_unordered,
+    run_batches,
 )
 from clearjoint.store import StoreWarning
 from clearjoint.sweep.file import Sweep
@@ -167,6 +168,8 @@ def run_sweep(
     force: bool = False,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    retries: int = 0,
+    lock_timeout: float = LOCK_TIMEOUT_S,
 ) -> Any:
     """Run the sweep and return its results as an xarray.Dataset.
 
@@ -187,7 +190,14 @@ def run_sweep(
     workers : int, optional
         Workers of the LocalCluster started when ``client`` is None.
     progress : callable, optional
-        ``progress(points_done, points_total)`` after each chunk (and once at the start).
+        ``progress(points_done, points_total)`` after each batch of chunks is stored
+        (and once at the start).
+    retries : int
+        Times a chunk is run again on a Dask client after its worker is lost or it
+        raises (default 0: such a chunk is reported, the others kept).
+    lock_timeout : float
+        Seconds without a heartbeat after which another client's lock on ``out`` is
+        stale and taken over (see :mod:`clearjoint.lock`); a fresh one is refused.
 
     Returns
     -------
@@ -201,20 +211,19 @@ def run_sweep(
     OutputExistsError
         ``out`` exists and neither ``resume`` nor ``force`` is given.
     StoreError
-        ``resume`` against a store made by a different sweep.
+        ``resume`` against a store made by a different sweep or of an older format;
+        ``out`` in use by another client (its lock); a store damaged after this run
+        wrote it.
     ChunkFailedError
         A chunk did not finish (a worker died); every other chunk is in the store.
     """
-    bounds = chunk_bounds(sweep.n_points, sweep.chunk_size)
-    store: ResultStore | None = None
-    todo = list(range(len(bounds)))
-    if out is not None:
+    if out is None:
+        return _run(sweep, None, None, client, workers, progress, retries)
+    with StoreLock(out, timeout=lock_timeout) as lock:
         path = Path(out)
         if resume and path.exists():
             store = ResultStore.open(path, fingerprint=sweep.fingerprint)
             _repair(store)
-            done = store.done_chunks()
-            todo = [i for i in todo if i not in done]
         else:
             store = ResultStore.create(
                 path,
@@ -225,6 +234,24 @@ def run_sweep(
                 attrs=_attrs(sweep),
                 force=force,
             )
+        return _run(sweep, store, lock, client, workers, progress, retries)
+
+
+def _run(
+    sweep: Sweep,
+    store: ResultStore | None,
+    lock: StoreLock | None,
+    client: Any,
+    workers: int | None,
+    progress: Callable[[int, int], None] | None,
+    retries: int,
+) -> Any:
+    """Run the chunks not done in ``store`` (all without one), writing them batch by batch."""
+    bounds = chunk_bounds(sweep.n_points, sweep.chunk_size)
+    todo = list(range(len(bounds)))
+    if store is not None:
+        done = store.done_chunks()
+        todo = [i for i in todo if i not in done]
     drawn = sweep.drawn()
     names = _column_names(sweep)
     chunks = [
@@ -245,30 +272,34 @@ def run_sweep(
         progress(finished, sweep.n_points)
     in_memory: dict[int, dict[str, NDArray[Any]]] = {}
     failures: list[str] = []
+    sample = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
     if chunks:
         with _runner(client, workers) as runner:
-            for outcome in run_unordered(_evaluate_chunk, chunks, runner):
-                chunk = todo[outcome.index]
-                if outcome.error is not None or outcome.result is None:
-                    failures.append(
-                        f"chunk {chunk}: {type(outcome.error).__name__}: {outcome.error}"
-                    )
-                    continue
-                if store is not None:
+            for batch in run_batches(_evaluate_chunk, chunks, runner, retries=retries):
+                written: list[tuple[int, dict[str, NDArray[Any]]]] = []
+                for outcome in batch:
+                    chunk = todo[outcome.index]
+                    if outcome.error is not None or outcome.result is None:
+                        error = outcome.error
+                        failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
+                        continue
                     values = dict(outcome.result)
+                    a, b = bounds[chunk]
                     for d in sweep.draws:
-                        a, b = bounds[chunk]
-                        values[d.name] = drawn[d.name][
-                            np.unravel_index(np.arange(a, b), sweep.shape)[0]
-                        ]
-                    store.write(chunk, values)
+                        values[d.name] = drawn[d.name][sample[a:b]]
+                    written.append((chunk, values))
+                if store is not None and lock is not None:
+                    lock.check()
+                    store.write_many(written)
                 else:
-                    in_memory[chunk] = outcome.result
-                finished += bounds[chunk][1] - bounds[chunk][0]
-                if progress:
+                    in_memory.update(written)
+                finished += sum(bounds[c][1] - bounds[c][0] for c, _ in written)
+                if progress and written:
                     progress(finished, sweep.n_points)
     if failures:
-        where = f"; the others are in {out}: finish with --resume" if out is not None else ""
+        where = (
+            f"; the others are in {store.path}: finish with --resume" if store is not None else ""
+        )
         raise ChunkFailedError(
             f"{len(failures)} of {len(bounds)} chunks did not finish ({failures[0]}){where}"
         )
@@ -277,8 +308,7 @@ def run_sweep(
     flat: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
     for var in _variables(sweep):
         if var.name in drawn:
-            index = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
-            array = drawn[var.name][index]
+            array = drawn[var.name][sample]
         else:
             array = np.concatenate([in_memory[i][var.name] for i in range(len(bounds))])
         flat[var.name] = (array, dict(var.attrs))
