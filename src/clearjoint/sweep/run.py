@@ -220,21 +220,25 @@ def run_sweep(
     if out is None:
         return _run(sweep, None, None, client, workers, progress, retries)
     with StoreLock(out, timeout=lock_timeout) as lock:
-        path = Path(out)
-        if resume and path.exists():
-            store = ResultStore.open(path, fingerprint=sweep.fingerprint)
-            _repair(store)
-        else:
-            store = ResultStore.create(
-                path,
-                fingerprint=sweep.fingerprint,
-                n_points=sweep.n_points,
-                chunk_size=sweep.chunk_size,
-                variables=_variables(sweep),
-                attrs=_attrs(sweep),
-                force=force,
-            )
+        store = _open_or_create(sweep, Path(out), resume=resume, force=force)
         return _run(sweep, store, lock, client, workers, progress, retries)
+
+
+def _open_or_create(sweep: Sweep, path: Path, *, resume: bool, force: bool) -> ResultStore:
+    """The sweep's store at ``path`` (its lock held): resumed and repaired, or made anew."""
+    if resume and path.exists():
+        store = ResultStore.open(path, fingerprint=sweep.fingerprint)
+        _repair(store)
+        return store
+    return ResultStore.create(
+        path,
+        fingerprint=sweep.fingerprint,
+        n_points=sweep.n_points,
+        chunk_size=sweep.chunk_size,
+        variables=_variables(sweep),
+        attrs=_attrs(sweep),
+        force=force,
+    )
 
 
 def _run(
@@ -342,6 +346,8 @@ def run_sweep_file(
     resume: bool = False,
     force: bool = False,
     progress: Callable[[Sweep], Callable[[int, int], None] | None] | None = None,
+    retries: int = 0,
+    lock_timeout: float = LOCK_TIMEOUT_S,
 ) -> tuple[Any, int]:
     """Return the results of the sweep file ``path`` run into the zarr store ``out``.
 
@@ -362,6 +368,8 @@ def run_sweep_file(
         Worker processes of the local cluster (default: one per core); not with
         ``scheduler``.
     resume, force : bool
+        As for :func:`run_sweep`.
+    retries, lock_timeout
         As for :func:`run_sweep`.
     progress : callable, optional
         Called with the loaded Sweep; returns the ``progress(done, total)`` callback
@@ -389,6 +397,9 @@ def run_sweep_file(
         if scheduler:  # an unreachable scheduler is said first, within seconds
             client = stack.enter_context(dask_client(scheduler))
         sweep = Sweep.from_toml(path)
+        # a store in use, of another sweep or damaged is said before a cluster starts
+        lock = stack.enter_context(StoreLock(out, timeout=lock_timeout))
+        store = _open_or_create(sweep, Path(out), resume=resume, force=force)
         if not scheduler:  # a bad sweep file is said before a cluster starts
             client = stack.enter_context(dask_client(workers=workers))
         report = progress(sweep) if progress is not None else None
@@ -399,9 +410,7 @@ def run_sweep_file(
             if report is not None:
                 report(done, total)
 
-        results = run_sweep(
-            sweep, client=client, out=out, resume=resume, force=force, progress=on_progress
-        )
+        results = _run(sweep, store, lock, client, None, on_progress, retries)
     return results, already[0] if already else 0
 
 
