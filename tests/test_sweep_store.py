@@ -19,6 +19,7 @@ import pytest
 import xarray as xr
 from distributed import LocalCluster
 
+import clearjoint.store
 from clearjoint.cli import main
 from clearjoint.parallel import StoreError
 from clearjoint.store import StoreWarning
@@ -58,7 +59,9 @@ def finished(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, xr.D
     path = folder / "sweep.toml"
     path.write_text(SWEEP, encoding="utf-8")
     out = folder / "whole.zarr"
-    results = run_sweep(Sweep.from_toml(path), client=SERIAL, out=out)
+    with pytest.MonkeyPatch.context() as patch:  # a file per task chunk: a neighbour to copy
+        patch.setattr(clearjoint.store, "POINTS_PER_FILE", 1)
+        results = run_sweep(Sweep.from_toml(path), client=SERIAL, out=out)
     return path, out, results
 
 
@@ -205,3 +208,21 @@ def test_a_store_of_the_older_format_is_one_clear_line(
         with pytest.raises(StoreError, match=r"older clearjoint .*--force") as info:
             attempt()
         assert "\n" not in str(info.value)
+
+
+def test_task_chunks_sharing_a_file_are_all_recomputed_when_it_is_damaged(
+    finished: tuple[Path, Path, xr.Dataset], tmp_path: Path
+) -> None:
+    sweep_file, _, reference = finished
+    out = tmp_path / "shared.zarr"
+    run_sweep(Sweep.from_toml(sweep_file), client=SERIAL, out=out)  # every chunk in one file
+    assert not _chunk_file(out, "amplitude_m", 1).exists()
+    _chunk_file(out, "amplitude_m", 0).write_bytes(b"\x00" * 9)
+    with pytest.raises(StoreError, match=r"chunk 0 \(points 0-1\) is damaged.*2 other chunks"):
+        open_sweep(out)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        resumed = run_sweep(Sweep.from_toml(sweep_file), client=SERIAL, out=out, resume=True)
+    said = [str(w.message) for w in caught if issubclass(w.category, StoreWarning)]
+    assert "recomputing 5 points of 3 damaged chunks" in said[0]
+    xr.testing.assert_identical(resumed, reference)

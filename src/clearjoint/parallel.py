@@ -163,15 +163,19 @@ def run_batches(
         submitted += len(part)
         return list(futures)
 
-    queue = dask_as_completed(
-        submit(min(window, len(arguments))), with_results=True, raise_errors=False
-    )  # type: ignore[no-untyped-call]
+    queue = dask_as_completed(submit(min(window, len(arguments))))  # type: ignore[no-untyped-call]
     try:
         for batch in queue.batches():  # type: ignore[no-untyped-call]
+            finished = [f for f in batch if f.status == "finished"]
+            results = runner.gather(finished) if finished else []  # one message a batch
             outcomes = [
-                _dask_outcome(where.pop(future.key), future, result) for future, result in batch
+                Finished(where.pop(f.key), result)
+                for f, result in zip(finished, results, strict=True)
             ]
-            del batch  # the futures: released once their results are here
+            for future in batch:
+                if future.status != "finished":  # lost, cancelled or raised
+                    outcomes.append(Finished(where.pop(future.key), None, _failure(future)))
+            del batch, finished, results  # the futures: released once their results are here
             if submitted < len(arguments) and len(where) < window // 2 + 1:
                 queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
             yield outcomes
@@ -184,12 +188,13 @@ def run_batches(
         queue.clear()  # type: ignore[no-untyped-call]
 
 
-def _dask_outcome(index: int, future: Any, result: Any) -> Finished[Any]:
-    if future.status == "error":
-        return Finished(index, None, result[1])
-    if future.status == "cancelled" or isinstance(result, BaseException):
-        return Finished(index, None, result if isinstance(result, BaseException) else None)
-    return Finished(index, result)
+def _failure(future: Any) -> BaseException:
+    """Why a Dask future did not finish: its exception, or that it was cancelled."""
+    try:
+        error = future.exception(timeout=CONNECT_TIMEOUT_S)
+    except BaseException as exc:  # CancelledError is a BaseException
+        return exc
+    return error if isinstance(error, BaseException) else RuntimeError(f"task {future.status}")
 
 
 def run_unordered(

@@ -44,6 +44,10 @@ __all__ = [
 #: The store layout this clearjoint writes: 2 adds crc32c and the chunk digests.
 STORE_FORMAT = 2
 
+#: Points per zarr chunk file, at least: small task chunks share a file (whole task
+#: chunks per file), so a batch of them is a few files, not a few per task chunk.
+POINTS_PER_FILE = 256
+
 _FINGERPRINT = "clearjoint_sweep_fingerprint"
 _FORMAT = "clearjoint_store_format"
 _DONE = "chunk_done"
@@ -111,6 +115,7 @@ class ResultStore:
         self.chunk_size = chunk_size
         self.n_points = n_points
         self._names = [str(n) for n in group[_DIGEST].attrs["variables"]]
+        self.per_file = int(group[_DONE].chunks[0])  # task chunks per zarr chunk file
         self._dtypes = {
             n: ("str" if group[n].dtype.kind in "OTUS" else group[n].dtype.str[1:])
             for n in self._names
@@ -161,6 +166,7 @@ class ResultStore:
             shutil.rmtree(path)
         group: Any = zarr.open_group(str(path), mode="w-", zarr_format=3)
         n_chunks = len(_bounds(n_points, chunk_size))
+        per_file = min(max(1, -(-POINTS_PER_FILE // chunk_size)), n_chunks)
         codecs = (ZstdCodec(), Crc32cCodec())
         for var in variables:
             kind: Any = str if var.dtype == "str" else var.dtype
@@ -168,7 +174,7 @@ class ResultStore:
             array = group.create_array(
                 var.name,
                 shape=(n_points, *var.shape),
-                chunks=(chunk_size, *var.shape),
+                chunks=(chunk_size * per_file, *var.shape),
                 dtype=kind,
                 fill_value=fill,
                 compressors=codecs,
@@ -178,7 +184,7 @@ class ResultStore:
         digest = group.create_array(
             _DIGEST,
             shape=(n_chunks, len(variables)),
-            chunks=(1, len(variables)),
+            chunks=(per_file, len(variables)),
             dtype="uint64",
             fill_value=0,
             compressors=codecs,
@@ -188,10 +194,10 @@ class ResultStore:
         group.create_array(
             _DONE,
             shape=(n_chunks,),
-            chunks=(1,),
             dtype="bool",
             fill_value=False,
             compressors=codecs,
+            chunks=(per_file,),
             dimension_names=["chunk"],
         )
         # the fingerprint last: a store cut while being made is no sweep store
@@ -257,8 +263,9 @@ class ResultStore:
             return flags, bad
 
     def _chunk_key(self, name: str, chunk: int) -> str:
+        """The key of the zarr chunk file of array ``name`` that holds task chunk ``chunk``."""
         array = self._group[name]
-        coords = (chunk, *(0,) * (array.ndim - 1))
+        coords = (chunk // self.per_file, *(0,) * (array.ndim - 1))
         return f"{name}/{array.metadata.encode_chunk_key(coords)}"
 
     def _load(self) -> tuple[dict[str, NDArray[Any]], dict[int, str]]:
@@ -320,14 +327,31 @@ class ResultStore:
         """Return the damaged chunks: index -> what is wrong (see the module docstring)."""
         return self._load()[1]
 
-    def discard(self, chunks: Sequence[int]) -> None:
-        """Unflag ``chunks`` and delete their data, so that they are computed again."""
+    def discard(self, chunks: Sequence[int]) -> set[int]:
+        """Unflag ``chunks`` so that they are computed again; return every chunk to recompute.
+
+        A file that does not decode is deleted (zarr could not write into it), so the
+        other done chunks it held are unflagged and returned too.
+        """
         if not chunks:
-            return
-        for chunk in chunks:
-            for name in (*self._names, *_OWN):
-                file = self.path / self._chunk_key(name, chunk)
-                file.unlink(missing_ok=True)
+            return set()
+        flags = self._flags()[0]
+        lost = set(chunks)
+        files = sorted({c // self.per_file for c in chunks})
+        for name in (*self._names, *_OWN):
+            array = self._group[name]
+            scale = self.chunk_size if name in self._names else 1
+            for f in files:
+                a = f * self.per_file
+                b = min(a + self.per_file, self.n_chunks)
+                try:
+                    array[a * scale : min(b * scale, array.shape[0])]
+                except Exception:
+                    (self.path / self._chunk_key(name, a)).unlink(missing_ok=True)
+                    lost |= {c for c in range(a, b) if flags[c]}
+        for run in _runs(np.asarray(sorted(lost))):
+            self._group[_DONE][run[0] : run[-1] + 1] = False
+        return lost
 
     def describe(self, chunk: int) -> str:
         """``chunk 3 (points 6-7)``: a chunk as a message names it."""

@@ -324,13 +324,13 @@ def _repair(store: ResultStore) -> None:
     damaged = store.check()
     if not damaged:
         return
-    store.discard(sorted(damaged))
+    again = store.discard(sorted(damaged))
     bounds = chunk_bounds(store.n_points, store.chunk_size)
-    points = sum(bounds[i][1] - bounds[i][0] for i in damaged)
+    points = sum(bounds[i][1] - bounds[i][0] for i in again)
     first = min(damaged)
     warnings.warn(
         StoreWarning(
-            f"{store.path}: recomputing {points} points of {len(damaged)} damaged chunks "
+            f"{store.path}: recomputing {points} points of {len(again)} damaged chunks "
             f"(first: {store.describe(first)}: {damaged[first]})"
         ),
         stacklevel=3,
