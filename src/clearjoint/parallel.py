@@ -21,6 +21,7 @@ import logging
 import os
 import socket
 import sys
+import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -122,6 +123,7 @@ def run_batches(
     *,
     retries: int = 0,
     window: int = DASK_WINDOW,
+    every: float = 0.0,
 ) -> Iterator[list[Finished[R]]]:
     """Yield the tasks' :class:`Finished` outcomes in batches, as they end.
 
@@ -140,6 +142,10 @@ def run_batches(
         raises (``client.map(retries=...)``). Ignored elsewhere.
     window : int
         On a Dask client: most tasks submitted and not yet yielded.
+    every : float
+        On a Dask client: seconds at least between two batches (the results that
+        came meanwhile are fetched and held), so that a caller writing each batch
+        writes few large ones; the last batch comes as soon as the last task ends.
     """
     if retries < 0:
         raise ParameterError(f"retries must be >= 0 (--retries), got {retries}")
@@ -164,21 +170,33 @@ def run_batches(
         return list(futures)
 
     queue = dask_as_completed(submit(min(window, len(arguments))))  # type: ignore[no-untyped-call]
+    collected: list[Finished[R]] = []
+    last = time.monotonic()
     try:
-        for batch in queue.batches():  # type: ignore[no-untyped-call]
+        while where:
+            if not collected:
+                batch = queue.next_batch(block=True)  # type: ignore[no-untyped-call]
+            elif queue.has_ready():  # type: ignore[no-untyped-call]
+                batch = queue.next_batch(block=False)  # type: ignore[no-untyped-call]
+            else:
+                time.sleep(0.005)
+                batch = []
             finished = [f for f in batch if f.status == "finished"]
             results = runner.gather(finished) if finished else []  # one message a batch
-            outcomes = [
+            collected += [
                 Finished(where.pop(f.key), result)
                 for f, result in zip(finished, results, strict=True)
             ]
             for future in batch:
                 if future.status != "finished":  # lost, cancelled or raised
-                    outcomes.append(Finished(where.pop(future.key), None, _failure(future)))
-            del batch, finished, results  # the futures: released once their results are here
+                    collected.append(Finished(where.pop(future.key), None, _failure(future)))
+            del batch, finished, results  # the futures: let go once their results are here
             if submitted < len(arguments) and len(where) < window // 2 + 1:
                 queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
-            yield outcomes
+            if collected and (not where or time.monotonic() - last >= every):
+                yield collected
+                collected = []
+                last = time.monotonic()
     finally:  # on Ctrl-C or an early stop: nothing left running for us
         with queue.lock:
             left = list(queue.futures)
@@ -338,7 +356,11 @@ def probe_scheduler(address: str, timeout: float = PROBE_TIMEOUT_S) -> None:
 
 @contextlib.contextmanager
 def dask_client(
-    address: str | None = None, *, workers: int | None = None, processes: bool = True
+    address: str | None = None,
+    *,
+    workers: int | None = None,
+    processes: bool = True,
+    threads: int = 1,
 ) -> Iterator[Client]:
     """Yield a Dask client: to the scheduler at ``address``, or to a new LocalCluster.
 
@@ -351,6 +373,11 @@ def dask_client(
         Workers of the LocalCluster (ignored with ``address``).
     processes : bool
         Workers as processes (default) or as threads of this process (for tests).
+    threads : int
+        Threads of each LocalCluster worker (default 1: tasks hold the GIL).
+
+    The LocalCluster's dashboard listens on 127.0.0.1 only, on any free port
+    (``client.dashboard_link``); reach it from another machine through an SSH tunnel.
 
     Raises
     ------
@@ -378,9 +405,10 @@ def dask_client(
     with (
         LocalCluster(  # type: ignore[no-untyped-call]
             n_workers=n,
-            threads_per_worker=1,
+            threads_per_worker=threads,
             processes=processes,
-            dashboard_address=":0",  # any free port: never a clash with a running one
+            host="127.0.0.1",  # scheduler, workers and dashboard: this machine only
+            dashboard_address="127.0.0.1:0",  # any free port: never a clash with a running one
             silence_logs=logging.ERROR,
         ) as cluster,
         Client(cluster) as client,  # type: ignore[no-untyped-call]

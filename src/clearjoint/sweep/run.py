@@ -47,6 +47,10 @@ __all__ = [
 #: Pass as ``client`` to run every chunk in this process, one after the other.
 SERIAL = "serial"
 
+#: Seconds at least between two writes to the store on a Dask client (results in between
+#: are held by the client, their futures let go): a few large writes, not one a chunk.
+_WRITE_EVERY_S = 1.0
+
 #: Longest reason kept in ``status`` for a failed point.
 _REASON_CHARS = 300
 
@@ -279,7 +283,10 @@ def _run(
     sample = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
     if chunks:
         with _runner(client, workers) as runner:
-            for batch in run_batches(_evaluate_chunk, chunks, runner, retries=retries):
+            batches = run_batches(
+                _evaluate_chunk, chunks, runner, retries=retries, every=_WRITE_EVERY_S
+            )
+            for batch in batches:
                 written: list[tuple[int, dict[str, NDArray[Any]]]] = []
                 for outcome in batch:
                     chunk = todo[outcome.index]
