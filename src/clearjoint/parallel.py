@@ -407,7 +407,7 @@ def dask_client(
             n_workers=n,
             threads_per_worker=threads,
             processes=processes,
-            host="127.0.0.1",  # scheduler, workers and dashboard: this machine only
+            **({"host": "127.0.0.1"} if processes else {}),  # this machine only (threads: inproc)
             dashboard_address="127.0.0.1:0",  # any free port: never a clash with a running one
             silence_logs=logging.ERROR,
         ) as cluster,
