@@ -19,8 +19,10 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import signal
 import socket
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
@@ -187,10 +189,14 @@ def run_batches(
                 Finished(where.pop(f.key), result)
                 for f, result in zip(finished, results, strict=True)
             ]
-            for future in batch:
-                if future.status != "finished":  # lost, cancelled or raised
-                    collected.append(Finished(where.pop(future.key), None, _failure(future)))
-            del batch, finished, results  # the futures: let go once their results are here
+            collected += [
+                Finished(where.pop(f.key), None, _failure(f))
+                for f in batch
+                if f.status != "finished"  # lost, cancelled or raised
+            ]
+            # the futures: let go once their results are here (no name left holding one,
+            # or the scheduler keeps its result and recomputes it if its worker dies)
+            del batch, finished, results
             if submitted < len(arguments) and len(where) < window // 2 + 1:
                 queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
             if collected and (not where or time.monotonic() - last >= every):
@@ -402,18 +408,51 @@ def dask_client(
             yield client
         return
     n = workers or os.cpu_count() or 1
-    with (
-        LocalCluster(  # type: ignore[no-untyped-call]
+    # the worker processes ignore Ctrl-C (a terminal sends it to the whole process group):
+    # this process says it in one line and closes them, with no traceback of theirs
+    with _interrupt_ignored_by_children():
+        cluster = LocalCluster(  # type: ignore[no-untyped-call]
             n_workers=n,
             threads_per_worker=threads,
             processes=processes,
             **({"host": "127.0.0.1"} if processes else {}),  # this machine only (threads: inproc)
             dashboard_address="127.0.0.1:0",  # any free port: never a clash with a running one
             silence_logs=logging.ERROR,
-        ) as cluster,
-        Client(cluster) as client,  # type: ignore[no-untyped-call]
-    ):
+        )
+    with cluster, Client(cluster) as client:  # type: ignore[no-untyped-call]
+        if processes:  # and so do the workers the nannies start again after a crash
+            client.register_plugin(_ignore_interrupt_plugin())
         yield client
+
+
+@contextlib.contextmanager
+def _interrupt_ignored_by_children() -> Iterator[None]:
+    """SIGINT ignored while processes start (they inherit it), then as it was."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _ignore_interrupt_plugin() -> Any:
+    """A Dask worker plugin that makes its worker process ignore SIGINT."""
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class IgnoreInterrupt(WorkerPlugin):
+        name = "clearjoint-ignore-interrupt"
+
+        def setup(self, worker: Any) -> None:
+            import signal
+            import threading
+
+            if threading.current_thread() is threading.main_thread():
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    return IgnoreInterrupt()
 
 
 @contextlib.contextmanager
