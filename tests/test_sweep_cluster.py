@@ -17,6 +17,7 @@ from pathlib import Path
 
 import cloudpickle
 import numpy as np
+import pytest
 
 from clearjoint.parallel import ResultStore, dask_client
 from clearjoint.sweep import SERIAL, Axis, Sweep, Task, run_sweep
@@ -161,3 +162,29 @@ def test_ctrl_c_on_a_local_cluster_is_one_line_and_exit_130(tmp_path: Path) -> N
     assert "--resume" in lines[0]
     assert ResultStore.open(out).done_chunks()  # what was finished is kept
     assert not Path(f"{out}.lock").exists()
+
+
+def test_a_batch_cluster_without_its_configuration_is_one_line_and_no_store(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import dask
+
+    from clearjoint.cli import main
+
+    (tmp_path / "study.toml").write_text(STUDY, encoding="utf-8")
+    path = tmp_path / "sweep.toml"
+    path.write_text(SLOW_SWEEP.format(num=4), encoding="utf-8")
+    out = tmp_path / "r.zarr"
+    command = ["sweep", str(path), "--out", str(out), "--cluster", "slurm"]
+    with dask.config.set({"jobqueue.slurm.cores": None, "jobqueue.slurm.memory": None}):
+        assert main(command) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "jobqueue.yaml" in err
+    assert not out.exists()
+    assert not Path(f"{out}.lock").exists()
+    monkeypatch.setitem(sys.modules, "dask_jobqueue", None)  # as if not installed
+    assert main(command) == 2
+    assert "pip install 'clearjoint[cluster]'" in capsys.readouterr().err
+    assert main([*command, "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    assert "leave out --scheduler" in capsys.readouterr().err

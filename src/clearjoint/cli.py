@@ -338,6 +338,7 @@ def _run_sweep(args: argparse.Namespace) -> int:
                 progress=bar,
                 retries=args.retries,
                 lock_timeout=lock_timeout,
+                cluster=args.cluster,
             )
         except KeyboardInterrupt:
             print(

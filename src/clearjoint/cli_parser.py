@@ -318,6 +318,11 @@ def _sweep_parser(sub: Any) -> None:
         "--retries", type=int, default=0, help="runs again of a chunk whose worker is lost (0)"
     )
     p.add_argument(
+        "--cluster",
+        choices=("slurm", "pbs", "sge"),
+        help="workers as batch jobs (dask-jobqueue; --workers jobs, default 1; docs/sweep.md)",
+    )
+    p.add_argument(
         "--lock-timeout",
         default="60s",
         help="another client's lock on --out without heartbeat this long is taken over (60s)",

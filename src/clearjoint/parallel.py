@@ -41,6 +41,7 @@ __all__ = [
     "CONNECT_TIMEOUT_S",
     "DASK_WINDOW",
     "DEFAULT_SCHEDULER_PORT",
+    "JOB_QUEUES",
     "PROBE_TIMEOUT_S",
     "ChunkFailedError",
     "Finished",
@@ -51,6 +52,7 @@ __all__ = [
     "Variable",
     "chunk_bounds",
     "dask_client",
+    "jobqueue_client",
     "point_seed",
     "probe_scheduler",
     "process_pool",
@@ -453,6 +455,59 @@ def _ignore_interrupt_plugin() -> Any:
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     return IgnoreInterrupt()
+
+
+#: The batch systems ``--cluster`` starts Dask workers on, and dask-jobqueue's class for each.
+JOB_QUEUES = {"slurm": "SLURMCluster", "pbs": "PBSCluster", "sge": "SGECluster"}
+
+
+@contextlib.contextmanager
+def jobqueue_client(kind: str, *, jobs: int | None = None) -> Iterator[Client]:
+    """Yield a Dask client to workers started as ``jobs`` batch jobs (dask-jobqueue).
+
+    Each job's cores, memory, queue, account and walltime come from the Dask
+    configuration (``~/.config/dask/jobqueue.yaml``, section ``jobqueue.<kind>``; see
+    docs/sweep.md); this process is the scheduler and the client, so run it where
+    the compute nodes can reach it (a login node, or a job of its own).
+
+    Parameters
+    ----------
+    kind : {"slurm", "pbs", "sge"}
+        The batch system.
+    jobs : int, optional
+        Jobs to submit (default 1); each starts the workers its configuration says.
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``kind``, dask-jobqueue not installed, or its configuration lacks
+        what a job needs (cores, memory): one line saying where to put it.
+    """
+    if kind not in JOB_QUEUES:
+        raise ParameterError(f"--cluster must be one of {sorted(JOB_QUEUES)}, got {kind!r}")
+    if jobs is not None and jobs < 1:
+        raise ParameterError(f"jobs must be >= 1 (--workers with --cluster), got {jobs}")
+    try:
+        import dask_jobqueue
+    except ImportError:
+        raise ParameterError(
+            f"--cluster {kind} needs dask-jobqueue: pip install 'clearjoint[cluster]'"
+        ) from None
+    import dask
+    from distributed import Client
+
+    missing = [
+        k for k in ("cores", "memory") if dask.config.get(f"jobqueue.{kind}.{k}", None) is None
+    ]
+    if missing:  # said before a cluster object exists (its __init__ would half-make one)
+        raise ParameterError(
+            f"--cluster {kind}: dask-jobqueue needs {' and '.join(missing)} per job: set "
+            f"them in ~/.config/dask/jobqueue.yaml under jobqueue.{kind} (see docs/sweep.md)"
+        )
+    cluster = getattr(dask_jobqueue, JOB_QUEUES[kind])()
+    with cluster, Client(cluster) as client:  # type: ignore[no-untyped-call]
+        cluster.scale(jobs=jobs or 1)
+        yield client
 
 
 @contextlib.contextmanager

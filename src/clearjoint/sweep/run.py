@@ -30,6 +30,7 @@ from clearjoint.parallel import (
     Variable,
     chunk_bounds,
     dask_client,
+    jobqueue_client,
     point_seed,
     run_batches,
 )
@@ -355,6 +356,7 @@ def run_sweep_file(
     progress: Callable[[Sweep], Callable[[int, int], None] | None] | None = None,
     retries: int = 0,
     lock_timeout: float = LOCK_TIMEOUT_S,
+    cluster: str | None = None,
 ) -> tuple[Any, int]:
     """Return the results of the sweep file ``path`` run into the zarr store ``out``.
 
@@ -378,6 +380,9 @@ def run_sweep_file(
         As for :func:`run_sweep`.
     retries, lock_timeout
         As for :func:`run_sweep`.
+    cluster : {"slurm", "pbs", "sge"}, optional
+        Start the workers as batch jobs (``workers`` of them, default 1) through
+        dask-jobqueue (:func:`clearjoint.parallel.jobqueue_client`); not with ``scheduler``.
     progress : callable, optional
         Called with the loaded Sweep; returns the ``progress(done, total)`` callback
         of :func:`run_sweep` (or None).
@@ -393,6 +398,8 @@ def run_sweep_file(
         raise ParameterError(f"--out must end in .zarr, got {str(out)!r}")
     if scheduler and workers is not None:
         raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    if scheduler and cluster:
+        raise ParameterError("--cluster starts its own scheduler; leave out --scheduler")
     if Path(out).exists() and not (resume or force):
         raise OutputExistsError(
             f"will not overwrite {out}; pass --resume to finish it, --force to start "
@@ -404,11 +411,14 @@ def run_sweep_file(
         if scheduler:  # an unreachable scheduler is said first, within seconds
             client = stack.enter_context(dask_client(scheduler))
         sweep = Sweep.from_toml(path)
-        # a store in use, of another sweep or damaged is said before a cluster starts
+        # a store in use is said before a cluster starts; the store is made once one has
+        # started (a cluster that cannot start leaves no empty store behind)
         lock = stack.enter_context(StoreLock(out, timeout=lock_timeout))
-        store = _open_or_create(sweep, Path(out), resume=resume, force=force)
-        if not scheduler:  # a bad sweep file is said before a cluster starts
+        if cluster:
+            client = stack.enter_context(jobqueue_client(cluster, jobs=workers))
+        elif not scheduler:  # a bad sweep file is said before a cluster starts
             client = stack.enter_context(dask_client(workers=workers))
+        store = _open_or_create(sweep, Path(out), resume=resume, force=force)
         report = progress(sweep) if progress is not None else None
 
         def on_progress(done: int, total: int) -> None:
