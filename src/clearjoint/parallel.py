@@ -32,7 +32,9 @@ from typing import TYPE_CHECKING, Any, Generic, TypeVar
 import numpy as np
 
 from clearjoint.errors import ClearjointError, ParameterError
-from clearjoint.store import ResultStore, StoreError, Variable
+from clearjoint.store import ResultStore as ResultStore  # re-exported: their old home
+from clearjoint.store import StoreError as StoreError
+from clearjoint.store import Variable as Variable
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -45,11 +47,8 @@ __all__ = [
     "PROBE_TIMEOUT_S",
     "ChunkFailedError",
     "Finished",
-    "ResultStore",
     "Runner",
     "SchedulerError",
-    "StoreError",
-    "Variable",
     "chunk_bounds",
     "dask_client",
     "jobqueue_client",
