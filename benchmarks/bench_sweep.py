@@ -187,6 +187,11 @@ SLEEP = Task(
 )
 
 
+def _noop(index: int) -> int:
+    """Nothing: what Dask alone costs a task."""
+    return index
+
+
 def _timed_store_run(sweep: Sweep, client: object) -> tuple[float, float]:
     """Wall seconds and this process's CPU seconds of one run into a fresh zarr store."""
     with tempfile.TemporaryDirectory() as folder:
@@ -231,11 +236,19 @@ def store_targets(scale: float = 1.0) -> None:
             warm = replace(sweep, samples=2 * workers)
             _timed_store_run(warm, client)  # workers and the store's imports warm
             wall, cpu = _timed_store_run(sweep, client)
+            # Dask alone, side by side: as many no-op tasks, one client.map and one gather
+            c0, t0 = time.process_time(), time.perf_counter()
+            client.gather(client.map(_noop, range(n), pure=False))
+            bare, bare_cpu = time.perf_counter() - t0, time.process_time() - c0
         over = (wall - loop / workers) / n
         print(
             f"   {workers} worker(s) with the store: {wall:.2f} s, {n / wall:.0f} points/s; "
             f"overhead {over * 1e3:.2f} ms a task (wall - loop/{workers}), client CPU "
             f"{cpu / n * 1e3:.2f} ms a task; target <= 2 ms"
+        )
+        print(
+            f"   Dask alone, {n} no-op tasks (map + gather): {bare:.2f} s, "
+            f"{bare / n * 1e3:.2f} ms a task, client CPU {bare_cpu / n * 1e3:.2f} ms a task"
         )
     # 2. a CPU-bound study, chunks of 0.5 s: 2 workers against 1
     spin = spin_sweep(max(40, int(200 * scale)), 0.050, 10)

@@ -185,19 +185,17 @@ def run_batches(
                 time.sleep(0.005)
                 batch = []
             finished = [f for f in batch if f.status == "finished"]
+            keys = {f.key for f in finished}  # (a status read once: it may change meanwhile)
+            failed = [f for f in batch if f.key not in keys]  # lost, cancelled or raised
             results = runner.gather(finished) if finished else []  # one message a batch
             collected += [
                 Finished(where.pop(f.key), result)
                 for f, result in zip(finished, results, strict=True)
             ]
-            collected += [
-                Finished(where.pop(f.key), None, _failure(f))
-                for f in batch
-                if f.status != "finished"  # lost, cancelled or raised
-            ]
+            collected += [Finished(where.pop(f.key), None, _failure(f)) for f in failed]
             # the futures: let go once their results are here (no name left holding one,
             # or the scheduler keeps its result and recomputes it if its worker dies)
-            del batch, finished, results
+            del batch, finished, failed, results
             if submitted < len(arguments) and len(where) < window // 2 + 1:
                 queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
             if collected and (not where or time.monotonic() - last >= every):
