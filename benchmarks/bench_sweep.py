@@ -168,6 +168,119 @@ def throughput(repeats: int, cases: list[tuple[float, int, int]] = CASES) -> Non
         print("kernel autogroup on: this session's processes share one session's CPU")
 
 
+def _sleep(
+    base: object, values: Mapping[str, float], seed: np.random.SeedSequence
+) -> dict[str, float]:
+    """A task that waits ``task.cost_s`` seconds (a simulated cluster's busy worker)."""
+    time.sleep(values["task.cost_s"])
+    return {"value": float(np.random.default_rng(seed).normal())}
+
+
+SLEEP = Task(
+    name="sleep",
+    base="none",
+    parameters={},
+    options={},
+    outputs={"value": ""},
+    evaluate=_sleep,
+    description="wait task.cost_s seconds",
+)
+
+
+def _noop(index: int) -> int:
+    """Nothing: what Dask alone costs a task."""
+    return index
+
+
+def _timed_store_run(sweep: Sweep, client: object) -> tuple[float, float]:
+    """Wall seconds and this process's CPU seconds of one run into a fresh zarr store."""
+    with tempfile.TemporaryDirectory() as folder:
+        c0, t0 = time.process_time(), time.perf_counter()
+        run_sweep(sweep, client=client, out=Path(folder) / "bench.zarr")
+        return time.perf_counter() - t0, time.process_time() - c0
+
+
+def store_targets(scale: float = 1.0) -> None:
+    """Issue 27's targets side by side in one run: client overhead, 2 workers, 200 threads."""
+    from dataclasses import replace
+
+    from clearjoint.sweep.run import _Chunk, _column_names, _evaluate_chunk, _point_values
+
+    load = os.getloadavg()[0]
+    print(f"load average before: {load:.1f} on {os.cpu_count()} cores (shared machine)")
+    # 1. overhead a task: examples/tolerance.toml at chunk_size = 1 against a plain loop
+    sweep = replace(Sweep.from_toml(EXAMPLES / "tolerance.toml"), chunk_size=1)
+    if scale < 1:
+        sweep = replace(sweep, samples=max(2, int(sweep.samples * scale)))
+    drawn = sweep.drawn()
+    names = _column_names(sweep)
+    every = _Chunk(
+        sweep.task,
+        sweep.base,
+        names,
+        _point_values(sweep, drawn, 0, sweep.n_points),
+        0,
+        sweep.seed,
+        sweep.outputs,
+        sweep.fixed,
+    )
+    _evaluate_chunk(replace(every, values=every.values[:4]))  # compiled and warm
+    t0 = time.perf_counter()
+    _evaluate_chunk(every)
+    loop = time.perf_counter() - t0
+    n = sweep.n_points
+    print(f"1. {n} points of tolerance.toml (chunk_size = 1): plain loop {loop:.2f} s")
+    for workers in (1, 2):
+        with dask_client(workers=workers) as client:
+            client.wait_for_workers(workers)
+            warm = replace(sweep, samples=2 * workers)
+            _timed_store_run(warm, client)  # workers and the store's imports warm
+            wall, cpu = _timed_store_run(sweep, client)
+            # Dask alone, side by side: as many no-op tasks, one client.map and one gather
+            c0, t0 = time.process_time(), time.perf_counter()
+            client.gather(client.map(_noop, range(n), pure=False))
+            bare, bare_cpu = time.perf_counter() - t0, time.process_time() - c0
+        over = (wall - loop / workers) / n
+        print(
+            f"   {workers} worker(s) with the store: {wall:.2f} s, {n / wall:.0f} points/s; "
+            f"overhead {over * 1e3:.2f} ms a task (wall - loop/{workers}), client CPU "
+            f"{cpu / n * 1e3:.2f} ms a task; target <= 2 ms"
+        )
+        print(
+            f"   Dask alone, {n} no-op tasks (map + gather): {bare:.2f} s, "
+            f"{bare / n * 1e3:.2f} ms a task, client CPU {bare_cpu / n * 1e3:.2f} ms a task"
+        )
+    # 2. a CPU-bound study, chunks of 0.5 s: 2 workers against 1
+    spin = spin_sweep(max(40, int(200 * scale)), 0.050, 10)
+    walls = {}
+    for workers in (1, 2):
+        with dask_client(workers=workers) as client:
+            client.wait_for_workers(workers)
+            client.run(_warm)
+            walls[workers], _ = _timed_store_run(spin, client)
+    print(
+        f"2. {spin.n_points} points of 50 ms CPU in chunks of 0.5 s, with the store: "
+        f"1 worker {walls[1]:.2f} s, 2 workers {walls[2]:.2f} s, "
+        f"{walls[1] / walls[2]:.2f}x; target >= 1.7x"
+    )
+    # 3. a simulated cluster of 200 threads on 50 ms sleeps, chunk_size = 1
+    sleeps = replace(spin_sweep(int(10_000 * scale), 0.050, 1), task=SLEEP)
+    with dask_client(workers=2, threads=100) as client:
+        client.wait_for_workers(2)
+        _timed_store_run(replace(sleeps, axes=(Axis("task.index", (0.0, 1.0), ""),)), client)
+        wall, cpu = _timed_store_run(sleeps, client)
+        t0 = time.perf_counter()
+        run_sweep(sleeps, client=client)
+        bare = time.perf_counter() - t0
+    print(
+        f"3. {sleeps.n_points} tasks of 50 ms sleep on 2 workers x 100 threads: with the store "
+        f"{sleeps.n_points / wall:.0f} tasks/s (client CPU {cpu / sleeps.n_points * 1e3:.2f} ms "
+        f"a task), without it {sleeps.n_points / bare:.0f} tasks/s; target >= 2,000/s "
+        f"(4,000/s if the 200 threads were never idle)"
+    )
+    print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+
+
 RESTART_SWEEP = """
 base = "{study}"
 seed = 3
@@ -232,9 +345,17 @@ if __name__ == "__main__":  # LocalCluster workers are spawned processes: keep t
     parser.add_argument("--repeats", type=int, default=2, help="runs per rate (best kept)")
     parser.add_argument("--throughput-only", action="store_true", help="skip the restart test")
     parser.add_argument(
+        "--store-targets",
+        action="store_true",
+        help="only issue 27's targets (client overhead, 2 workers, 200 threads)",
+    )
+    parser.add_argument(
         "--smoke", action="store_true", help="tiny sizes: checks it runs, no figures"
     )
     options = parser.parse_args()
+    if options.store_targets:
+        store_targets(0.05 if options.smoke else 1.0)
+        raise SystemExit(0)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     sizes = [(cost, points // 20, chunk // 10) for cost, points, chunk in CASES]
     throughput(options.repeats, sizes if options.smoke else CASES)

@@ -302,15 +302,22 @@ def _run_sweep(args: argparse.Namespace) -> int:
     if args.plot:
         return _plot_sweep(args)
     from clearjoint.sweep.run import run_sweep_file
+    from clearjoint.units import parse_quantity
 
     if args.sweep is None or args.out is None:
         raise ParameterError("give a sweep file and --out results.zarr (or --plot STORE VAR)")
+    lock_timeout = parse_quantity(args.lock_timeout, "time", name="--lock-timeout")
+    every = parse_quantity(args.progress_every, "time", name="--progress-every")
+    if not lock_timeout > 0 or not every > 0:
+        raise ParameterError("--lock-timeout and --progress-every must be > 0 s, e.g. 60s")
     start = time.perf_counter()
     with contextlib.ExitStack() as stack:
 
         def bar(sweep: Any) -> Callable[[int, int], None] | None:
-            if args.quiet or not sys.stderr.isatty():
+            if args.quiet:
                 return None
+            if not sys.stderr.isatty():  # a batch log: a line every `every` seconds
+                return _progress_lines(every, start)
             from rich.progress import Progress, TimeRemainingColumn
 
             columns = (*Progress.get_default_columns()[:-1], TimeRemainingColumn())
@@ -326,6 +333,9 @@ def _run_sweep(args: argparse.Namespace) -> int:
             resume=args.resume,
             force=args.force,
             progress=bar,
+            retries=args.retries,
+            lock_timeout=lock_timeout,
+            cluster=args.cluster,
         )
     failed = results.attrs["points_failed"]
     kept_text = f", {kept} of them kept from the store" if kept else ""
@@ -334,6 +344,27 @@ def _run_sweep(args: argparse.Namespace) -> int:
         f"to {args.out} in {time.perf_counter() - start:.1f} s"
     )
     return 0
+
+
+def _progress_lines(every: float, start: float) -> Callable[[int, int], None]:
+    """A progress callback that prints one line on stderr at most every ``every`` seconds."""
+    import time
+
+    last = [time.perf_counter()]
+
+    def line(done: int, total: int) -> None:
+        now = time.perf_counter()
+        if now - last[0] < every:  # the end is said by the "wrote" line
+            return
+        last[0] = now
+        print(
+            f"clearjoint sweep: {done} of {total} points stored ({100 * done / total:.0f} %) "
+            f"after {now - start:.0f} s",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    return line
 
 
 def _plot_sweep(args: argparse.Namespace) -> int:

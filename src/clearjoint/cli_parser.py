@@ -359,6 +359,24 @@ def _sweep_parser(sub: Any) -> None:
         scheduler="a running Dask scheduler, e.g. tcp://host:8786",
     )
     p.add_argument("--workers", type=int, help="local cluster's worker processes (default: cores)")
+    p.add_argument(
+        "--retries", type=int, default=0, help="runs again of a chunk whose worker is lost (0)"
+    )
+    p.add_argument(
+        "--cluster",
+        choices=("slurm", "pbs", "sge"),
+        help="workers as batch jobs (dask-jobqueue; --workers jobs, default 1; docs/sweep.md)",
+    )
+    p.add_argument(
+        "--lock-timeout",
+        default="60s",
+        help="another client's lock on --out without heartbeat this long is taken over (60s)",
+    )
+    p.add_argument(
+        "--progress-every",
+        default="30s",
+        help="without a terminal: a progress line on stderr this often (30s)",
+    )
     _flags(
         p,
         resume="finish an interrupted --out store",

@@ -9,11 +9,9 @@ Reproducibility does not depend on where a task runs: a point's random numbers
 come from :func:`point_seed`, ``SeedSequence(seed).spawn(n)[index]`` made from the
 point's index alone, and every task is a pure function of its frozen argument.
 
-:class:`ResultStore` keeps a sweep's results on disk as a zarr group with one
-array per variable along ``point`` (a zarr chunk per task chunk) and a
-``chunk_done`` flag written after each chunk's values, so a run stopped at any
-moment resumes by computing only the chunks not flagged. A store records the
-fingerprint of the sweep that made it; resuming from another sweep is refused.
+:class:`ResultStore` (clearjoint.store, re-exported here) keeps a sweep's results on
+disk, checked chunk by chunk, so a run stopped at any moment resumes by computing only
+the chunks not done or damaged.
 """
 
 from __future__ import annotations
@@ -21,39 +19,43 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-import shutil
 import signal
 import socket
-from collections.abc import Callable, Iterator, Mapping, Sequence
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 import numpy as np
-from numpy.typing import NDArray
 
-from clearjoint.errors import ClearjointError, OutputExistsError, ParameterError
+from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.store import ResultStore as ResultStore  # re-exported: their old home
+from clearjoint.store import StoreError as StoreError
+from clearjoint.store import Variable as Variable
 
 if TYPE_CHECKING:
     from distributed import Client
 
 __all__ = [
     "CONNECT_TIMEOUT_S",
+    "DASK_WINDOW",
     "DEFAULT_SCHEDULER_PORT",
+    "JOB_QUEUES",
     "PROBE_TIMEOUT_S",
     "ChunkFailedError",
     "Finished",
-    "ResultStore",
     "Runner",
     "SchedulerError",
-    "StoreError",
-    "Variable",
     "chunk_bounds",
     "dask_client",
+    "jobqueue_client",
     "point_seed",
     "probe_scheduler",
     "process_pool",
+    "run_batches",
     "run_ordered",
     "run_unordered",
 ]
@@ -76,10 +78,6 @@ DEFAULT_SCHEDULER_PORT = 8786
 
 class SchedulerError(ClearjointError, ConnectionError):
     """The Dask scheduler cannot be reached; the message names the address."""
-
-
-class StoreError(ClearjointError, ValueError):
-    """A result store cannot be used: it belongs to another sweep, or is not a sweep store."""
 
 
 class ChunkFailedError(ClearjointError, RuntimeError):
@@ -112,7 +110,114 @@ class Finished(Generic[R]):
 
 
 def _is_dask_client(runner: Any) -> bool:
-    return type(runner).__name__ == "Client" and hasattr(runner, "scheduler_info")
+    """True for a distributed.Client or any subclass of it (never imports distributed)."""
+    distributed = sys.modules.get("distributed")
+    return distributed is not None and isinstance(runner, distributed.Client)
+
+
+#: Most tasks a Dask client keeps submitted at once (more are submitted as these end).
+DASK_WINDOW = 20_000
+
+
+def run_batches(
+    function: Callable[[A], R],
+    arguments: Sequence[A],
+    runner: Runner = None,
+    *,
+    retries: int = 0,
+    window: int = DASK_WINDOW,
+    every: float = 0.0,
+) -> Iterator[list[Finished[R]]]:
+    """Yield the tasks' :class:`Finished` outcomes in batches, as they end.
+
+    As :func:`run_unordered`, but on a Dask client every task that has ended since the
+    last batch comes at once (the client fetches results in the background meanwhile),
+    tasks are submitted ``window`` at a time in one message each (``client.map``), and
+    the client lets go of a task's future once its batch is yielded: the scheduler then
+    forgets its result, so a worker lost later has nothing of it to recompute.
+
+    Parameters
+    ----------
+    function, arguments, runner
+        As for :func:`run_unordered`.
+    retries : int
+        On a Dask client: times a task is run again after its worker is lost or it
+        raises (``client.map(retries=...)``). Ignored elsewhere.
+    window : int
+        On a Dask client: most tasks submitted and not yet yielded.
+    every : float
+        On a Dask client: seconds at least between two batches (the results that
+        came meanwhile are fetched and held), so that a caller writing each batch
+        writes few large ones; the last batch comes as soon as the last task ends.
+    """
+    if retries < 0:
+        raise ParameterError(f"retries must be >= 0 (--retries), got {retries}")
+    if window < 1:
+        raise ParameterError(f"window must be >= 1, got {window}")
+    if not _is_dask_client(runner):
+        for outcome in run_unordered(function, arguments, runner):
+            yield [outcome]
+        return
+    from distributed import as_completed as dask_as_completed
+
+    where: dict[str, int] = {}  # key -> index, of the futures submitted and not yet yielded
+    submitted = 0
+
+    def submit(count: int) -> list[Any]:
+        nonlocal submitted
+        part = arguments[submitted : submitted + count]
+        futures = runner.map(function, part, pure=False, retries=retries or None)
+        for i, future in enumerate(futures):
+            where[future.key] = submitted + i
+        submitted += len(part)
+        return list(futures)
+
+    queue = dask_as_completed(submit(min(window, len(arguments))))  # type: ignore[no-untyped-call]
+    collected: list[Finished[R]] = []
+    last = time.monotonic()
+    try:
+        while where:
+            if not collected:
+                batch = queue.next_batch(block=True)  # type: ignore[no-untyped-call]
+            elif queue.has_ready():  # type: ignore[no-untyped-call]
+                batch = queue.next_batch(block=False)  # type: ignore[no-untyped-call]
+            else:
+                time.sleep(0.005)
+                batch = []
+            finished = [f for f in batch if f.status == "finished"]
+            keys = {f.key for f in finished}  # (a status read once: it may change meanwhile)
+            failed = [f for f in batch if f.key not in keys]  # lost, cancelled or raised
+            results = runner.gather(finished) if finished else []  # one message a batch
+            collected += [
+                Finished(where.pop(f.key), result)
+                for f, result in zip(finished, results, strict=True)
+            ]
+            collected += [Finished(where.pop(f.key), None, _failure(f)) for f in failed]
+            # the futures: let go once their results are here (no name left holding one,
+            # or the scheduler keeps its result and recomputes it if its worker dies)
+            del batch, finished, failed, results
+            if submitted < len(arguments) and len(where) < window // 2 + 1:
+                queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
+            if collected and (not where or time.monotonic() - last >= every):
+                yield collected
+                collected = []
+                last = time.monotonic()
+    finally:  # on Ctrl-C or an early stop: nothing left running for us
+        with queue.lock:
+            left = list(queue.futures)
+        if left:
+            with contextlib.suppress(Exception):
+                runner.cancel(left)
+        queue.clear()  # type: ignore[no-untyped-call]
+
+
+def _failure(future: Any) -> BaseException:
+    """Why a Dask future did not finish: its exception, or that it was cancelled."""
+    try:
+        error = future.exception(timeout=CONNECT_TIMEOUT_S)
+    except BaseException as exc:  # CancelledError is a BaseException
+        return exc
+    return error if isinstance(error, BaseException) else RuntimeError(f"task {future.status}")
 
 
 def run_unordered(
@@ -143,16 +248,8 @@ def run_unordered(
                 yield Finished(index, None, exc)
         return
     if _is_dask_client(runner):
-        from distributed import as_completed as dask_as_completed
-
-        futures = [runner.submit(function, a, pure=False) for a in arguments]
-        where = {future.key: i for i, future in enumerate(futures)}
-        try:
-            for future in dask_as_completed(futures):  # type: ignore[no-untyped-call]
-                yield _outcome(where[future.key], future)
-        finally:
-            for future in futures:  # on Ctrl-C or an early stop: nothing left running for us
-                future.cancel()
+        for batch in run_batches(function, arguments, runner):
+            yield from batch
         return
     if not isinstance(runner, Executor):
         raise ParameterError(
@@ -277,7 +374,11 @@ def probe_scheduler(address: str, timeout: float = PROBE_TIMEOUT_S) -> None:
 
 @contextlib.contextmanager
 def dask_client(
-    address: str | None = None, *, workers: int | None = None, processes: bool = True
+    address: str | None = None,
+    *,
+    workers: int | None = None,
+    processes: bool = True,
+    threads: int = 1,
 ) -> Iterator[Client]:
     """Yield a Dask client: to the scheduler at ``address``, or to a new LocalCluster.
 
@@ -290,6 +391,11 @@ def dask_client(
         Workers of the LocalCluster (ignored with ``address``).
     processes : bool
         Workers as processes (default) or as threads of this process (for tests).
+    threads : int
+        Threads of each LocalCluster worker (default 1: tasks hold the GIL).
+
+    The LocalCluster's dashboard listens on 127.0.0.1 only, on any free port
+    (``client.dashboard_link``); reach it from another machine through an SSH tunnel.
 
     Raises
     ------
@@ -314,16 +420,103 @@ def dask_client(
             yield client
         return
     n = workers or os.cpu_count() or 1
-    with (
-        LocalCluster(  # type: ignore[no-untyped-call]
+    # the worker processes ignore Ctrl-C (a terminal sends it to the whole process group):
+    # this process says it in one line and closes them, with no traceback of theirs
+    with _interrupt_ignored_by_children():
+        cluster = LocalCluster(  # type: ignore[no-untyped-call]
             n_workers=n,
-            threads_per_worker=1,
+            threads_per_worker=threads,
             processes=processes,
-            dashboard_address=":0",  # any free port: never a clash with a running one
+            **({"host": "127.0.0.1"} if processes else {}),  # this machine only (threads: inproc)
+            dashboard_address="127.0.0.1:0",  # any free port: never a clash with a running one
             silence_logs=logging.ERROR,
-        ) as cluster,
-        Client(cluster) as client,  # type: ignore[no-untyped-call]
-    ):
+        )
+    with cluster, Client(cluster) as client:  # type: ignore[no-untyped-call]
+        if processes:  # and so do the workers the nannies start again after a crash
+            client.register_plugin(_ignore_interrupt_plugin())
+        yield client
+
+
+@contextlib.contextmanager
+def _interrupt_ignored_by_children() -> Iterator[None]:
+    """SIGINT ignored while processes start (they inherit it), then as it was."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _ignore_interrupt_plugin() -> Any:
+    """A Dask worker plugin that makes its worker process ignore SIGINT."""
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class IgnoreInterrupt(WorkerPlugin):
+        name = "clearjoint-ignore-interrupt"
+
+        def setup(self, worker: Any) -> None:
+            import signal
+            import threading
+
+            if threading.current_thread() is threading.main_thread():
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    return IgnoreInterrupt()
+
+
+#: The batch systems ``--cluster`` starts Dask workers on, and dask-jobqueue's class for each.
+JOB_QUEUES = {"slurm": "SLURMCluster", "pbs": "PBSCluster", "sge": "SGECluster"}
+
+
+@contextlib.contextmanager
+def jobqueue_client(kind: str, *, jobs: int | None = None) -> Iterator[Client]:
+    """Yield a Dask client to workers started as ``jobs`` batch jobs (dask-jobqueue).
+
+    Each job's cores, memory, queue, account and walltime come from the Dask
+    configuration (``~/.config/dask/jobqueue.yaml``, section ``jobqueue.<kind>``; see
+    docs/sweep.md); this process is the scheduler and the client, so run it where
+    the compute nodes can reach it (a login node, or a job of its own).
+
+    Parameters
+    ----------
+    kind : {"slurm", "pbs", "sge"}
+        The batch system.
+    jobs : int, optional
+        Jobs to submit (default 1); each starts the workers its configuration says.
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``kind``, dask-jobqueue not installed, or its configuration lacks
+        what a job needs (cores, memory): one line saying where to put it.
+    """
+    if kind not in JOB_QUEUES:
+        raise ParameterError(f"--cluster must be one of {sorted(JOB_QUEUES)}, got {kind!r}")
+    if jobs is not None and jobs < 1:
+        raise ParameterError(f"jobs must be >= 1 (--workers with --cluster), got {jobs}")
+    try:
+        import dask_jobqueue
+    except ImportError:
+        raise ParameterError(
+            f"--cluster {kind} needs dask-jobqueue: pip install 'clearjoint[cluster]'"
+        ) from None
+    import dask
+    from distributed import Client
+
+    missing = [
+        k for k in ("cores", "memory") if dask.config.get(f"jobqueue.{kind}.{k}", None) is None
+    ]
+    if missing:  # said before a cluster object exists (its __init__ would half-make one)
+        raise ParameterError(
+            f"--cluster {kind}: dask-jobqueue needs {' and '.join(missing)} per job: set "
+            f"them in ~/.config/dask/jobqueue.yaml under jobqueue.{kind} (see docs/sweep.md)"
+        )
+    cluster = getattr(dask_jobqueue, JOB_QUEUES[kind])()
+    with cluster, Client(cluster) as client:  # type: ignore[no-untyped-call]
+        cluster.scale(jobs=jobs or 1)
         yield client
 
 
@@ -347,158 +540,3 @@ def optional_client(
             yield client
     else:
         yield None
-
-
-# ---- the result store ------------------------------------------------------------------------
-
-_FINGERPRINT = "clearjoint_sweep_fingerprint"
-_DONE = "chunk_done"
-
-
-@dataclass(frozen=True)
-class Variable:
-    """One array of a store: its name, numpy dtype ('f8', 'i8' or 'str') and attributes.
-
-    ``shape`` is what each point holds beyond the ``point`` dimension: () for one
-    value, (n,) for n values (a per-joint draw: dimension ``joint``).
-    """
-
-    name: str
-    dtype: str
-    attrs: Mapping[str, Any]
-    shape: tuple[int, ...] = ()
-
-
-class ResultStore:
-    """A zarr group of point-wise results written chunk by chunk (see the module docstring)."""
-
-    def __init__(self, path: Path, group: Any, chunk_size: int, n_points: int) -> None:
-        self.path = path
-        self._group = group
-        self.chunk_size = chunk_size
-        self.n_points = n_points
-
-    def __repr__(self) -> str:
-        done = len(self.done_chunks())
-        total = len(chunk_bounds(self.n_points, self.chunk_size))
-        return f"ResultStore({str(self.path)!r}, {self.n_points} points, {done}/{total} chunks)"
-
-    @classmethod
-    def create(
-        cls,
-        path: str | Path,
-        *,
-        fingerprint: str,
-        n_points: int,
-        chunk_size: int,
-        variables: Sequence[Variable],
-        attrs: Mapping[str, Any],
-        force: bool = False,
-    ) -> ResultStore:
-        """Create an empty store; an existing one is replaced only with ``force``.
-
-        Raises
-        ------
-        OutputExistsError
-            ``path`` exists and ``force`` is False.
-        StoreError
-            ``path`` exists and is not a sweep store (it is never deleted, even with force).
-        """
-        import zarr
-
-        path = Path(path)
-        if path.exists():
-            if not force:
-                raise OutputExistsError(
-                    f"will not overwrite {path}; pass resume=True to finish it, force=True "
-                    f"to start again, or choose another out"
-                )
-            cls.open(path)  # a StoreError unless it is a sweep store: never delete anything else
-            shutil.rmtree(path)
-        group: Any = zarr.open_group(str(path), mode="w-", zarr_format=3)
-        n_chunks = len(chunk_bounds(n_points, chunk_size))
-        for var in variables:
-            kind: Any = str if var.dtype == "str" else var.dtype
-            fill: Any = "" if var.dtype == "str" else (np.nan if var.dtype == "f8" else 0)
-            array = group.create_array(
-                var.name,
-                shape=(n_points, *var.shape),
-                chunks=(chunk_size, *var.shape),
-                dtype=kind,
-                fill_value=fill,
-                dimension_names=["point", *("joint",) * len(var.shape)],
-            )
-            array.attrs.update(dict(var.attrs))
-        group.create_array(
-            _DONE,
-            shape=(n_chunks,),
-            chunks=(1,),
-            dtype="bool",
-            fill_value=False,
-            dimension_names=["chunk"],
-        )
-        group.attrs.update({**dict(attrs), _FINGERPRINT: fingerprint, "chunk_size": chunk_size})
-        return cls(path, group, chunk_size, n_points)
-
-    @classmethod
-    def open(cls, path: str | Path, *, fingerprint: str | None = None) -> ResultStore:
-        """Open an existing store; with ``fingerprint``, refuse one made by another sweep.
-
-        Raises
-        ------
-        StoreError
-            ``path`` is not a sweep store, or its fingerprint differs.
-        """
-        import zarr
-
-        path = Path(path)
-        if not path.exists():
-            raise StoreError(f"{path}: no such result store; check the path")
-        if not (path / "zarr.json").is_file():  # a file, a folder of something else
-            raise StoreError(f"{path}: not a clearjoint sweep store (no zarr.json); left as it is")
-        try:
-            group: Any = zarr.open_group(str(path), mode="r+")
-            stored = group.attrs[_FINGERPRINT]
-            chunk_size = int(group.attrs["chunk_size"])
-        except (KeyError, OSError, ValueError, TypeError) as exc:
-            raise StoreError(
-                f"{path}: not a clearjoint sweep store ({type(exc).__name__}: {exc}); "
-                f"choose another --out"
-            ) from None
-        if fingerprint is not None and stored != fingerprint:
-            raise StoreError(
-                f"{path} was made from a different sweep file (hash {stored[:12]} here, "
-                f"{fingerprint[:12]} now); use --force to start again or another --out"
-            )
-        points = [int(group[n].shape[0]) for n in group.array_keys() if n != _DONE]
-        return cls(path, group, chunk_size, points[0] if points else 0)
-
-    @property
-    def attrs(self) -> dict[str, Any]:
-        """The store's attributes (the sweep's description)."""
-        return dict(self._group.attrs)
-
-    def done_chunks(self) -> set[int]:
-        """Indices of the chunks whose values are all written."""
-        flags = np.asarray(self._group[_DONE][:], dtype=bool)
-        return {int(i) for i in np.flatnonzero(flags)}
-
-    def write(self, chunk: int, values: Mapping[str, NDArray[Any]]) -> None:
-        """Write one chunk's values, then flag the chunk done (so a cut never leaves half)."""
-        start = chunk * self.chunk_size
-        for name, array in values.items():
-            self._group[name][start : start + len(array)] = array
-        self._group[_DONE][chunk] = True
-
-    def read(self) -> dict[str, tuple[NDArray[Any], dict[str, Any]]]:
-        """Every variable along ``point`` with its attributes (not yet computed: NaN / '')."""
-        out: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
-        for name in sorted(self._group.array_keys()):
-            if name == _DONE:
-                continue
-            array = self._group[name]
-            values = np.asarray(array[:])
-            if values.dtype.kind in "OTU":
-                values = np.array(values.tolist(), dtype=str)
-            out[name] = (values, dict(array.attrs))
-        return out

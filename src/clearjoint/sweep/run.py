@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint.errors import OutputExistsError, ParameterError
+from clearjoint.lock import LOCK_TIMEOUT_S, StoreLock
 from clearjoint.parallel import (
     ChunkFailedError,
     ResultStore,
@@ -29,9 +30,11 @@ from clearjoint.parallel import (
     Variable,
     chunk_bounds,
     dask_client,
+    jobqueue_client,
     point_seed,
-    run_unordered,
+    run_batches,
 )
+from clearjoint.store import StoreWarning
 from clearjoint.sweep.file import Sweep
 from clearjoint.sweep.tasks import Task
 
@@ -44,6 +47,10 @@ __all__ = [
 
 #: Pass as ``client`` to run every chunk in this process, one after the other.
 SERIAL = "serial"
+
+#: Seconds at least between two writes to the store on a Dask client (results in between
+#: are held by the client, their futures let go): a few large writes, not one a chunk.
+_WRITE_EVERY_S = 1.0
 
 #: Longest reason kept in ``status`` for a failed point.
 _REASON_CHARS = 300
@@ -166,6 +173,8 @@ def run_sweep(
     force: bool = False,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    retries: int = 0,
+    lock_timeout: float = LOCK_TIMEOUT_S,
 ) -> Any:
     """Run the sweep and return its results as an xarray.Dataset.
 
@@ -186,7 +195,14 @@ def run_sweep(
     workers : int, optional
         Workers of the LocalCluster started when ``client`` is None.
     progress : callable, optional
-        ``progress(points_done, points_total)`` after each chunk (and once at the start).
+        ``progress(points_done, points_total)`` after each batch of chunks is stored
+        (and once at the start).
+    retries : int
+        Times a chunk is run again on a Dask client after its worker is lost or it
+        raises (default 0: such a chunk is reported, the others kept).
+    lock_timeout : float
+        Seconds without a heartbeat after which another client's lock on ``out`` is
+        stale and taken over (see :mod:`clearjoint.lock`); a fresh one is refused.
 
     Returns
     -------
@@ -200,29 +216,51 @@ def run_sweep(
     OutputExistsError
         ``out`` exists and neither ``resume`` nor ``force`` is given.
     StoreError
-        ``resume`` against a store made by a different sweep.
+        ``resume`` against a store made by a different sweep or of an older format;
+        ``out`` in use by another client (its lock); a store damaged after this run
+        wrote it.
     ChunkFailedError
         A chunk did not finish (a worker died); every other chunk is in the store.
     """
+    if out is None:
+        return _run(sweep, None, None, client, workers, progress, retries)
+    with StoreLock(out, timeout=lock_timeout) as lock:
+        store = _open_or_create(sweep, Path(out), resume=resume, force=force)
+        return _run(sweep, store, lock, client, workers, progress, retries)
+
+
+def _open_or_create(sweep: Sweep, path: Path, *, resume: bool, force: bool) -> ResultStore:
+    """The sweep's store at ``path`` (its lock held): resumed and repaired, or made anew."""
+    if resume and path.exists():
+        store = ResultStore.open(path, fingerprint=sweep.fingerprint)
+        _repair(store)
+        return store
+    return ResultStore.create(
+        path,
+        fingerprint=sweep.fingerprint,
+        n_points=sweep.n_points,
+        chunk_size=sweep.chunk_size,
+        variables=_variables(sweep),
+        attrs=_attrs(sweep),
+        force=force,
+    )
+
+
+def _run(
+    sweep: Sweep,
+    store: ResultStore | None,
+    lock: StoreLock | None,
+    client: Any,
+    workers: int | None,
+    progress: Callable[[int, int], None] | None,
+    retries: int,
+) -> Any:
+    """Run the chunks not done in ``store`` (all without one), writing them batch by batch."""
     bounds = chunk_bounds(sweep.n_points, sweep.chunk_size)
-    store: ResultStore | None = None
     todo = list(range(len(bounds)))
-    if out is not None:
-        path = Path(out)
-        if resume and path.exists():
-            store = ResultStore.open(path, fingerprint=sweep.fingerprint)
-            done = store.done_chunks()
-            todo = [i for i in todo if i not in done]
-        else:
-            store = ResultStore.create(
-                path,
-                fingerprint=sweep.fingerprint,
-                n_points=sweep.n_points,
-                chunk_size=sweep.chunk_size,
-                variables=_variables(sweep),
-                attrs=_attrs(sweep),
-                force=force,
-            )
+    if store is not None:
+        done = store.done_chunks()
+        todo = [i for i in todo if i not in done]
     drawn = sweep.drawn()
     names = _column_names(sweep)
     chunks = [
@@ -243,30 +281,37 @@ def run_sweep(
         progress(finished, sweep.n_points)
     in_memory: dict[int, dict[str, NDArray[Any]]] = {}
     failures: list[str] = []
+    sample = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
     if chunks:
         with _runner(client, workers) as runner:
-            for outcome in run_unordered(_evaluate_chunk, chunks, runner):
-                chunk = todo[outcome.index]
-                if outcome.error is not None or outcome.result is None:
-                    failures.append(
-                        f"chunk {chunk}: {type(outcome.error).__name__}: {outcome.error}"
-                    )
-                    continue
-                if store is not None:
+            batches = run_batches(
+                _evaluate_chunk, chunks, runner, retries=retries, every=_WRITE_EVERY_S
+            )
+            for batch in batches:
+                written: list[tuple[int, dict[str, NDArray[Any]]]] = []
+                for outcome in batch:
+                    chunk = todo[outcome.index]
+                    if outcome.error is not None or outcome.result is None:
+                        error = outcome.error
+                        failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
+                        continue
                     values = dict(outcome.result)
+                    a, b = bounds[chunk]
                     for d in sweep.draws:
-                        a, b = bounds[chunk]
-                        values[d.name] = drawn[d.name][
-                            np.unravel_index(np.arange(a, b), sweep.shape)[0]
-                        ]
-                    store.write(chunk, values)
+                        values[d.name] = drawn[d.name][sample[a:b]]
+                    written.append((chunk, values))
+                if store is not None and lock is not None:
+                    lock.check()
+                    store.write_many(written)
                 else:
-                    in_memory[chunk] = outcome.result
-                finished += bounds[chunk][1] - bounds[chunk][0]
-                if progress:
+                    in_memory.update(written)
+                finished += sum(bounds[c][1] - bounds[c][0] for c, _ in written)
+                if progress and written:
                     progress(finished, sweep.n_points)
     if failures:
-        where = f"; the others are in {out}: finish with --resume" if out is not None else ""
+        where = (
+            f"; the others are in {store.path}: finish with --resume" if store is not None else ""
+        )
         raise ChunkFailedError(
             f"{len(failures)} of {len(bounds)} chunks did not finish ({failures[0]}){where}"
         )
@@ -275,12 +320,29 @@ def run_sweep(
     flat: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
     for var in _variables(sweep):
         if var.name in drawn:
-            index = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
-            array = drawn[var.name][index]
+            array = drawn[var.name][sample]
         else:
             array = np.concatenate([in_memory[i][var.name] for i in range(len(bounds))])
         flat[var.name] = (array, dict(var.attrs))
     return _dataset(flat, {**_attrs(sweep), "clearjoint_sweep_fingerprint": sweep.fingerprint})
+
+
+def _repair(store: ResultStore) -> None:
+    """Unflag the store's damaged chunks, so that they are computed again; say so in one line."""
+    damaged = store.check()
+    if not damaged:
+        return
+    again = store.discard(sorted(damaged))
+    bounds = chunk_bounds(store.n_points, store.chunk_size)
+    points = sum(bounds[i][1] - bounds[i][0] for i in again)
+    first = min(damaged)
+    warnings.warn(
+        StoreWarning(
+            f"{store.path}: recomputing {points} points of {len(again)} damaged chunks "
+            f"(first: {store.describe(first)}: {damaged[first]})"
+        ),
+        stacklevel=3,
+    )
 
 
 def run_sweep_file(
@@ -292,6 +354,9 @@ def run_sweep_file(
     resume: bool = False,
     force: bool = False,
     progress: Callable[[Sweep], Callable[[int, int], None] | None] | None = None,
+    retries: int = 0,
+    lock_timeout: float = LOCK_TIMEOUT_S,
+    cluster: str | None = None,
 ) -> tuple[Any, int]:
     """Return the results of the sweep file ``path`` run into the zarr store ``out``.
 
@@ -313,6 +378,11 @@ def run_sweep_file(
         ``scheduler``.
     resume, force : bool
         As for :func:`run_sweep`.
+    retries, lock_timeout
+        As for :func:`run_sweep`.
+    cluster : {"slurm", "pbs", "sge"}, optional
+        Start the workers as batch jobs (``workers`` of them, default 1) through
+        dask-jobqueue (:func:`clearjoint.parallel.jobqueue_client`); not with ``scheduler``.
     progress : callable, optional
         Called with the loaded Sweep; returns the ``progress(done, total)`` callback
         of :func:`run_sweep` (or None).
@@ -328,6 +398,8 @@ def run_sweep_file(
         raise ParameterError(f"--out must end in .zarr, got {str(out)!r}")
     if scheduler and workers is not None:
         raise ParameterError("--workers sizes a local cluster; leave it out with --scheduler")
+    if scheduler and cluster:
+        raise ParameterError("--cluster starts its own scheduler; leave out --scheduler")
     if Path(out).exists() and not (resume or force):
         raise OutputExistsError(
             f"will not overwrite {out}; pass --resume to finish it, --force to start "
@@ -339,8 +411,14 @@ def run_sweep_file(
         if scheduler:  # an unreachable scheduler is said first, within seconds
             client = stack.enter_context(dask_client(scheduler))
         sweep = Sweep.from_toml(path)
-        if not scheduler:  # a bad sweep file is said before a cluster starts
+        # a store in use is said before a cluster starts; the store is made once one has
+        # started (a cluster that cannot start leaves no empty store behind)
+        lock = stack.enter_context(StoreLock(out, timeout=lock_timeout))
+        if cluster:
+            client = stack.enter_context(jobqueue_client(cluster, jobs=workers))
+        elif not scheduler:  # a bad sweep file is said before a cluster starts
             client = stack.enter_context(dask_client(workers=workers))
+        store = _open_or_create(sweep, Path(out), resume=resume, force=force)
         report = progress(sweep) if progress is not None else None
 
         def on_progress(done: int, total: int) -> None:
@@ -349,9 +427,7 @@ def run_sweep_file(
             if report is not None:
                 report(done, total)
 
-        results = run_sweep(
-            sweep, client=client, out=out, resume=resume, force=force, progress=on_progress
-        )
+        results = _run(sweep, store, lock, client, None, on_progress, retries)
     return results, already[0] if already else 0
 
 
