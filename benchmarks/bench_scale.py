@@ -234,10 +234,13 @@ def compare(rows: list[dict[str, Any]], path: str) -> None:
         diff = float(np.max(np.abs(a_old[:m] - a_new[:m]))) / peak
         dw = float(np.max(np.abs(old[f"omega_{b}"][:m] - row["omega"][:m])))
         verdicts = int(np.sum(old[f"stable_{b}"][:m] != row["stable"][:m]))
+        each = np.max(np.abs(a_old[:m] - a_new[:m]).reshape(m, -1), axis=1) / peak
+        apart = np.flatnonzero(each > 1e-8)
+        first = f"first point beyond 1e-8: {apart[0]}" if apart.size else "all within 1e-8"
         print(
             f"{b:3d} bays: {m} points compared ({a_old.shape[0]} old, {a_new.shape[0]} new): "
             f"orbits differ by {diff:.2e} of the largest coefficient, omega by {dw:.2e} rad/s, "
-            f"{verdicts} verdicts differ"
+            f"{verdicts} verdicts differ; {first}"
         )
 
 
