@@ -38,9 +38,6 @@ def linear_solve(jacobian: Any, rhs: FloatArray) -> FloatArray:
     (dense) in both cases.
     """
     if not isinstance(jacobian, np.ndarray) or jacobian.shape[0] > SPARSE_ABOVE:
-        import scipy.sparse
-        import scipy.sparse.linalg
-
         try:
             x = SparseLU(jacobian).solve(rhs)  # the column ordering reused along Newton
             if np.all(np.isfinite(x)):
@@ -290,9 +287,8 @@ class SparseResidual:
             column = r_lam * (scale[d] / u_scale)
             rs = r / u_scale
             size = float(np.max(np.abs(rs)))
-            if not (
-                math.isfinite(size) and np.all(np.isfinite(jac.data)) and np.all(np.isfinite(column))
-            ):
+            finite = np.all(np.isfinite(jac.data)) and np.all(np.isfinite(column))
+            if not (math.isfinite(size) and finite):
                 return None
             if size <= settings.tolerance:
                 a = scipy.sparse.hstack(
