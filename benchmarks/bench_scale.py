@@ -2,14 +2,14 @@
 
 Run on demand:
 
-    python benchmarks/bench_scale.py [--bays 5,10,20,40,80] [--points 100]
+    python benchmarks/bench_scale.py [--bays 5,10,20,40:30,80:10] [--points 100]
         [--save FILE.npz] [--compare FILE.npz] [--modes 40] [--pyharm PYTHON]
 
 The issue's case: the planar mast of ``clearjoint.structure.mast`` (width and bay 0.5 m,
 member rigidity 2e7 N, node mass 0.5 kg), a hinge ``ClearanceJoint(50e-6, 5e7,
 gap_stiffness=1e5)`` in every longeron, Rayleigh beta 2e-6 s, 0.1 N at the tip (x), H = 7,
-``points`` points at most from 0.8 x the first open mode to 1.2 x the first closed one,
-``max_step=0.05``, ``check_points=0``. For each size it prints the unknowns, the start
+``points`` points at most (``--bays 40:30``: 30 at 40 bays) from 0.8 x the first open
+mode to 1.2 x the first closed one, ``max_step=0.05``, ``check_points=0``. For each size it prints the unknowns, the start
 (the HB solve at the first frequency, ``harmonic.response._start``), the cost per point
 of the rest of the curve, the share of it spent in the stability verdict and in the sparse
 LU factorizations (scipy's ``splu``, wherever it is called), the peak resident memory so
@@ -290,7 +290,9 @@ def plot(rows: list[dict[str, Any]], exponent: float, path: str) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--bays", default=SIZES, help=f"comma-separated sizes ({SIZES})")
+    parser.add_argument(
+        "--bays", default=SIZES, help=f"comma-separated sizes, BAYS or BAYS:POINTS ({SIZES})"
+    )
     parser.add_argument("--points", type=int, default=100, help="points per curve (100)")
     parser.add_argument("--save", help="write the orbits and verdicts to this .npz")
     parser.add_argument("--compare", help="compare with the orbits in this .npz")
@@ -299,7 +301,7 @@ def main() -> None:
     parser.add_argument("--plot", help="write the growth plot to this .png")
     parser.add_argument("--pyharm", help="pyHarm's interpreter: run bench_harmonic --pyharm")
     args = parser.parse_args()
-    sizes = [int(b) for b in args.bays.split(",") if b]
+    sizes = [tuple(int(v) for v in b.split(":")) for b in args.bays.split(",") if b]
     print(
         f"mast, H = {H}, 0.1 N at the tip, {args.points} points from 0.8 x open to 1.2 x closed "
         f"first mode, max_step 0.05, check_points 0; clearjoint from "
@@ -307,8 +309,8 @@ def main() -> None:
         flush=True,
     )
     rows = []
-    for bays in sizes:
-        row = run_size(bays, args.points, args.exact)
+    for bays, *cap in sizes:
+        row = run_size(bays, min(args.points, *cap) if cap else args.points, args.exact)
         report(row)
         rows.append(row)
     fitted = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows
