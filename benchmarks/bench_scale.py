@@ -9,7 +9,8 @@ The issue's case: the planar mast of ``clearjoint.structure.mast`` (width and ba
 member rigidity 2e7 N, node mass 0.5 kg), a hinge ``ClearanceJoint(50e-6, 5e7,
 gap_stiffness=1e5)`` in every longeron, Rayleigh beta 2e-6 s, 0.1 N at the tip (x), H = 7,
 ``points`` points at most (``--bays 40:30``: 30 at 40 bays) from 0.8 x the first open
-mode to 1.2 x the first closed one, ``max_step=0.05``, ``check_points=0``. For each size it prints the unknowns, the start
+mode to 1.2 x the first closed one, ``max_step=0.05``, ``check_points=0``. For each size
+it prints the unknowns, the start
 (the HB solve at the first frequency, ``harmonic.response._start``), the cost per point
 of the rest of the curve, the share of it spent in the stability verdict and in the sparse
 LU factorizations (scipy's ``splu``, wherever it is called), the peak resident memory so
