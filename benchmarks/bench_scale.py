@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse.linalg
 
-from clearjoint import ClearanceJoint
+from clearjoint import ClearanceJoint, ClearjointError
 from clearjoint.harmonic import frequency_response, nonlinear_modes
 from clearjoint.harmonic import monodromy as _monodromy
 from clearjoint.harmonic import response as _response
@@ -311,7 +311,11 @@ def main() -> None:
     )
     rows = []
     for bays, *cap in sizes:
-        row = run_size(bays, min(args.points, *cap) if cap else args.points, args.exact)
+        try:
+            row = run_size(bays, min(args.points, *cap) if cap else args.points, args.exact)
+        except ClearjointError as error:  # e.g. no start found: say so, go on
+            print(f"{bays:3d} bays: no curve: {error}", flush=True)
+            continue
         report(row)
         rows.append(row)
     fitted = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows

@@ -321,9 +321,9 @@ def test_leading_multipliers_give_the_exact_verdict_on_every_point_of_a_mast_cur
     """Issue 25's verdict that scales: the monodromy applied to a block of columns (subspace
     iteration, the product never formed), on every point of the 10-bay mast's curve into
     its first resonance (the issue's case, 60 points), against the eigenvalues of the whole
-    monodromy matrix of the same orbit: the same verdict everywhere and the same largest
-    moduli (the leading route forced on, as it is by itself from 49 DOF up; the 20-bay
-    curve is checked by ``benchmarks/bench_scale.py --exact``)."""
+    monodromy matrix of the same orbit: the same verdict everywhere, the largest modulus
+    to 1e-9 and the next three to 1e-8 of it (the leading route forced on, as it is by
+    itself from 49 DOF up; the 20-bay curve is checked by ``bench_scale.py --exact``)."""
     from clearjoint.structure import mast
 
     structure = mast(10, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), rayleigh=(0, 2e-6))
@@ -347,7 +347,11 @@ def test_leading_multipliers_give_the_exact_verdict_on_every_point_of_a_mast_cur
     for i in range(fr.omega.size):
         exact = monodromy.multipliers(model, basis, fr.coefficients[i], float(fr.omega[i]))
         top = np.abs(exact[:4])
-        assert np.abs(fr.multipliers[i, :4]) == pytest.approx(top, rel=1e-9, abs=1e-12)
+        mine = np.abs(fr.multipliers[i, :4])
+        assert mine[0] == pytest.approx(top[0], rel=1e-9)  # the verdict's multiplier
+        # the next ones to 1e-8 of it (the two routes of the whole monodromy, eigen and
+        # expm, differ by up to 6e-8 at 20 bays: docs/harmonic.md, Speed)
+        assert mine == pytest.approx(top, rel=0.0, abs=1e-8 * top[0])
         assert bool(fr.stable[i]) == bool(top[0] < 1.0)
         assert np.count_nonzero(fr.multipliers[i]) == 16  # the block's; outside it 0
         flips += int(i > 0 and fr.stable[i] != fr.stable[i - 1])

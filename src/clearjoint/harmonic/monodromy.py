@@ -400,8 +400,9 @@ def _product(
 #: invariant subspace of Phi to ``_INVARIANT``).
 _LEADING = 16
 
-#: Subspace passes (Phi applied to the block, then orthonormalised) before the Ritz step.
-_PASSES = 2
+#: Ritz steps tried on one block size (each after one more pass of Phi over the block)
+#: before the block doubles.
+_PASSES = 3
 
 #: The block Q is accepted as invariant when ||Phi Q - Q (Q^T Phi Q)|| (Frobenius) is at
 #: most this times ||Phi Q||: the Ritz values are then the eigenvalues of a matrix within
@@ -410,7 +411,7 @@ _INVARIANT = 1e-10
 
 #: Above this many states (2N) :func:`leading_multipliers` works on a block of columns;
 #: below, the whole Phi costs less than the passes.
-LEADING_ABOVE = 2 * _LEADING * (_PASSES + 1)
+LEADING_ABOVE = 6 * _LEADING
 
 
 def leading_multipliers(
@@ -422,13 +423,14 @@ def leading_multipliers(
     """Return the 2N Floquet multipliers, the leading ones exact and the rest 0 (issue 25).
 
     The monodromy is never formed: its product of per-pattern exponentials (cached
-    decompositions, as :func:`monodromy`) is applied to a block of k columns (16 first),
-    ``_PASSES`` times with an orthonormalisation after each (subspace iteration), and the
-    Ritz values of Q^T Phi Q are the leading multipliers. Accepted when Q spans an
-    invariant subspace of Phi to ``_INVARIANT`` (the residual ||Phi Q - Q B|| measured,
-    not assumed); else k doubles. A structure's multipliers fall off fast (the mast: fewer
-    than 5 above 0.5, none of the 20th above 1e-6), so k stays far below 2N and the cost per
-    point is 3 k products of (2N)^2 per stretch instead of one of (2N)^3. The multipliers
+    decompositions, as :func:`monodromy`) is applied to a block of k random columns (16
+    first), orthonormalised, applied again (subspace iteration), and the Ritz values of
+    B = Q^T Phi Q are the leading multipliers. Accepted when Q spans an invariant subspace
+    of Phi to ``_INVARIANT`` (the residual ||Phi Q - Q B|| measured, not assumed); else
+    one more pass, up to ``_PASSES``, then k doubles. A structure's multipliers fall off
+    fast (the mast: fewer than 5 above 0.5, none of the 20th above 1e-6), so k stays far
+    below 2N and the cost per point is about 2 k products of (2N)^2 per stretch instead of
+    one of (2N)^3. The multipliers
     outside the block are below the resolved ones by the residual test's margin and are
     returned as 0 (the stability verdict and the events see only the leading ones).
     At or below ``LEADING_ABOVE`` states, and with friction, it is :func:`multipliers`.
@@ -454,17 +456,17 @@ def leading_multipliers(
     rng = np.random.default_rng(0)  # the same start at every point: reproducible
     k = _LEADING
     while 2 * k <= size:
-        q = np.linalg.qr(rng.standard_normal((size, k)))[0]
+        q = np.linalg.qr(apply(np.linalg.qr(rng.standard_normal((size, k)))[0]))[0]
         for _ in range(_PASSES):
-            q = np.linalg.qr(apply(q))[0]
-        z = apply(q)
-        b = q.T @ z
-        miss = float(np.linalg.norm(z - q @ b))
-        if miss <= _INVARIANT * max(float(np.linalg.norm(z)), 1e-300):
-            mu = np.zeros(size, dtype=np.complex128)
-            ritz = np.linalg.eigvals(b)
-            mu[:k] = ritz[np.argsort(-np.abs(ritz), kind="stable")]
-            return mu
+            z = apply(q)
+            b = q.T @ z
+            miss = float(np.linalg.norm(z - q @ b))
+            if miss <= _INVARIANT * max(float(np.linalg.norm(z)), 1e-300):
+                mu = np.zeros(size, dtype=np.complex128)
+                ritz = np.linalg.eigvals(b)
+                mu[:k] = ritz[np.argsort(-np.abs(ritz), kind="stable")]
+                return mu
+            q = np.linalg.qr(z)[0]  # not invariant yet: one more pass
         k *= 2
     return multipliers(system, basis, coefficients, omega)
 
