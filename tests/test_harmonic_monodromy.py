@@ -313,3 +313,46 @@ def test_an_unknown_method_is_refused(three_links: Structure) -> None:
     model, basis, coef = _chain_orbit(three_links, 300.0)
     with pytest.raises(ParameterError, match="method must be 'eigen' or 'expm'"):
         monodromy.monodromy(model, basis, coef, 300.0, method="pade")  # type: ignore[arg-type]
+
+
+def test_leading_multipliers_give_the_exact_verdict_on_every_point_of_a_mast_curve(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Issue 25's verdict that scales: the monodromy applied to a block of columns (subspace
+    iteration, the product never formed), on every point of the 10-bay mast's curve into
+    its first resonance (the issue's case, 60 points), against the eigenvalues of the whole
+    monodromy matrix of the same orbit: the same verdict everywhere, the largest modulus
+    to 1e-9 and the next three to 1e-8 of it (the leading route forced on, as it is by
+    itself from 49 DOF up; the 20-bay curve is checked by ``bench_scale.py --exact``)."""
+    from clearjoint.structure import mast
+
+    structure = mast(10, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), rayleigh=(0, 2e-6))
+    force = np.zeros(structure.n_dof)
+    force[list(structure.dof_names).index("n21x")] = 0.1
+    w_open = float(structure.modes("open").omega[0])
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)
+    fr = frequency_response(
+        structure,
+        force,
+        0.8 * w_open,
+        2.0 * w_open,
+        max_points=60,
+        max_step=0.05,
+        check_points=0,
+    )
+    model = build(structure, None, 1.0)  # no friction: the speed is unused
+    basis = aft.Basis.make(fr.settings["harmonics"], fr.settings["samples"])
+    assert fr.coefficients is not None
+    flips = 0
+    for i in range(fr.omega.size):
+        exact = monodromy.multipliers(model, basis, fr.coefficients[i], float(fr.omega[i]))
+        top = np.abs(exact[:4])
+        mine = np.abs(fr.multipliers[i, :4])
+        assert mine[0] == pytest.approx(top[0], rel=1e-9)  # the verdict's multiplier
+        # the next ones to 1e-8 of it (the two routes of the whole monodromy, eigen and
+        # expm, differ by up to 6e-8 at 20 bays: docs/harmonic.md, Speed)
+        assert mine == pytest.approx(top, rel=0.0, abs=1e-8 * top[0])
+        assert bool(fr.stable[i]) == bool(top[0] < 1.0)
+        assert np.count_nonzero(fr.multipliers[i]) == 16  # the block's; outside it 0
+        flips += int(i > 0 and fr.stable[i] != fr.stable[i - 1])
+    assert flips >= 2  # the curve crosses the verdict's boundary

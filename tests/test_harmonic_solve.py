@@ -106,3 +106,22 @@ def test_sparse_start_homotopy_is_the_dense_one(
     np.testing.assert_allclose(sparse, dense, rtol=0.0, atol=1e-10 * size)
     ev = aft.evaluate(model, basis, sparse, 400.0, FORCE)
     assert float(np.abs(ev.residual).max()) < 1e-9 * k_ref * size
+
+
+def test_epmc_sparse_jacobian_is_the_dense_one() -> None:
+    """EPMC's bordered Jacobian assembled sparse (nonlinear_modes above SPARSE_ABOVE) holds
+    the dense one's entries, the w and xi columns and the two phase rows included."""
+    from clearjoint.harmonic.modes import epmc_residual
+
+    model = from_structure(_small_mast())
+    basis = aft.Basis.make(5, 64)
+    n_u = 11 * model.n_dof
+    rng = np.random.default_rng(11)
+    z = np.concatenate((rng.normal(scale=0.5, size=n_u), [1.1, 0.02]))
+    r, dense = epmc_residual(model, basis, z, 2e-4, 80.0, 2)
+    r_s, sparse = epmc_residual(
+        model, basis, z, 2e-4, 80.0, 2, sparse_jacobian=solve.SparseJacobian(model, basis)
+    )
+    assert np.array_equal(r, r_s)
+    assert sparse.shape == dense.shape
+    np.testing.assert_allclose(sparse.toarray(), dense, rtol=0.0, atol=1e-13 * np.abs(dense).max())

@@ -283,24 +283,41 @@ def _tangent(a: Any, previous: FloatArray) -> FloatArray:
 def _sparse_tangent(a: Any, previous: FloatArray) -> FloatArray:
     """:func:`_tangent` for a scipy sparse ``a``: [a; previous] t = e_last by a sparse LU.
 
-    The same bordered system as the dense route, factored by scipy's splu (SuperLU);
-    a singular one falls back to the dense SVD, as there.
+    The same bordered system as the dense route, solved by block elimination on the
+    sparse LU of dR/du alone, its column ordering reused along the branch
+    (:func:`clearjoint.bordered.bordered_solve`); where that fails, a sparse LU of the
+    whole bordered matrix, and a singular one falls back to the dense SVD, as there.
     """
     import scipy.sparse
     import scipy.sparse.linalg
 
+    from clearjoint.bordered import bordered_solve
+
     d = a.shape[0]
-    matrix = scipy.sparse.vstack((a, scipy.sparse.csr_matrix(previous[None, :])), format="csc")
     rhs = np.zeros(d + 1)
     rhs[d] = 1.0
     t: FloatArray | None = None
+    columns = scipy.sparse.csc_matrix(a)
     try:
-        solved = np.asarray(scipy.sparse.linalg.splu(matrix).solve(rhs), dtype=np.float64)
-        norm = float(np.linalg.norm(solved))
-        if norm > 0.0 and math.isfinite(norm):
-            t = solved / norm
-    except RuntimeError:  # "Factor is exactly singular"
-        pass
+        solved = bordered_solve(
+            columns[:, :d],
+            columns[:, d].toarray().ravel(),
+            previous[:d],
+            float(previous[d]),
+            rhs[:d],
+            1.0,
+        )
+    except RuntimeError:  # dR/du singular: the whole bordered matrix instead
+        try:
+            matrix = scipy.sparse.vstack(
+                (a, scipy.sparse.csr_matrix(previous[None, :])), format="csc"
+            )
+            solved = np.asarray(scipy.sparse.linalg.splu(matrix).solve(rhs), dtype=np.float64)
+        except RuntimeError:  # "Factor is exactly singular"
+            solved = np.zeros(0)
+    norm = float(np.linalg.norm(solved))
+    if solved.size and norm > 0.0 and math.isfinite(norm):
+        t = solved / norm
     if t is None:
         _, _, vt = np.linalg.svd(a.toarray())
         t = vt[-1] / np.linalg.norm(vt[-1])

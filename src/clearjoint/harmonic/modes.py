@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from clearjoint.errors import ParameterError, ParameterTypeError
 from clearjoint.harmonic import aft
-from clearjoint.harmonic.solve import newton
+from clearjoint.harmonic.solve import SPARSE_ABOVE, SparseJacobian, newton
 from clearjoint.harmonic.system import (
     LinearSystem,
     build,
@@ -393,12 +393,15 @@ def nonlinear_modes(
     basis = aft.Basis.make(h, n_t)
     n, n_c = model.n_dof, 2 * h + 1
     n_u = n_c * n
+    # a large structure: the Jacobian assembled sparse and factored by a sparse LU
+    # (its column ordering reused from one Newton step and amplitude to the next)
+    sparse = SparseJacobian(model, basis) if not model.is_joint and n_u > SPARSE_ABOVE else None
 
     def solve_at(a: float, guess: FloatArray, iterations: int = 80) -> FloatArray | None:
         w_scale = max(omega_lin, 1e-300)
 
-        def function(z: FloatArray) -> tuple[FloatArray, FloatArray]:
-            return epmc_residual(model, basis, z, a, w_scale, ref)
+        def function(z: FloatArray) -> tuple[FloatArray, Any]:
+            return epmc_residual(model, basis, z, a, w_scale, ref, sparse_jacobian=sparse)
 
         def residual(z: FloatArray) -> FloatArray:
             return epmc_residual(model, basis, z, a, w_scale, ref, jacobian=False)[0]
@@ -499,7 +502,8 @@ def epmc_residual(
     ref: int,
     *,
     jacobian: bool = True,
-) -> tuple[FloatArray, FloatArray]:
+    sparse_jacobian: SparseJacobian | None = None,
+) -> tuple[FloatArray, Any]:
     """Return EPMC's scaled residual and its exact Jacobian at z (MODEL.md 5.4).
 
     The HB residual of the free motion with the negative damping -xi M u'
@@ -522,18 +526,30 @@ def epmc_residual(
         The reference DOF.
     jacobian : bool
         False: the Jacobian is an empty (0, 0) array.
+    sparse_jacobian : SparseJacobian, optional
+        The structure's sparse assembly (:class:`clearjoint.harmonic.solve.SparseJacobian`):
+        the Jacobian is then a scipy CSR matrix with the same entries, never dense (a
+        large structure's Newton factors it by a sparse LU).
 
     Returns
     -------
     residual : (N (2H + 1) + 2,) ndarray
-    jacobian : (N (2H + 1) + 2, N (2H + 1) + 2) ndarray
+    jacobian : (N (2H + 1) + 2, N (2H + 1) + 2) ndarray or scipy CSR matrix
         d residual / d z.
     """
     n, n_c = model.n_dof, 2 * basis.harmonics + 1
     n_u = n_c * n
     k_ref, a = model.reference_stiffness, amplitude
     q, w, xi = z[:n_u] * a, z[n_u] * w_scale, z[n_u + 1] * w_scale
-    ev = aft.evaluate(model, basis, q, w, np.zeros(n), negative_damping=xi, jacobian=jacobian)
+    ev = aft.evaluate(
+        model,
+        basis,
+        q,
+        w,
+        np.zeros(n),
+        negative_damping=xi,
+        jacobian=jacobian and sparse_jacobian is None,
+    )
     r = np.empty(n_u + 2)
     r[:n_u] = ev.residual / (k_ref * a)
     r[n_u] = z[n + ref] - 1.0  # a_1 on the reference DOF = a
@@ -541,6 +557,14 @@ def epmc_residual(
     if not jacobian:
         return r, np.empty((0, 0))
     d_xi = -w * ((basis.derivative @ q.reshape(n_c, n)) @ model.mass).ravel()
+    if sparse_jacobian is not None:
+        return r, _sparse_epmc_jacobian(
+            sparse_jacobian(ev, w, model.damping - xi * model.mass) * (1.0 / k_ref),
+            ev.d_omega * w_scale / (k_ref * a),
+            d_xi * w_scale / (k_ref * a),
+            n + ref,
+            2 * n + ref,
+        )
     jac = np.zeros((n_u + 2, n_u + 2))
     jac[:n_u, :n_u] = ev.jacobian / k_ref
     jac[:n_u, n_u] = ev.d_omega * w_scale / (k_ref * a)
@@ -548,6 +572,19 @@ def epmc_residual(
     jac[n_u, n + ref] = 1.0
     jac[n_u + 1, 2 * n + ref] = 1.0
     return r, jac
+
+
+def _sparse_epmc_jacobian(
+    jac_u: Any, d_omega: FloatArray, d_xi: FloatArray, a_row: int, b_row: int
+) -> Any:
+    """[[dR/dq, dR/dw, dR/dxi], [e_a^T, 0, 0], [e_b^T, 0, 0]] as a CSR matrix (as the dense)."""
+    import scipy.sparse
+
+    n_u = jac_u.shape[0]
+    border = scipy.sparse.csr_matrix((np.ones(2), ([0, 1], [a_row, b_row])), shape=(2, n_u + 2))
+    return scipy.sparse.vstack(
+        (scipy.sparse.hstack((jac_u, np.column_stack((d_omega, d_xi)))), border), format="csr"
+    )
 
 
 def _march(

@@ -505,7 +505,7 @@ def _response(
     disagree: list[tuple[int, float, float]] = []
     for i in range(n_pts):
         if not by_hill:  # the exact monodromy of the orbit's linearisation
-            multipliers[i] = monodromy.multipliers(model, basis, coef[i], float(omega[i]))
+            multipliers[i] = _verdicts(model, basis, coef[i], float(omega[i]))
             continue
         ev = evaluations[i] if i < len(evaluations) else None
         if not isinstance(ev, aft.Evaluation):  # a point the continuation did not evaluate
@@ -582,6 +582,15 @@ def _response(
         method="harmonic",
         dof_names=None if model.is_joint else _dof_names(settings, n),
     )
+
+
+def _verdicts(
+    model: LinearSystem, basis: aft.Basis, coefficients: FloatArray, omega: float
+) -> NDArray[np.complex128]:
+    """One point's multipliers for the stability verdict: the exact monodromy's leading
+    ones (:func:`clearjoint.harmonic.monodromy.leading_multipliers`: its product applied
+    to a few columns, never formed, on a large structure; all 2N on a small one)."""
+    return monodromy.leading_multipliers(model, basis, coefficients, omega)
 
 
 def _dof_names(settings: dict[str, Any], n_dof: int) -> tuple[str, ...] | None:

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from clearjoint.bordered import SparseLU, bordered_solve
 from clearjoint.harmonic.aft import Basis, Evaluation, _scatter
 from clearjoint.harmonic.system import LinearSystem
 
@@ -37,12 +38,8 @@ def linear_solve(jacobian: Any, rhs: FloatArray) -> FloatArray:
     (dense) in both cases.
     """
     if not isinstance(jacobian, np.ndarray) or jacobian.shape[0] > SPARSE_ABOVE:
-        import scipy.sparse
-        import scipy.sparse.linalg
-
         try:
-            lu = scipy.sparse.linalg.splu(scipy.sparse.csc_matrix(jacobian))
-            x = lu.solve(rhs)
+            x = SparseLU(jacobian).solve(rhs)  # the column ordering reused along Newton
             if np.all(np.isfinite(x)):
                 return np.asarray(x, dtype=np.float64)
         except RuntimeError:  # "Factor is exactly singular"
@@ -270,48 +267,80 @@ class SparseResidual:
             data, iterations).
         """
         import scipy.sparse
-        import scipy.sparse.linalg
 
         from clearjoint.errors import ClearjointError
 
         y = y0.copy()
         d = y.size - 1
         u_scale = scale[:d]
-        border = np.zeros(d + 1)
-        border[d] = 1.0
-        last_row = scipy.sparse.csr_matrix((border if fixed_lambda else tangent)[None, :])
-        rows = scipy.sparse.diags(1.0 / u_scale)
-        columns = scipy.sparse.diags(u_scale)
+        if fixed_lambda:
+            row, corner = np.zeros(d), 1.0
+        else:
+            row, corner = tangent[:d], float(tangent[d])
         for iteration in range(settings.max_iterations + 1):
             try:
                 r, jac_u, r_lam, data = self.function(y[:d] * u_scale, float(y[d] * scale[d]))
             except ClearjointError:
                 return None
             # rows scaled by the unknowns' sizes, columns by the scaled unknowns
-            a = scipy.sparse.hstack(
-                (
-                    rows @ scipy.sparse.csr_matrix(jac_u) @ columns,
-                    scipy.sparse.csr_matrix((r_lam * (scale[d] / u_scale))[:, None]),
-                ),
-                format="csr",
-            )
+            jac = _scaled(jac_u, u_scale)
+            column = r_lam * (scale[d] / u_scale)
             rs = r / u_scale
             size = float(np.max(np.abs(rs)))
-            if not math.isfinite(size) or not np.all(np.isfinite(a.data)):
+            finite = np.all(np.isfinite(jac.data)) and np.all(np.isfinite(column))
+            if not (math.isfinite(size) and finite):
                 return None
             if size <= settings.tolerance:
+                a = scipy.sparse.hstack(
+                    (jac, scipy.sparse.csr_matrix(column[:, None])), format="csr"
+                )
                 return y, a, data, iteration
             if iteration == settings.max_iterations:
                 return None
-            rhs = np.empty(d + 1)
-            rhs[:d] = -rs
-            rhs[d] = 0.0 if fixed_lambda else -float(tangent @ (y - y0))
-            matrix = scipy.sparse.vstack((a, last_row), format="csc")
-            try:
-                dy = scipy.sparse.linalg.splu(matrix).solve(rhs)
-            except RuntimeError:  # "Factor is exactly singular"
-                return None
-            if not np.all(np.isfinite(dy)):
+            last = 0.0 if fixed_lambda else -float(tangent @ (y - y0))
+            dy = _bordered(jac, column, row, corner, -rs, last)
+            if dy is None or not np.all(np.isfinite(dy)):
                 return None
             y = y + dy
+        return None
+
+
+def _scaled(jacobian: Any, u_scale: FloatArray) -> Any:
+    """diag(1 / u_scale) @ jacobian @ diag(u_scale) as a CSR matrix (the pattern kept)."""
+    import scipy.sparse
+
+    jac = scipy.sparse.csr_matrix(jacobian, dtype=np.float64, copy=True)
+    rows = np.repeat(np.arange(jac.shape[0]), np.diff(jac.indptr))
+    jac.data *= u_scale[jac.indices] / u_scale[rows]
+    return jac
+
+
+def _bordered(
+    jac: Any, column: FloatArray, row: FloatArray, corner: float, rhs: FloatArray, last: float
+) -> FloatArray | None:
+    """Solve [[jac, column], [row^T, corner]] dy = [rhs; last]; None if singular.
+
+    Block elimination on the sparse LU of ``jac`` alone (its column ordering reused along
+    the branch: :mod:`clearjoint.bordered`); where ``jac`` is exactly singular, a direct
+    sparse LU of the whole bordered matrix, as before issue 25.
+    """
+    import scipy.sparse
+    import scipy.sparse.linalg
+
+    try:
+        return bordered_solve(jac, column, row, corner, rhs, last)
+    except RuntimeError:
+        pass
+    matrix = scipy.sparse.vstack(
+        (
+            scipy.sparse.hstack((jac, scipy.sparse.csr_matrix(column[:, None]))),
+            scipy.sparse.csr_matrix(np.append(row, corner)[None, :]),
+        ),
+        format="csc",
+    )
+    try:
+        return np.asarray(
+            scipy.sparse.linalg.splu(matrix).solve(np.append(rhs, last)), dtype=np.float64
+        )
+    except RuntimeError:  # "Factor is exactly singular"
         return None
