@@ -322,3 +322,19 @@ def test_one_link_curve_has_the_one_joint_curves_period_doublings():
     b = sorted(e.omega for e in theirs.events if e.kind == "period_doubling")
     assert len(a) == len(b) == 2  # near 41.56 and 44.71 Hz
     np.testing.assert_allclose(a, b, atol=2 * math.pi * 2e-3)
+
+
+def test_a_massless_dof_is_one_line_for_modes_motion_and_orbits():
+    from clearjoint.structure import from_matrices, system_modes, time_response
+
+    m = np.diag([1.0, 0.0])
+    k = np.array([[2e4, -1e4], [-1e4, 2e4]])
+    s = from_matrices(m, k, joints=[(0, None, LAW)])
+    for call in (
+        lambda: system_modes(s),
+        lambda: time_response(s, [1.0, 0.0], 10.0, 1.0),
+        lambda: periodic_orbit(s, [1.0, 0.0], 10.0),
+    ):
+        with pytest.raises(StructureError, match=r"DOF 1 .* mass of 0\.0 kg") as info:
+            call()
+        assert "\n" not in str(info.value)

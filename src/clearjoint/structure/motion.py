@@ -541,5 +541,12 @@ def _system(structure: Any) -> VibrationSystem:
         )
     system = as_system(structure)
     _check_joints(system)
-    system.mass_diagonal()  # a consistent mass is refused here, in one line
+    mass = system.mass_diagonal()  # a consistent mass is refused here, in one line
+    if not np.all(mass > 0.0):
+        k = int(np.flatnonzero(~(mass > 0.0))[0])
+        raise StructureError(
+            f"DOF {k} ({system.dof_names[k]}) has a mass of {float(mass[k])!r} kg: the exact "
+            "motion needs a mass on every DOF; give it one, or reduce the model onto its "
+            "massive DOFs (clearjoint.structure.reduce)"
+        )
     return system
