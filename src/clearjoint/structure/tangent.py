@@ -40,6 +40,10 @@ from clearjoint.system import VibrationSystem
 
 FloatArray = NDArray[np.float64]
 
+#: Bytes the decompositions and transitions of one PatternFlows may hold before it starts
+#: anew (a rattling structure with many joints visits new patterns without end).
+STORE_BYTES = 256 * 2**20
+
 
 class PatternFlows:
     """The exact linear flows expm(A_p t) of one system's contact patterns, each decomposed once.
@@ -76,6 +80,9 @@ class PatternFlows:
         self._base[n:, n:] = -inv_m[:, None] * np.asarray(c, dtype=np.float64)
         self._flows: dict[bytes, _Flow | FloatArray] = {}
         self._transitions: dict[tuple[bytes, bytes], FloatArray] = {}
+        # patterns kept at once: a decomposition holds two (2N)^2 matrices, and a
+        # transition one per pair met, so about 3 (2N)^2 8 bytes a pattern
+        self._limit = max(16, int(STORE_BYTES // (3 * 8 * (2 * n) ** 2)))
         self._norms: dict[bytes, FloatArray] = {}
         self._mass = system.mass_diagonal()
 
@@ -114,6 +121,9 @@ class PatternFlows:
         key = np.asarray(states, dtype=np.int8).tobytes()
         found = self._flows.get(key)
         if found is None:
+            if len(self._flows) >= self._limit:  # a rattling structure meets patterns
+                self._flows.clear()  # without end (3^J of them): start the store anew
+                self._transitions.clear()
             a = self.generator(states)
             decomposed = _decompose(a)
             found = a if decomposed is None else decomposed
@@ -123,6 +133,8 @@ class PatternFlows:
     def _transition(self, source: bytes, here: _Flow, target: bytes, there: _Flow) -> FloatArray:
         found = self._transitions.get((source, target))
         if found is None:
+            if len(self._transitions) >= 2 * self._limit:
+                self._transitions.clear()
             found = there.inverse @ here.vectors
             self._transitions[(source, target)] = found
         return found
