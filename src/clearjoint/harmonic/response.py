@@ -537,7 +537,9 @@ def _response(
     x0 = coef[:, 0, :] + coef[:, 1::2, :].sum(axis=1)
     v0 = omega[:, None] * np.einsum("c,pcn->pn", _velocity_row(basis), coef)
     initial = np.concatenate((x0, v0), axis=1)
-    events = _events(model, lam, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1))
+    events = curve_events(
+        model, lam, multipliers, d_max, d_min, omega, force, np.max(amplitude, axis=1)
+    )
     events += [
         check.untrusted(
             omega,
@@ -671,7 +673,7 @@ def _complex_pair_test(multipliers: NDArray[np.complex128]) -> FloatArray:
     return np.where(np.isfinite(top), top - 1.0, np.nan)
 
 
-def _events(
+def curve_events(
     model: LinearSystem,
     lam: FloatArray,
     multipliers: NDArray[np.complex128],
@@ -682,6 +684,11 @@ def _events(
     amplitude: FloatArray,
 ) -> list[ResponseEvent]:
     """Folds, period doublings, Neimark-Sacker crossings and grazings between successive points.
+
+    For any curve of periodic orbits (harmonic balance, or a structure's exact shooting)
+    with Floquet multipliers and the joints' extreme shortenings ``d_max``, ``d_min``
+    (n, n_j) per point; ``model`` gives the joints' directions and gap edges
+    (``directions``, ``g_c``, ``g_t``, ``is_joint``).
 
     Period doublings, Neimark-Sacker crossings (:func:`_complex_pair_test`) and
     grazings are located linearly between the points where their test function
@@ -762,23 +769,3 @@ def start_coefficients(
         No orbit found (``NoPeriodicResponse``).
     """
     return _start(model, basis, omega, force, model.reference_stiffness)
-
-
-def curve_events(
-    model: LinearSystem,
-    lam: FloatArray,
-    multipliers: NDArray[np.complex128],
-    d_max: FloatArray,
-    d_min: FloatArray,
-    omega: FloatArray,
-    force: FloatArray,
-    amplitude: FloatArray,
-) -> list[ResponseEvent]:
-    """Folds, period doublings, Neimark-Sacker crossings and grazings along a curve.
-
-    For any curve of periodic orbits with Floquet multipliers and the joints' extreme
-    shortenings ``d_max``, ``d_min`` (n, n_j) per point; ``model`` gives the joints'
-    directions and gap edges (``directions``, ``g_c``, ``g_t``, ``is_joint``). See
-    ``_events`` for how each is located.
-    """
-    return _events(model, lam, multipliers, d_max, d_min, omega, force, amplitude)

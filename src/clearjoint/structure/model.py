@@ -621,6 +621,19 @@ def edge_positions(laws: Sequence[ClearanceJoint]) -> tuple[FloatArray, FloatArr
     )
 
 
+def require_masses(mass: FloatArray, what: str, names: tuple[str, ...] = ()) -> None:
+    """Refuse, in one line naming it, a DOF without a positive mass (``what`` needs them all)."""
+    if np.all(mass > 0.0):
+        return
+    k = int(np.flatnonzero(~(mass > 0.0))[0])
+    name = f" ({names[k]})" if names else ""
+    raise StructureError(
+        f"DOF {k}{name} has a mass of {float(mass[k])!r} kg: {what} needs a mass on every "
+        "DOF; give it one, or reduce the model onto its massive DOFs "
+        "(clearjoint.structure.reduce)"
+    )
+
+
 def _pattern_modes(k: Matrix, m: FloatArray, count: int | None) -> tuple[FloatArray, FloatArray]:
     """Return omega (rad/s) and mass-normalised shapes of K phi = omega^2 diag(m) phi.
 
@@ -630,13 +643,7 @@ def _pattern_modes(k: Matrix, m: FloatArray, count: int | None) -> tuple[FloatAr
     n = m.size
     if count is not None and (not isinstance(count, int) or count < 1):
         raise StructureError(f"count must be a positive integer, got {count!r}")
-    if not np.all(m > 0.0):
-        k_bad = int(np.flatnonzero(~(m > 0.0))[0])
-        raise StructureError(
-            f"DOF {k_bad} has a mass of {float(m[k_bad])!r} kg: modes need a mass on every DOF; "
-            "give it one, or reduce the model onto its massive DOFs "
-            "(clearjoint.structure.reduce)"
-        )
+    require_masses(m, "modes")
     if n > SPARSE_ABOVE and count is not None and count < n - 1:
         # shift-invert just below 0: an open pattern with k0 = 0 has a singular K, so
         # K - 0 M cannot be factorised; K + s M (s > 0, far below the spectrum) can

@@ -51,6 +51,7 @@ from clearjoint.structure.model import (
     Structure,
     StructureError,
     default_dof_names,
+    require_masses,
     system_modes,
 )
 from clearjoint.system import Matrix, VibrationSystem, as_system
@@ -541,12 +542,6 @@ def _system(structure: Any) -> VibrationSystem:
         )
     system = as_system(structure)
     _check_joints(system)
-    mass = system.mass_diagonal()  # a consistent mass is refused here, in one line
-    if not np.all(mass > 0.0):
-        k = int(np.flatnonzero(~(mass > 0.0))[0])
-        raise StructureError(
-            f"DOF {k} ({system.dof_names[k]}) has a mass of {float(mass[k])!r} kg: the exact "
-            "motion needs a mass on every DOF; give it one, or reduce the model onto its "
-            "massive DOFs (clearjoint.structure.reduce)"
-        )
+    # a consistent mass is refused here, in one line, and so is a DOF without mass
+    require_masses(system.mass_diagonal(), "the exact motion", system.dof_names)
     return system
