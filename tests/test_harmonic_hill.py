@@ -285,7 +285,7 @@ def test_neimark_sacker_crossings_are_events_and_collisions_are_not() -> None:
     it): one "neimark_sacker" event at w = 2.5 by linear interpolation. A real multiplier
     through +1 and a complex pair that meets the real axis outside the circle (the largest
     complex modulus drops from 1.2 to the inside pair's 0.5) give none."""
-    from clearjoint.harmonic.response import _events
+    from clearjoint.harmonic.response import curve_events as _events
 
     model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
     omega = np.array([1.0, 2.0, 3.0, 4.0])
