@@ -50,6 +50,7 @@ model's DOFs too.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -264,7 +265,7 @@ def _build(values: dict[str, dict[str, Any]], where: str) -> StructureStudy:
         structure = _structure(values.get("structure", {}), joint, where)
     except (StructureError, ParameterError) as exc:  # the item and its fix, in the file's words
         raise StructureStudyError(f"{where}: {exc}") from None
-    return _tasks(values, structure, where)
+    return _structure_tasks(values, structure, where)
 
 
 def _joint(joint_values: dict[str, Any] | None, where: str) -> ClearanceJoint | None:
@@ -366,7 +367,9 @@ def _structure(st: dict[str, Any], joint: ClearanceJoint | None, where: str) -> 
     return structure
 
 
-def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) -> StructureStudy:
+def _structure_tasks(
+    values: dict[str, dict[str, Any]], structure: Structure, where: str
+) -> StructureStudy:
     """The [excitation], [decay] and [output] of the study, on its structure."""
     names = structure.dof_names
 
@@ -384,6 +387,27 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
             )
         return names.index(name)
 
+    closed = structure.modes("closed") if values.get("decay") else None
+    return _tasks(values, where, structure, names, dof_index, closed)
+
+
+def _tasks(
+    values: dict[str, dict[str, Any]],
+    where: str,
+    system: Structure | VibrationSystem,
+    names: Sequence[str],
+    dof_index: Callable[[str, str], int],
+    closed: Any,
+    reduced: Any = None,
+) -> StructureStudy:
+    """The [excitation], [decay] and [output] of a study, on its structure or model.
+
+    ``names`` and ``dof_index`` are the DOFs a study names (a model's full DOFs);
+    ``closed`` is ``system``'s closed modes (None without a [decay] section). With
+    ``reduced`` (a ReducedSystem) the force is projected onto it (``project_force``) and
+    the decay starts along its closed mode, scaled so that the named DOF (through
+    ``expand``) moves by initial_amplitude.
+    """
     ex = values.get("excitation", {})
     omega = force = None
     if ex:
@@ -400,8 +424,10 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
                 f"{where}: [excitation] periods must be at least 1, got {ex['periods']}"
             )
         omega = 2.0 * math.pi * ex["frequency"]
-        force = np.zeros(structure.n_dof)
+        force = np.zeros(len(names))
         force[dof_index("excitation", ex["force_dof"])] = ex["force_amplitude"]
+        if reduced is not None:
+            force = reduced.project_force(force)
     de = values.get("decay", {})
     decay_dof = initial = duration = mode = None
     if de:
@@ -409,7 +435,6 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
             if key not in de:
                 raise StructureStudyError(f"{where}: [decay] {key} is required")
         decay_dof = dof_index("decay", de["dof"])
-        closed = structure.modes("closed")
         mode = de.get("mode", 1)
         if not 1 <= mode <= closed.shapes.shape[1]:
             raise StructureStudyError(
@@ -426,12 +451,15 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
                 f"{where}: [decay] duration must be finite and > 0, got {de['duration']:g} s"
             )
         shape = closed.shapes[:, mode - 1]
-        if shape[decay_dof] == 0.0:
+        moved = reduced.expand(shape)[decay_dof] if reduced is not None else shape[decay_dof]
+        if moved == 0.0:
             raise StructureStudyError(
                 f"{where}: [decay] mode {mode} does not move {de['dof']}; "
                 "choose another dof or mode"
             )
-        initial = de["initial_amplitude"] * shape / shape[decay_dof]
+        initial = de["initial_amplitude"] * shape / moved
+        if reduced is not None:  # the reduced model's own coordinate that moves most
+            decay_dof = int(np.argmax(np.abs(shape)))
         duration = de["duration"]
     samples = values.get("output", {}).get("samples_per_period", 64)
     if samples < 8:  # time_response would refuse it without naming the file and section
@@ -439,7 +467,7 @@ def _tasks(values: dict[str, dict[str, Any]], structure: Structure, where: str) 
             f"{where}: [output] samples_per_period must be at least 8, got {samples}"
         )
     return StructureStudy(
-        structure=structure,
+        structure=system,
         omega=omega,
         force=force,
         periods=ex.get("periods", 20),
@@ -482,60 +510,9 @@ def _model_study(
             )
         return names.index(name)
 
-    omega = force = None
-    if ex:
-        for key in ("frequency", "force_dof", "force_amplitude"):
-            if key not in ex:
-                raise StructureStudyError(f"{where}: [excitation] {key} is required")
-        if not (math.isfinite(ex["frequency"]) and ex["frequency"] > 0.0):
-            raise StructureStudyError(
-                f"{where}: [excitation] frequency must be finite and > 0, got "
-                f'{ex["frequency"]:g} Hz; e.g. frequency = "15Hz"'
-            )
-        omega = 2.0 * math.pi * ex["frequency"]
-        force = np.zeros(full.n_dof)
-        force[dof_index("excitation", ex["force_dof"])] = ex["force_amplitude"]
-        if isinstance(system, ReducedSystem):
-            force = system.project_force(force)
-    decay_dof = initial = duration = mode = None
-    if de:
-        for key in ("dof", "initial_amplitude", "duration"):
-            if key not in de:
-                raise StructureStudyError(f"{where}: [decay] {key} is required")
-        dof = dof_index("decay", de["dof"])
-        closed = system_modes(system, "closed")
-        mode = de.get("mode", 1)
-        if not 1 <= mode <= closed.shapes.shape[1]:
-            raise StructureStudyError(
-                f"{where}: [decay] mode must be 1 to {closed.shapes.shape[1]}, got {mode}"
-            )
-        shape = closed.shapes[:, mode - 1]
-        moved = system.expand(shape)[dof] if isinstance(system, ReducedSystem) else shape[dof]
-        if moved == 0.0 or not math.isfinite(de["initial_amplitude"]):
-            raise StructureStudyError(
-                f"{where}: [decay] mode {mode} does not move {de['dof']}, or initial_amplitude "
-                "is not finite; choose another dof or mode"
-            )
-        initial = de["initial_amplitude"] * shape / moved
-        decay_dof = int(np.argmax(np.abs(shape))) if isinstance(system, ReducedSystem) else dof
-        duration = de["duration"]
-    samples = values.get("output", {}).get("samples_per_period", 64)
-    if samples < 8:
-        raise StructureStudyError(
-            f"{where}: [output] samples_per_period must be at least 8, got {samples}"
-        )
-    return StructureStudy(
-        structure=system,
-        omega=omega,
-        force=force,
-        periods=ex.get("periods", 20),
-        decay_dof=decay_dof,
-        decay_initial=initial,
-        decay_duration=duration,
-        samples_per_period=samples,
-        source=where,
-        decay_mode=mode,
-    )
+    reduced = system if isinstance(system, ReducedSystem) else None
+    closed = system_modes(system, "closed") if de else None
+    return _tasks(values, where, system, names, dof_index, closed, reduced)
 
 
 def read_model(path: str | Path) -> VibrationSystem:
