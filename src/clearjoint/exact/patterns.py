@@ -11,6 +11,7 @@ form (e^(a t) times a rotation by b t). The monodromy of a harmonic-balance orbi
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,7 @@ from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["MAX_CONDITION", "PatternFlow", "decompose"]
+__all__ = ["MAX_CONDITION", "PatternFlow", "Stretch", "chain", "decompose"]
 
 #: A pattern's A = V B V^-1 is used when V's 1-norm condition number (balanced
 #: coordinates) is at most this; above it (a defective or nearly defective A) the segment
@@ -100,3 +101,61 @@ def decompose(a: FloatArray) -> PatternFlow | None:
         real=r,
         frequency=np.asarray(lam[upper].imag, dtype=np.float64),
     )
+
+
+#: What a stretch's pattern gives :func:`chain`: its decomposition, or its generator A
+#: (a pattern whose V is ill-conditioned: its exponential is taken by scipy.linalg.expm).
+Stretch = PatternFlow | FloatArray
+
+
+def chain(
+    start: FloatArray,
+    times: Sequence[float] | FloatArray,
+    keys: Sequence[bytes],
+    flow_of: Callable[[int], Stretch],
+    transition: Callable[[bytes, PatternFlow, bytes, PatternFlow], FloatArray],
+) -> FloatArray:
+    """Return expm(A_k t_k) ... expm(A_1 t_1) @ start over stretches of the given patterns.
+
+    The product is carried in the patterns' eigen-coordinates (module docstring): one
+    change of coordinates where the pattern changes, ``transition(key_from, flow_from,
+    key_to, flow_to)`` = V_to^-1 V_from (the caller caches it), and a closed-form
+    scaling per stretch. Stretch i lasts ``times[i]`` (s; those not positive are
+    skipped) in the pattern ``keys[i]``, whose ``flow_of(i)`` is a :class:`PatternFlow`
+    or, where V is ill-conditioned, the generator A itself (its exponential then by
+    ``scipy.linalg.expm``; A is used at once, so the caller may reuse its array).
+
+    Parameters
+    ----------
+    start : (2N, m) ndarray
+    times : (k,) sequence of float
+    keys : (k,) sequence of bytes
+    flow_of : callable
+    transition : callable
+
+    Returns
+    -------
+    (2N, m) ndarray
+    """
+    phi = np.array(start, dtype=np.float64)
+    here: PatternFlow | None = None  # the pattern whose eigen-coordinates phi is in
+    here_key = b""
+    for i, (t, key) in enumerate(zip(times, keys, strict=True)):
+        if t <= 0.0:
+            continue
+        flow = flow_of(i)
+        if not isinstance(flow, PatternFlow):  # the plain exponential
+            if here is not None:
+                phi = here.vectors @ phi
+                here = None
+            phi = scipy.linalg.expm(flow * t) @ phi
+            continue
+        if here is None:
+            phi = flow.inverse @ phi
+        elif here_key != key:
+            phi = transition(here_key, here, key, flow) @ phi
+        phi = flow.propagate(float(t), phi)
+        here, here_key = flow, key
+    if here is not None:
+        phi = here.vectors @ phi
+    return np.asarray(phi, dtype=np.float64)

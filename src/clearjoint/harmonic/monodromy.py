@@ -59,12 +59,12 @@ from collections.abc import Callable
 from typing import Literal
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
 from clearjoint.errors import ParameterError
 from clearjoint.exact.patterns import PatternFlow as _Flow
+from clearjoint.exact.patterns import Stretch, chain
 from clearjoint.exact.patterns import decompose as _decompose
 from clearjoint.harmonic.aft import Basis
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
@@ -282,37 +282,26 @@ def _product(
     eigen = method == "eigen" and 2 * len(set(keys)) * a.nbytes <= _FLOWS.limit
     system_key = _fingerprint(system) if eigen else b""
 
+    def flow_of(i: int) -> Stretch:
+        if eigen:
+            found, cached = _FLOWS.get((system_key, keys[i]))
+            if not found:
+                a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
+                cached = _decompose(a)
+                _FLOWS.put((system_key, keys[i]), cached, 2 * a.nbytes if cached else 0)
+            if isinstance(cached, _Flow):
+                return cached
+        # the plain exponential (the reference and the fallback): chain uses a at once
+        a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
+        return a
+
     def apply(start: FloatArray) -> FloatArray:
-        phi = np.array(start, dtype=np.float64)
-        here: _Flow | None = None  # the pattern whose eigen-coordinates phi is in (None: plain)
-        here_key = b""
-        for width, state, key in zip(widths, states, keys, strict=True):
-            if width <= 0.0:
-                continue
-            flow = None
-            if eigen:
-                found, cached = _FLOWS.get((system_key, key))
-                if not found:
-                    a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, state)
-                    cached = _decompose(a)
-                    _FLOWS.put((system_key, key), cached, 2 * a.nbytes if cached else 0)
-                flow = cached if isinstance(cached, _Flow) else None
-            if flow is None:  # the plain exponential (the reference and the fallback)
-                if here is not None:
-                    phi = here.vectors @ phi
-                    here = None
-                a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, state)
-                phi = scipy.linalg.expm(a * (width / omega)) @ phi
-                continue
-            if here is None:
-                phi = flow.inverse @ phi
-            elif here_key != key:
-                phi = _transition(system_key, here_key, here, key, flow) @ phi
-            phi = flow.propagate(width / omega, phi)
-            here, here_key = flow, key
-        if here is not None:
-            phi = here.vectors @ phi
-        return np.asarray(phi, dtype=np.float64)
+        return chain(start, widths / omega, keys, flow_of, transition)
+
+    def transition(
+        source_key: bytes, source: _Flow, target_key: bytes, target: _Flow
+    ) -> FloatArray:
+        return _transition(system_key, source_key, source, target_key, target)
 
     return apply
 

@@ -29,11 +29,11 @@ import math
 from typing import Any
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from clearjoint.exact import march
 from clearjoint.exact.patterns import PatternFlow as _Flow
+from clearjoint.exact.patterns import chain
 from clearjoint.exact.patterns import decompose as _decompose
 from clearjoint.structure.model import StructureError
 from clearjoint.system import VibrationSystem
@@ -152,28 +152,9 @@ class PatternFlows:
             Each stretch's contact pattern.
         start : (2N, m) ndarray, optional
         """
-        phi = np.eye(2 * self.n) if start is None else np.array(start, dtype=np.float64)
-        here: _Flow | None = None
-        here_key = b""
-        for width, states in zip(widths, patterns, strict=True):
-            if width <= 0.0:
-                continue
-            key, flow = self.flow(states)
-            if not isinstance(flow, _Flow):
-                if here is not None:
-                    phi = here.vectors @ phi
-                    here = None
-                phi = scipy.linalg.expm(flow * width) @ phi
-                continue
-            if here is None:
-                phi = flow.inverse @ phi
-            elif here_key != key:
-                phi = self._transition(here_key, here, key, flow) @ phi
-            phi = flow.propagate(float(width), phi)
-            here, here_key = flow, key
-        if here is not None:
-            phi = here.vectors @ phi
-        return np.asarray(phi, dtype=np.float64)
+        phi = np.eye(2 * self.n) if start is None else start
+        keys = [np.asarray(states, dtype=np.int8).tobytes() for states in patterns]
+        return chain(phi, widths, keys, lambda i: self.flow(patterns[i])[1], self._transition)
 
 
 def stretches(
