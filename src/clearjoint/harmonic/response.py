@@ -370,6 +370,52 @@ def _start(
     )
 
 
+def linear_start(
+    model: LinearSystem,
+    basis: aft.Basis,
+    omega: float,
+    force: FloatArray,
+    k_ref: float,
+    *,
+    sparse: Any = None,
+    max_iterations: int = 80,
+    tolerate: tuple[type[Exception], ...] = (),
+) -> FloatArray | None:
+    """Harmonic balance's orbit by Newton from the open, then the closed, linear response.
+
+    The first part of :func:`frequency_response`'s start (its force homotopy is the
+    second). ``sparse``: a ``SparseJacobian`` for a large structure. An exception of a
+    type in ``tolerate`` counts as no solution from that guess (the next is tried).
+
+    Returns
+    -------
+    (2H + 1) N ndarray or None
+        The coefficients a_0, a_1, b_1, ..., a_H, b_H (per DOF), m; None if neither
+        converged.
+    """
+    scale = 0.5 * scale_length(model)
+
+    def function(q: FloatArray) -> tuple[FloatArray, Any]:
+        ev = aft.evaluate(model, basis, q, omega, force, jacobian=sparse is None)
+        jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
+        return ev.residual / k_ref, jac / k_ref
+
+    for stiffness in (model.open_stiffness(), model.closed_stiffness()):
+        guess = linear_guess(model, basis, omega, force, stiffness)
+        try:
+            found = newton(
+                function,
+                guess,
+                max(scale, float(np.max(np.abs(guess)))),
+                max_iterations=max_iterations,
+            )
+        except tolerate:
+            found = None
+        if found is not None:
+            return found[0]
+    return None
+
+
 def _start_plain(
     model: LinearSystem, basis: aft.Basis, omega: float, force: FloatArray, k_ref: float
 ) -> FloatArray:
@@ -382,17 +428,10 @@ def _start_plain(
         None if model.is_joint or n_u <= solve.SPARSE_ABOVE else solve.SparseJacobian(model, basis)
     )
 
-    def function(q: FloatArray) -> tuple[FloatArray, Any]:
-        ev = aft.evaluate(model, basis, q, omega, force, jacobian=sparse is None)
-        jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
-        return ev.residual / k_ref, jac / k_ref
-
     hz = omega / (2.0 * math.pi)
-    for stiffness in (model.open_stiffness(), model.closed_stiffness()):
-        guess = linear_guess(model, basis, omega, force, stiffness)
-        found = newton(function, guess, max(scale, float(np.max(np.abs(guess)))))
-        if found is not None:
-            return found[0]
+    found = linear_start(model, basis, omega, force, k_ref, sparse=sparse)
+    if found is not None:
+        return found
     reached = 0.0
     # Homotopy: from a force small enough for the open (all joints in free-play) linear
     # response to stay inside every gap, follow the solution up to the full force.

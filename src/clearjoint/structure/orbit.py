@@ -54,9 +54,9 @@ def harmonic_seed(
     part of ``clearjoint.harmonic``'s start); with ``homotopy`` its whole start, the
     force homotopy included (seconds on a small chain).
     """
-    from clearjoint.harmonic import aft, solve
-    from clearjoint.harmonic.response import start_coefficients
-    from clearjoint.harmonic.system import HarmonicError, build, scale_length
+    from clearjoint.harmonic import aft
+    from clearjoint.harmonic.response import linear_start, start_coefficients
+    from clearjoint.harmonic.system import HarmonicError, build
 
     try:
         model = build(system, None)
@@ -64,27 +64,19 @@ def harmonic_seed(
         basis = aft.Basis.make(h, n_t)
     except (HarmonicError, ParameterError):
         return None
-    k_ref = model.reference_stiffness
-    if homotopy:
-        try:
-            return _state_of(start_coefficients(model, basis, omega, force), h, system.n_dof, omega)
-        except (HarmonicError, np.linalg.LinAlgError, ValueError):
-            return None
-
-    def function(q: FloatArray) -> tuple[FloatArray, Any]:
-        ev = aft.evaluate(model, basis, q, omega, force)
-        return ev.residual / k_ref, ev.jacobian / k_ref
-
-    for stiffness in (model.open_stiffness(), model.closed_stiffness()):
-        guess = solve.linear_guess(model, basis, omega, force, stiffness)
-        scale = max(0.5 * scale_length(model), float(np.max(np.abs(guess))))
-        try:
-            found = solve.newton(function, guess, scale, max_iterations=30)
-        except (HarmonicError, np.linalg.LinAlgError, ValueError):
-            found = None
-        if found is not None:
-            return _state_of(found[0], h, system.n_dof, omega)
-    return None
+    failures = (HarmonicError, np.linalg.LinAlgError, ValueError)
+    q: FloatArray | None
+    try:
+        if homotopy:
+            q = start_coefficients(model, basis, omega, force)
+        else:
+            k_ref = model.reference_stiffness
+            q = linear_start(
+                model, basis, omega, force, k_ref, max_iterations=30, tolerate=failures
+            )
+    except failures:
+        return None
+    return None if q is None else _state_of(q, h, system.n_dof, omega)
 
 
 def _seeds(
