@@ -102,8 +102,8 @@ def frequency_response(
     flows = PatternFlows(system)
     first = periodic_orbit(system, f, w0, initial=initial)
     n = system.n_dof
-    eye = np.eye(n)
     b = system.directions
+    rows = np.vstack((np.eye(n), b))
     maps: dict[float, ShootingMap] = {}
 
     def shooting_map(w: float) -> ShootingMap:
@@ -128,8 +128,9 @@ def frequency_response(
             d_lam = (np.concatenate(up.final_state) - np.concatenate(down.final_state)) / (
                 2.0 * D_OMEGA * lam
             )
-        x_max, x_min = turning_extremes(motion, system, f, eye)
-        d_max, d_min = turning_extremes(motion, system, f, b)
+        # the DOFs' extremes and the joints' shortenings' in one pass over the samples
+        top, bottom = turning_extremes(motion, system, f, rows)
+        x_max, d_max, x_min, d_min = top[:n], top[n:], bottom[:n], bottom[n:]
         data = SimpleNamespace(
             events=motion.events,
             x_max=x_max,

@@ -59,7 +59,7 @@ from clearjoint.progress import report
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.motion import _Flow, _run, _system, _vector
 from clearjoint.structure.poincare import OrbitError, ShootingMap, newton_orbit, turning_extremes
-from clearjoint.structure.tangent import PatternFlows, largest_exponent
+from clearjoint.structure.tangent import PatternFlows, largest_exponent, refuse_restitution
 from clearjoint.system import VibrationSystem
 
 FloatArray = NDArray[np.float64]
@@ -521,7 +521,7 @@ def stepped_sine(
         raise SteppedSineError(f"direction must be 'up', 'down' or 'both', got {direction!r}")
     settle = _whole("settle_periods", settle_periods, 1)
     record = _whole("record_periods", record_periods, 1)
-    PatternFlows(system)  # refuses restitution below 1 here, before any work
+    refuse_restitution(system)  # before any work
     names: tuple[str, ...] = ("up", "down") if direction == "both" else (direction,)
     n_runs = 1 if runner is None else _whole("chunks", 8 if chunks is None else chunks, 1)
     n_runs = min(n_runs, w.size)

@@ -45,6 +45,20 @@ FloatArray = NDArray[np.float64]
 STORE_BYTES = 256 * 2**20
 
 
+def refuse_restitution(system: VibrationSystem) -> None:
+    """Refuse, in one line, a joint whose restitution is below 1 (its impacts would need
+    saltation jumps that the tangent flow does not carry)."""
+    e = system.restitution()
+    if np.any(e < 1.0):
+        joint = int(np.flatnonzero(e < 1.0)[0])
+        raise StructureError(
+            f"joint {joint} has a restitution of {float(e[joint]):g}: the exact tangent "
+            "flow (monodromy, Lyapunov exponent) of a structure carries continuous "
+            "contact only; give that joint restitution=1 (its contact stiffness "
+            "carries the impact), or study one joint with clearjoint.periodic"
+        )
+
+
 class PatternFlows:
     """The exact linear flows expm(A_p t) of one system's contact patterns, each decomposed once.
 
@@ -60,15 +74,7 @@ class PatternFlows:
     """
 
     def __init__(self, system: VibrationSystem) -> None:
-        e = system.restitution()
-        if np.any(e < 1.0):
-            joint = int(np.flatnonzero(e < 1.0)[0])
-            raise StructureError(
-                f"joint {joint} has a restitution of {float(e[joint]):g}: the exact tangent "
-                "flow (monodromy, Lyapunov exponent) of a structure carries continuous "
-                "contact only; give that joint restitution=1 (its contact stiffness "
-                "carries the impact), or study one joint with clearjoint.periodic"
-            )
+        refuse_restitution(system)
         self.system = system
         self.n = n = system.n_dof
         inv_m = 1.0 / system.mass_diagonal()
