@@ -105,3 +105,20 @@ def test_the_front_page_five_lines_give_the_numbers_in_their_comment() -> None:
     assert shown is not None
     for text_value, value in zip(shown.groups(), k_d, strict=True):
         assert float(text_value) == pytest.approx(value, rel=5e-3), (text_value, value)
+
+
+def test_steady_md_cascade_is_what_the_example_prints(capsys: pytest.CaptureFixture[str]) -> None:
+    """docs/steady.md quotes examples/one_link_cascade.py's period doublings and ratios."""
+    import runpy
+
+    text = page("steady.md")
+    doublings = quoted(r"doublings fall at (\S+), (\S+), (\S+) and (\S+) Hz", text)
+    ratios = quoted(r"ratios of the intervals are (\S+) and (\S+)\.", text)
+    capsys.readouterr()
+    runpy.run_path(str(ROOT / "examples" / "one_link_cascade.py"), run_name="__main__")
+    out = capsys.readouterr().out
+    printed = [float(x) for x in re.findall(r"period doubling at (\S+) Hz", out)]
+    assert len(printed) == 4
+    assert all(agrees(s, v) for s, v in zip(doublings, printed, strict=True))
+    gaps = -np.diff(printed)
+    assert all(agrees(s, v) for s, v in zip(ratios, gaps[:-1] / gaps[1:], strict=True))
