@@ -231,10 +231,45 @@ def test_a_force_of_the_wrong_length_is_one_line():
 
 
 def test_restitution_is_refused_where_the_jacobian_would_miss_its_jumps():
+    """Orbits and curves carry each impact's saltation matrix; the stepped sine's long
+    tangent flow (its Lyapunov exponent) does not, and a restitution of 0 leaves no speed
+    before the impact to form the saltation matrix from: both are one line."""
     law = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.8)
     s = chain([0.5], [math.inf], [law], [2.0])
     with pytest.raises(StructureError, match="restitution"):
-        periodic_orbit(s, [30.0], 2 * math.pi * 40)
+        stepped_sine(s, [30.0], 2 * math.pi * np.array([40.0, 41.0]))
+    dead = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.0)
+    shoot = ShootingMap(
+        chain([0.5], [math.inf], [dead], [2.0]).to_system(), np.array([30.0]), 2 * math.pi * 40
+    )
+    with pytest.raises(StructureError, match="restitution of 0"):
+        shoot(np.array([0.0, 0.0]))
+
+
+def test_monodromy_with_impacts_is_the_finite_difference_jacobian_of_the_exact_map():
+    """Restitution 0.7 on a 3-mass chain: the monodromy with each impact's saltation matrix
+    against central differences of the exact map (without the jumps it is off by O(1))."""
+    n = 3
+    law = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.7)
+    s = chain([0.5] * n, [math.inf] * n, [law] * n, [2.0] * n)
+    f, w = _force(n, 2.0), 2 * math.pi * 15.0
+    from clearjoint.structure import time_response
+
+    z = np.concatenate(time_response(s, f, w, 50 * 2 * math.pi / w).final_state)
+    shoot = ShootingMap(s.to_system(), f, w)
+    _, phi, motion = shoot(z)
+    assert motion.energy.impact > 0.0  # the run has impacts
+    fd = np.empty_like(phi)
+    scale = np.concatenate((np.full(n, w), np.ones(n)))
+    for k in range(2 * n):
+        h = 1e-9 / scale[k]
+        dz = np.zeros(2 * n)
+        dz[k] = h
+        fd[:, k] = (shoot(z + dz)[0] - shoot(z - dz)[0]) / (2 * h)
+    size = np.max(np.abs(phi * scale[:, None] / scale[None, :]))
+    assert np.max(np.abs((fd - phi) * scale[:, None] / scale[None, :])) < 1e-6 * size
+    plain = ShootingMap(chain([0.5] * n, [math.inf] * n, [LAW] * n, [2.0] * n).to_system(), f, w)
+    assert np.max(np.abs((plain(z)[1] - phi) * scale[:, None] / scale[None, :])) > 0.1 * size
 
 
 def test_results_have_repr_plot_and_xarray():
@@ -338,3 +373,104 @@ def test_a_massless_dof_is_one_line_for_modes_motion_and_orbits():
         with pytest.raises(StructureError, match=r"DOF 1 .* mass of 0\.0 kg") as info:
             call()
         assert "\n" not in str(info.value)
+
+
+def test_impact_oscillator_cascade_against_the_rigid_limit_and_feigenbaum():
+    """The period-doubling cascade of the impact oscillator (Shaw & Holmes 1983; Budd & Dux
+    1994): x'' + x = cos(w t) below a stop at sigma = 0.3, restitution 0.8, going down from
+    w = 2.83, where one impact every two forcing periods doubles again and again.
+
+    The reference (tests/impact_oscillator.py) is the rigid limit in closed form, sharing no
+    code with clearjoint; its cascade converges at Feigenbaum's rate (delta = 4.6692...,
+    Feigenbaum 1978, J. Stat. Phys. 19, 25-52), as a smooth cascade must: the ratio of
+    successive intervals falls from 10.8 to 4.74 at the fifth doubling.
+    clearjoint's structure solver models the stop as a one-sided clearance joint with a
+    contact stiffness 1e6 times the spring's and the same restitution, and carries the
+    impacts' saltation matrices in its monodromy: its first two doublings fall within 2e-3
+    of the rigid limit's (the contact's finite stiffness), and its first one where the
+    one-joint solver (clearjoint.periodic, its own kernel and saltation) finds it.
+    """
+    from scipy.optimize import brentq
+
+    import impact_oscillator as rigid
+    from clearjoint.structure import time_response
+    from clearjoint.structure.poincare import ShootingMap, newton_orbit
+
+    sigma, r, w_top = 0.3, 0.8, 2.83
+    model = rigid.ImpactOscillator(w_top, sigma, r)
+    z = np.array([0.0, 0.5])
+    for _ in range(300):
+        z = model.iterate(z, 1)
+    reference = rigid.cascade(sigma, r, w_top, np.array([z[0] % model.period, z[1]]), 5)
+    gaps = -np.diff(reference)
+    ratios = gaps[:-1] / gaps[1:]
+    assert np.all(np.diff(ratios) < 0)
+    assert ratios[-1] == pytest.approx(4.6692, rel=0.02)
+
+    law = cj.ClearanceJoint(10.0, 1e6, gap_stiffness=1.0, gap_offset=sigma - 5.0, restitution=r)
+    structure = chain([1.0], [math.inf], [law], [0.0])
+    system, force = structure.to_system(), np.array([1.0])
+
+    def orbit(w: float, p: int, seed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        found = newton_orbit(ShootingMap(system, force, w, p), seed, 1e-12)
+        assert found is not None, f"no period-{p} orbit at {w}"
+        return found[0], np.linalg.eigvals(found[1])
+
+    def lowest(mu: np.ndarray) -> float:
+        real = mu[np.abs(mu.imag) < 1e-9].real
+        return float(real.min()) if real.size else 1.0
+
+    def doubling(p: int, w: float, z: np.ndarray, largest: float) -> tuple[float, dict]:
+        known, step = {w: z}, largest
+        while True:
+            z_next, mu = orbit(w + step, p, known[w])
+            if lowest(mu) < -1.0:
+                known[w + step] = z_next
+                break
+            if np.abs(mu).max() > 1.0:  # left the branch: a shorter step
+                step *= 0.25
+                continue
+            w += step
+            known[w] = z_next
+            step = max(1.5 * step, largest)  # steps are negative: grow back to the largest
+
+        def past(x: float) -> float:
+            known[x], mu = orbit(x, p, known[min(known, key=lambda k: abs(k - x))])
+            return lowest(mu) + 1.0
+
+        return brentq(past, w + step, w, xtol=1e-11), known
+
+    start = time_response(structure, force, w_top, 300 * 2 * math.pi / w_top)
+    z0, _ = orbit(w_top, 2, np.concatenate(start.final_state))
+    first, known = doubling(2, w_top, z0, -0.01)
+    # just below it, the stable orbit of twice the period, from the unstable one pushed
+    # along the eigenvector of its multiplier past -1
+    w = first - 1e-3
+    shoot = ShootingMap(system, force, w, 2)
+    found = newton_orbit(shoot, known[min(known, key=lambda k: abs(k - w))], 1e-12)
+    assert found is not None
+    base, phi = found[0], found[1]
+    values, vectors = np.linalg.eig(phi)
+    push = vectors[:, np.argmin(values.real)].real
+    size = shoot.size(base) / shoot.size(push)
+    for scale in (1e-3, 3e-3, 1e-2, 3e-2, 1e-1, -1e-2, -3e-2, -1e-1):
+        z4, mu4 = orbit(w, 4, base + scale * size * push)
+        if np.abs(mu4).max() < 1.0 and shoot.size(z4 - base) > 1e-6 * shoot.size(base):
+            break  # stable, and not the period-2 orbit run twice
+    else:
+        pytest.fail("no stable period-4 orbit just below the first doubling")
+    second, _ = doubling(4, w, z4, -0.05)
+    assert first == pytest.approx(reference[0], abs=2e-3)
+    assert second == pytest.approx(reference[1], abs=2e-3)
+
+    # the one-joint solver on the same joint finds the first doubling at the same frequency
+    j, losses = system.to_joint()
+    one = periodic.periodic_orbit(j, 1.0, first + 1e-3, losses=losses, period_multiple=2,
+                                  initial=(float(z0[0]), float(z0[1])))  # fmt: skip
+
+    def theirs(x: float) -> float:
+        o = periodic.periodic_orbit(j, 1.0, x, losses=losses, period_multiple=2,
+                                    initial=tuple(one.initial_state))  # fmt: skip
+        return lowest(np.asarray(o.multipliers)) + 1.0
+
+    assert brentq(theirs, first - 1e-4, first + 1e-4, xtol=1e-11) == pytest.approx(first, abs=1e-7)

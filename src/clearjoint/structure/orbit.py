@@ -138,7 +138,8 @@ def periodic_orbit(
     Parameters
     ----------
     structure : Structure or VibrationSystem
-        Lumped (diagonal) mass; joints without friction and with restitution 1.
+        Lumped (diagonal) mass; joints without friction. A restitution below 1 (but above
+        0) is carried: each impact's saltation matrix enters the monodromy.
     force : (N,) array_like
         Force amplitude per DOF, N.
     omega : float
@@ -156,7 +157,7 @@ def periodic_orbit(
     Raises
     ------
     StructureError
-        A force or initial vector of the wrong length, friction or restitution below 1.
+        A force or initial vector of the wrong length, friction, a restitution of 0.
     ParameterError
         omega not finite and positive, period_multiple not an integer >= 1.
     OrbitError

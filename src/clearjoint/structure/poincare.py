@@ -28,9 +28,15 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
+from clearjoint.exact.march import OPEN
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.motion import StructureMotion, _Flow, _run
-from clearjoint.structure.tangent import PatternFlows, stretches
+from clearjoint.structure.tangent import (
+    PatternFlows,
+    impact_saltation,
+    pattern_history,
+    stretches,
+)
 from clearjoint.system import VibrationSystem
 
 FloatArray = NDArray[np.float64]
@@ -211,7 +217,8 @@ class ShootingMap:
         self.period = 2.0 * math.pi / omega
         self.duration = self.p * self.period
         self.flow = _Flow(system, force, omega)
-        self.flows = PatternFlows(system) if flows is None else flows
+        self.impacts = bool(np.any(self.flow.restitution < 1.0))
+        self.flows = PatternFlows(system, impacts=self.impacts) if flows is None else flows
 
     def run(self, z: FloatArray, samples_per_period: int = 1) -> StructureMotion:
         """The exact motion from z = (u, v) over p periods."""
@@ -225,8 +232,46 @@ class ShootingMap:
         """Return (P(z), Phi, motion)."""
         motion = self.run(z, samples_per_period)
         end = np.concatenate(motion.final_state)
+        if self.impacts:
+            return end, self._with_impacts(z, motion), motion
         widths, patterns = stretches(motion, 0.0, self.duration)
         return end, self.flows.product(widths, patterns), motion
+
+    def _with_impacts(self, z: FloatArray, motion: StructureMotion) -> FloatArray:
+        """The monodromy with each impact's saltation matrix between the stretches.
+
+        The state just after each impact is read from a second run of the same motion
+        sampled at the impacts' times (the march's steps do not depend on where it samples,
+        and a sample at an event's time is taken at the start of the step after it); that
+        run's events are checked to be the first run's, bit for bit.
+        """
+        history = pattern_history(motion)
+        joints = np.asarray(motion.event_joints, dtype=np.int64)
+        times = np.asarray(motion.event_times, dtype=np.float64)
+        order = np.arange(joints.size)
+        entering = (history[order, joints] == OPEN) & (history[order + 1, joints] != OPEN)
+        hits = np.flatnonzero(entering & (self.flow.restitution[joints] < 1.0))
+        if hits.size == 0:
+            widths, patterns = stretches(motion, 0.0, self.duration, history)
+            return self.flows.product(widths, patterns)
+        after = _run(self.flow, z[: self.n], z[self.n :], self.duration, times[hits])
+        if not np.array_equal(np.asarray(after.event_times), times):
+            raise SimulationError(
+                "the exact motion met its gap edges differently when sampled at its impacts; "
+                "the monodromy with impacts cannot be formed (please report this)"
+            )
+        phi = np.eye(2 * self.n)
+        start = 0.0
+        for k, i in enumerate(hits):
+            widths, patterns = stretches(motion, start, float(times[i]), history)
+            phi = self.flows.product(widths, patterns, start=phi)
+            salt = impact_saltation(
+                self.flow, int(joints[i]), float(times[i]), after.u[k], after.v[k]
+            )
+            phi = salt @ phi
+            start = float(times[i])
+        widths, patterns = stretches(motion, start, self.duration, history)
+        return self.flows.product(widths, patterns, start=phi)
 
     def size(self, z: FloatArray) -> float:
         """abs(z) in the norm of (w u, v), m/s."""

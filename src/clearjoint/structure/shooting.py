@@ -63,7 +63,8 @@ def frequency_response(
     Parameters
     ----------
     structure : Structure or VibrationSystem
-        Lumped mass; joints without friction and with restitution 1.
+        Lumped mass; joints without friction; a restitution in (0, 1] (impacts' saltation
+        matrices enter the monodromy).
     force : (N,) array_like
         Force amplitude per DOF, N.
     omega_start, omega_stop : float
@@ -99,7 +100,7 @@ def frequency_response(
         raise ParameterError(f"max_points must be an integer >= 2, got {max_points!r}")
     if not (isinstance(max_step, int | float) and 0.0 < max_step <= 1.0):
         raise ParameterError(f"max_step must be in (0, 1], got {max_step!r}")
-    flows = PatternFlows(system)
+    flows = PatternFlows(system, impacts=bool(np.any(system.restitution() < 1.0)))
     first = periodic_orbit(system, f, w0, initial=initial)
     n = system.n_dof
     b = system.directions

@@ -13,8 +13,12 @@ motion is the ordered product of the stretches' exponentials, the stretches and 
 patterns being those the exact event-driven motion (``clearjoint.exact.march``) met.
 Over one forcing period of a periodic orbit that product is the monodromy matrix.
 
-A restitution below 1 makes R (and so S) differ from the identity at every impact; this
-module refuses it in one line rather than give a Jacobian without its jumps.
+A restitution e below 1 makes R differ from the identity at every impact (the joint's
+relative speed drops to e times itself as it enters contact, MODEL.md 5.2), and S with it:
+:func:`impact_saltation` gives S at one impact, and the shooting map
+(``clearjoint.structure.poincare``) multiplies it in between the stretches. The long tangent
+flows of a stepped sine do not carry the jumps: :class:`PatternFlows` refuses restitution
+unless its caller says it carries them (``impacts=True``).
 
 Each pattern's A is decomposed once, A = V B V^-1 with B real block-diagonal
 (``clearjoint.exact.patterns``, as harmonic balance's monodromy uses it: an
@@ -65,16 +69,20 @@ class PatternFlows:
     Parameters
     ----------
     system : VibrationSystem
-        Lumped (diagonal) M; every joint's restitution 1.
+        Lumped (diagonal) M; every joint's restitution 1, unless ``impacts``.
+    impacts : bool
+        The caller multiplies each impact's saltation matrix (:func:`impact_saltation`)
+        in between the products itself, so a restitution below 1 is allowed.
 
     Raises
     ------
     StructureError
-        A joint with a restitution below 1 (its impacts would need saltation jumps).
+        A joint with a restitution below 1 and ``impacts`` false.
     """
 
-    def __init__(self, system: VibrationSystem) -> None:
-        refuse_restitution(system)
+    def __init__(self, system: VibrationSystem, *, impacts: bool = False) -> None:
+        if not impacts:
+            refuse_restitution(system)
         self.system = system
         self.n = n = system.n_dof
         inv_m = 1.0 / system.mass_diagonal()
@@ -161,6 +169,61 @@ class PatternFlows:
         phi = np.eye(2 * self.n) if start is None else start
         keys = [np.asarray(states, dtype=np.int8).tobytes() for states in patterns]
         return chain(phi, widths, keys, lambda i: self.flow(patterns[i])[1], self._transition)
+
+
+def impact_saltation(
+    flow: Any, joint: int, t: float, u: FloatArray, v_after: FloatArray
+) -> FloatArray:
+    """The saltation matrix S (2N, 2N) of an impact of ``joint`` at time t (MODEL.md 5.1).
+
+    At contact onset the joint's relative speed s = b^T v drops to e s through an impulse
+    along b (MODEL.md 5.2): v+ = R_v v-, R_v = I - (1 - e) m_eff M^-1 b b^T, u unchanged,
+    R = diag(I, R_v). With h(z) = b^T u - edge, grad(h) = (b, 0), the saltation matrix is
+
+        S = R + (f+ - R f-) grad(h)^T / (b^T v-),
+
+    f = (v, a) the vector field on each side. The spring and joint forces are continuous at
+    the edge, so a+ - a- = -M^-1 C (v+ - v-), and f+ - R f- = (v+ - v-,
+    -M^-1 C (v+ - v-) + (1 - e) m_eff M^-1 b (b^T a-)).
+
+    Parameters
+    ----------
+    flow : clearjoint.structure.motion._Flow
+        The structure's flow at the forcing (its M, C, K, b, e, m_eff and force).
+    joint : int
+    t : float
+        The impact's time, s.
+    u, v_after : (N,) ndarray
+        The state just after the impact, m and m/s (v- is recovered: b^T v+ = e b^T v-).
+
+    Raises
+    ------
+    StructureError
+        A restitution of 0 (the speed before the impact cannot be recovered from after it).
+    """
+    e = float(flow.restitution[joint])
+    if e <= 0.0:
+        raise StructureError(
+            f"joint {joint} has a restitution of 0: the exact Jacobian of its impacts needs "
+            "e > 0; give it a small positive restitution (0.01)"
+        )
+    n = flow.n
+    b = np.asarray(flow.b[joint], dtype=np.float64)
+    push = np.asarray(flow.impulse_dirs[joint], dtype=np.float64)  # M^-1 b
+    m_eff = float(flow.m_eff[joint])
+    before = float(b @ v_after) / e  # b^T v-
+    v_before = v_after + (1.0 - e) * m_eff * push * before
+    system = flow.system
+    delta = flow.b @ u
+    f_joint, _ = system.joint_forces(delta)
+    restoring = flow.k_linear @ u + flow.b.T @ f_joint
+    a_before = (flow.force * math.sin(flow.omega * t) - flow.c @ v_before - restoring) / flow.m
+    jump_v = v_after - v_before
+    jump_a = -(flow.c @ jump_v) / flow.m + (1.0 - e) * m_eff * push * float(b @ a_before)
+    salt = np.eye(2 * n)
+    salt[n:, n:] -= (1.0 - e) * m_eff * np.outer(push, b)
+    salt[:, :n] += np.outer(np.concatenate((jump_v, jump_a)), b) / before
+    return salt
 
 
 def stretches(
