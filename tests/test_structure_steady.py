@@ -231,19 +231,37 @@ def test_a_force_of_the_wrong_length_is_one_line():
 
 
 def test_restitution_is_refused_where_the_jacobian_would_miss_its_jumps():
-    """Orbits and curves carry each impact's saltation matrix; the stepped sine's long
-    tangent flow (its Lyapunov exponent) does not, and a restitution of 0 leaves no speed
-    before the impact to form the saltation matrix from: both are one line."""
-    law = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.8)
-    s = chain([0.5], [math.inf], [law], [2.0])
-    with pytest.raises(StructureError, match="restitution"):
-        stepped_sine(s, [30.0], 2 * math.pi * np.array([40.0, 41.0]))
+    """A restitution of 0 leaves no speed before the impact to form its saltation matrix
+    from: the orbit, curve and stepped-sine solvers refuse it in one line."""
     dead = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.0)
-    shoot = ShootingMap(
-        chain([0.5], [math.inf], [dead], [2.0]).to_system(), np.array([30.0]), 2 * math.pi * 40
-    )
+    s = chain([0.5], [math.inf], [dead], [2.0])
+    with pytest.raises(StructureError, match="restitution of 0"):
+        stepped_sine(s, [30.0], 2 * math.pi * np.array([40.0, 41.0]))
+    shoot = ShootingMap(s.to_system(), np.array([30.0]), 2 * math.pi * 40)
     with pytest.raises(StructureError, match="restitution of 0"):
         shoot(np.array([0.0, 0.0]))
+
+
+def test_lyapunov_exponent_with_impacts_is_the_log_of_the_largest_multiplier():
+    """Restitution 0.7 on a 3-mass chain at 2 N and 15 Hz, a stable periodic motion with
+    impacts: the stepped sine's exponent (its tangent flow with each impact's saltation
+    matrix) against log|mu|max / T of a finite-difference monodromy of the exact map."""
+    n = 3
+    law = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.7)
+    s = chain([0.5] * n, [math.inf] * n, [law] * n, [2.0] * n)
+    f, w = _force(n, 2.0), 2 * math.pi * 15.0
+    diagram = stepped_sine(s, f, [w], settle_periods=100, record_periods=100)
+    assert diagram.kind[0, 0] == "periodic"
+    z = diagram.poincare[0, 0, -1]
+    shoot = ShootingMap(s.to_system(), f, w)
+    scale = np.concatenate((np.full(n, w), np.ones(n)))
+    fd = np.empty((2 * n, 2 * n))
+    for k in range(2 * n):
+        dz = np.zeros(2 * n)
+        dz[k] = 1e-9 / scale[k]
+        fd[:, k] = (shoot(z + dz)[0] - shoot(z - dz)[0]) / (2 * dz[k])
+    expected = math.log(np.abs(np.linalg.eigvals(fd)).max()) / shoot.period
+    assert float(diagram.lyapunov[0, 0]) == pytest.approx(expected, rel=0.02)
 
 
 def test_monodromy_with_impacts_is_the_finite_difference_jacobian_of_the_exact_map():

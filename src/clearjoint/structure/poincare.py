@@ -28,12 +28,12 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
-from clearjoint.exact.march import OPEN
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.motion import StructureMotion, _Flow, _run
 from clearjoint.structure.tangent import (
     PatternFlows,
-    impact_saltation,
+    carry,
+    impact_jumps,
     pattern_history,
     stretches,
 )
@@ -238,40 +238,11 @@ class ShootingMap:
         return end, self.flows.product(widths, patterns), motion
 
     def _with_impacts(self, z: FloatArray, motion: StructureMotion) -> FloatArray:
-        """The monodromy with each impact's saltation matrix between the stretches.
-
-        The state just after each impact is read from a second run of the same motion
-        sampled at the impacts' times (the march's steps do not depend on where it samples,
-        and a sample at an event's time is taken at the start of the step after it); that
-        run's events are checked to be the first run's, bit for bit.
-        """
+        """The monodromy with each impact's saltation matrix between the stretches."""
         history = pattern_history(motion)
-        joints = np.asarray(motion.event_joints, dtype=np.int64)
-        times = np.asarray(motion.event_times, dtype=np.float64)
-        order = np.arange(joints.size)
-        entering = (history[order, joints] == OPEN) & (history[order + 1, joints] != OPEN)
-        hits = np.flatnonzero(entering & (self.flow.restitution[joints] < 1.0))
-        if hits.size == 0:
-            widths, patterns = stretches(motion, 0.0, self.duration, history)
-            return self.flows.product(widths, patterns)
-        after = _run(self.flow, z[: self.n], z[self.n :], self.duration, times[hits])
-        if not np.array_equal(np.asarray(after.event_times), times):
-            raise SimulationError(
-                "the exact motion met its gap edges differently when sampled at its impacts; "
-                "the monodromy with impacts cannot be formed (please report this)"
-            )
-        phi = np.eye(2 * self.n)
-        start = 0.0
-        for k, i in enumerate(hits):
-            widths, patterns = stretches(motion, start, float(times[i]), history)
-            phi = self.flows.product(widths, patterns, start=phi)
-            salt = impact_saltation(
-                self.flow, int(joints[i]), float(times[i]), after.u[k], after.v[k]
-            )
-            phi = salt @ phi
-            start = float(times[i])
-        widths, patterns = stretches(motion, start, self.duration, history)
-        return self.flows.product(widths, patterns, start=phi)
+        u0, v0 = z[: self.n], z[self.n :]
+        jumps = impact_jumps(self.flow, motion, history, u0, v0, self.duration)
+        return carry(self.flows, motion, history, 0.0, self.duration, jumps=jumps)
 
     def size(self, z: FloatArray) -> float:
         """abs(z) in the norm of (w u, v), m/s."""

@@ -59,7 +59,13 @@ from clearjoint.progress import report
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.motion import _Flow, _run, _system, _vector
 from clearjoint.structure.poincare import OrbitError, ShootingMap, newton_orbit, turning_extremes
-from clearjoint.structure.tangent import PatternFlows, largest_exponent, refuse_restitution
+from clearjoint.structure.tangent import (
+    PatternFlows,
+    impact_jumps,
+    largest_exponent,
+    pattern_history,
+    refuse_restitution,
+)
 from clearjoint.system import VibrationSystem
 
 FloatArray = NDArray[np.float64]
@@ -155,7 +161,8 @@ def _run_chunk(chunk: _Chunk) -> list[_Point]:
     """Step through one run of frequencies from rest; a pure function of ``chunk``."""
     system = chunk.system
     n = system.n_dof
-    flows = PatternFlows(system)
+    impacts = bool(np.any(system.restitution() < 1.0))
+    flows = PatternFlows(system, impacts=impacts)
     u = np.zeros(n)
     v = np.zeros(n)
     out: list[_Point] = []
@@ -172,6 +179,13 @@ def _run_chunk(chunk: _Chunk) -> list[_Point]:
         times = np.arange(count, dtype=np.float64) * (period / SAMPLES_PER_PERIOD)
         recorded = _run(flow, u, v, chunk.record_periods * period, times)
         x_max, x_min = turning_extremes(recorded, system, chunk.force, eye)
+        jumps = (
+            impact_jumps(
+                flow, recorded, pattern_history(recorded), u, v, chunk.record_periods * period
+            )
+            if impacts
+            else None
+        )
         rate, error, tangent = largest_exponent(
             flows,
             recorded,
@@ -179,6 +193,7 @@ def _run_chunk(chunk: _Chunk) -> list[_Point]:
             chunk.record_periods,
             start=tangent,
             aligning=chunk.record_periods // ALIGNING,
+            jumps=jumps,
         )
         poincare = np.concatenate(
             (recorded.u[::SAMPLES_PER_PERIOD], recorded.v[::SAMPLES_PER_PERIOD]), axis=1
@@ -489,7 +504,8 @@ def stepped_sine(
     Parameters
     ----------
     structure : Structure or VibrationSystem
-        Lumped mass; joints without friction and with restitution 1.
+        Lumped mass; joints without friction; a restitution in (0, 1] (each impact's
+        saltation matrix enters the tangent flow).
     force : (N,) array_like
         Force amplitude per DOF, N.
     omegas : (n,) array_like
@@ -512,7 +528,7 @@ def stepped_sine(
     SteppedSineError
         Frequencies not positive or not increasing, periods below 1, a bad direction.
     StructureError
-        A force vector of the wrong length, friction or restitution below 1.
+        A force vector of the wrong length, friction, a restitution of 0.
     """
     system = _system(structure)
     f = _vector("force", force, system)
@@ -521,7 +537,7 @@ def stepped_sine(
         raise SteppedSineError(f"direction must be 'up', 'down' or 'both', got {direction!r}")
     settle = _whole("settle_periods", settle_periods, 1)
     record = _whole("record_periods", record_periods, 1)
-    refuse_restitution(system)  # before any work
+    refuse_restitution(system, below=0.0)  # before any work: e = 0 has no saltation
     names: tuple[str, ...] = ("up", "down") if direction == "both" else (direction,)
     n_runs = 1 if runner is None else _whole("chunks", 8 if chunks is None else chunks, 1)
     n_runs = min(n_runs, w.size)

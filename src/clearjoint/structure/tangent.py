@@ -15,10 +15,10 @@ Over one forcing period of a periodic orbit that product is the monodromy matrix
 
 A restitution e below 1 makes R differ from the identity at every impact (the joint's
 relative speed drops to e times itself as it enters contact, MODEL.md 5.2), and S with it:
-:func:`impact_saltation` gives S at one impact, and the shooting map
-(``clearjoint.structure.poincare``) multiplies it in between the stretches. The long tangent
-flows of a stepped sine do not carry the jumps: :class:`PatternFlows` refuses restitution
-unless its caller says it carries them (``impacts=True``).
+:func:`impact_saltation` gives S at one impact, :func:`impact_jumps` all of a motion's, and
+:func:`carry` multiplies them in between the stretches (the shooting map's monodromy, the
+stepped sine's Lyapunov exponent). :class:`PatternFlows` alone refuses restitution unless
+its caller says it carries the jumps (``impacts=True``).
 
 Each pattern's A is decomposed once, A = V B V^-1 with B real block-diagonal
 (``clearjoint.exact.patterns``, as harmonic balance's monodromy uses it: an
@@ -35,11 +35,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from clearjoint.errors import SimulationError
 from clearjoint.exact import march
 from clearjoint.exact.patterns import PatternFlow as _Flow
 from clearjoint.exact.patterns import chain
 from clearjoint.exact.patterns import decompose as _decompose
 from clearjoint.structure.model import StructureError
+from clearjoint.structure.motion import _run
 from clearjoint.system import VibrationSystem
 
 FloatArray = NDArray[np.float64]
@@ -49,11 +51,18 @@ FloatArray = NDArray[np.float64]
 STORE_BYTES = 256 * 2**20
 
 
-def refuse_restitution(system: VibrationSystem) -> None:
-    """Refuse, in one line, a joint whose restitution is below 1 (its impacts would need
-    saltation jumps that the tangent flow does not carry)."""
+def refuse_restitution(system: VibrationSystem, *, below: float = 1.0) -> None:
+    """Refuse, in one line, a joint whose restitution is below ``below`` (1: its impacts
+    would need saltation jumps that a plain product of exponentials does not carry; 0 is
+    always refused where impacts are carried, :func:`impact_saltation`)."""
     e = system.restitution()
-    if np.any(e < 1.0):
+    if below <= 0.0 and np.any(e <= 0.0):
+        joint = int(np.flatnonzero(e <= 0.0)[0])
+        raise StructureError(
+            f"joint {joint} has a restitution of 0: the exact Jacobian of its impacts needs "
+            "e > 0; give it a small positive restitution (0.01)"
+        )
+    if np.any(e < below):
         joint = int(np.flatnonzero(e < 1.0)[0])
         raise StructureError(
             f"joint {joint} has a restitution of {float(e[joint]):g}: the exact tangent "
@@ -226,6 +235,80 @@ def impact_saltation(
     return salt
 
 
+def impact_jumps(
+    flow: Any,
+    motion: Any,
+    history: NDArray[np.int8],
+    u0: FloatArray,
+    v0: FloatArray,
+    duration: float,
+) -> dict[int, FloatArray]:
+    """Each impact's saltation matrix along ``motion``, by the index of its event.
+
+    An impact is an event that takes a joint with restitution below 1 from open into
+    contact. The state just after each is read from a second run of the same motion
+    (``flow`` from (u0, v0) over its ``duration``, s) sampled at the impacts' times: the
+    march's steps do not depend on where it samples, and a sample at an event's time is
+    taken at the start of the step after the event. That run's events are checked to be
+    the first run's, bit for bit.
+
+    Raises
+    ------
+    SimulationError
+        The second run met its gap edges otherwise (it should not).
+    StructureError
+        A restitution of 0 (:func:`impact_saltation`).
+    """
+    joints = np.asarray(motion.event_joints, dtype=np.int64)
+    times = np.asarray(motion.event_times, dtype=np.float64)
+    order = np.arange(joints.size)
+    entering = (history[order, joints] == march.OPEN) & (history[order + 1, joints] != march.OPEN)
+    hits = np.flatnonzero(entering & (flow.restitution[joints] < 1.0))
+    if hits.size == 0:
+        return {}
+    after = _run(flow, u0, v0, duration, times[hits])
+    if not np.array_equal(np.asarray(after.event_times), times):
+        raise SimulationError(
+            "the exact motion met its gap edges differently when sampled at its impacts; "
+            "its Jacobian with impacts cannot be formed (please report this)"
+        )
+    return {
+        int(i): impact_saltation(flow, int(joints[i]), float(times[i]), after.u[k], after.v[k])
+        for k, i in enumerate(hits)
+    }
+
+
+def carry(
+    flows: PatternFlows,
+    motion: Any,
+    history: NDArray[np.int8],
+    start: float,
+    stop: float,
+    vectors: FloatArray | None = None,
+    jumps: dict[int, FloatArray] | None = None,
+) -> FloatArray:
+    """The exact tangent flow of ``motion`` over [start, stop] applied to ``vectors``.
+
+    The product of the stretches' exponentials (identity ``vectors`` by default), with
+    each impact's saltation matrix in ``jumps`` (:func:`impact_jumps`) multiplied in at
+    its event.
+    """
+    phi = np.eye(2 * flows.n) if vectors is None else vectors
+    times = np.asarray(motion.event_times, dtype=np.float64)
+    inside = [] if not jumps else [
+        i for i in range(
+            int(np.searchsorted(times, start, side="right")),
+            int(np.searchsorted(times, stop, side="left")),
+        ) if i in jumps
+    ]  # fmt: skip
+    for i in inside:
+        widths, patterns = stretches(motion, start, float(times[i]), history)
+        phi = jumps[i] @ flows.product(widths, patterns, start=phi)  # type: ignore[index]
+        start = float(times[i])
+    widths, patterns = stretches(motion, start, stop, history)
+    return flows.product(widths, patterns, start=phi)
+
+
 def stretches(
     motion: Any, start: float, stop: float, history: NDArray[np.int8] | None = None
 ) -> tuple[FloatArray, NDArray[np.int8]]:
@@ -277,6 +360,7 @@ def largest_exponent(
     *,
     start: FloatArray | None = None,
     aligning: int = 0,
+    jumps: dict[int, FloatArray] | None = None,
 ) -> tuple[float, float, FloatArray]:
     """The largest Lyapunov exponent of the motion from its exact tangent flow, and its error.
 
@@ -288,7 +372,8 @@ def largest_exponent(
     the others give lambda = mean(g_k) / T (they telescope, so the norm biases lambda by
     at most the log of the norms' ratio over the whole record). The uncertainty is the
     standard error of the mean of g over blocks of periods (ten blocks, so neighbouring
-    periods' correlation is averaged out), divided by T.
+    periods' correlation is averaged out), divided by T. With impacts, ``jumps``
+    (:func:`impact_jumps` of the motion) multiplies each one's saltation matrix in.
 
     Returns
     -------
@@ -306,7 +391,10 @@ def largest_exponent(
     for k in range(periods):
         t0 = k * period
         widths, patterns = stretches(motion, t0, t0 + period, history)
-        w = flows.product(widths, patterns, w)
+        if jumps:
+            w = carry(flows, motion, history, t0, t0 + period, w, jumps)
+        else:
+            w = flows.product(widths, patterns, w)
         size = flows.energy_norm(patterns[-1], w)
         if not size > 0.0 or not math.isfinite(size):
             raise StructureError("the tangent vector vanished or overflowed over one period")
