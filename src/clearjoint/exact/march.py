@@ -187,7 +187,7 @@ def first_root(
     low = a0 + min(a1, 0.0) * limit + min(a2, 0.0) * limit * limit - r * limit**3
     if low > 0.0:
         return 2.0
-    if certified_step(a0, a1, 2.0 * a2, 6.0 * r, limit) >= limit:
+    if certified_step(a0, a1, 2.0 * a2, 6.0 * r, limit, 0.0, 0.0) >= limit:
         return 2.0
     # Bernstein coefficients on [0, 1]: beta_k = sum_(i<=k) C(k,i)/C(d,i) a_i
     for k in range(d + 1):
