@@ -226,6 +226,7 @@ def _simulate_parser(sub: Any) -> None:
         force="overwrite --out or --plot if it exists",
     )
     _add_plot_option(p, force=False)
+    _flags(p, allow_long=_ALLOW_LONG)
 
 
 def _rig_parser(sub: Any) -> None:
@@ -434,6 +435,7 @@ def _structure_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="netCDF results file (.nc)")
     _add_plot_option(p, force=False)
     _flags(p, json="print a JSON summary", force="overwrite existing output", quiet=_QUIET)
+    _flags(p, allow_long=_ALLOW_LONG)
     g = p.add_argument_group("stepped-sine")
     g.add_argument("--from", dest="start", help="first frequency, e.g. 2Hz")
     g.add_argument("--to", dest="stop", help="last frequency, e.g. 60Hz")

@@ -438,7 +438,9 @@ def _next_event(
             d2 = -f0 * w * w * math.sin(theta)
             remaining = tau_end - tau
             h_up = certified_step(ff - net, -d1, -d2, bound, remaining, 0.0, 0.0)
-            h_dn = certified_step(ff + net, d1, d2, bound, h_up, 0.0, 0.0)  # only: does it come first?
+            h_dn = certified_step(
+                ff + net, d1, d2, bound, h_up, 0.0, 0.0
+            )  # only: does it come first?
             h = min(h_up, h_dn)
             if h >= remaining:
                 return tau_end, EV_PERIOD_END

@@ -621,7 +621,17 @@ def arclength_step(
         for i in range(3):
             predicted[i] = points[0, i] + h * tangent[i] + 0.5 * h * h * curvature[i]
     its = correct_orbit(
-        p, parameter, predicted, tangent, scale, bool(False), tolerance, max_iterations, y, system, out
+        p,
+        parameter,
+        predicted,
+        tangent,
+        scale,
+        bool(False),
+        tolerance,
+        max_iterations,
+        y,
+        system,
+        out,
     )
     if its < 0:
         return its
