@@ -439,8 +439,9 @@ def map_residual(
     state = np.zeros(4)
     start_state(q, x, v, state)
     o1 = np.zeros(N_OUT)
-    # int(...), bool(...): a literal argument would compile a second copy of the callee
-    status = shoot_map(q, state, int(1), o1, int(parameter if derivative else NO_PARAMETER))
+    # int(1), not 1: numba compiles a callee afresh for a literal argument (Literal[int])
+    once = int(1)  # noqa: UP018, RUF046
+    status = shoot_map(q, state, once, o1, int(parameter if derivative else NO_PARAMETER))
     out[R_EVALS] += 1.0
     if status != kn.STATUS_OK:
         return status
@@ -454,7 +455,7 @@ def map_residual(
             shifted = np.zeros(4)
             start_state(q, x, v, shifted)
             o2 = np.zeros(N_OUT)
-            status = shoot_map(q, shifted, int(1), o2, int(NO_PARAMETER))
+            status = shoot_map(q, shifted, once, o2, int(NO_PARAMETER))
             out[R_EVALS] += 1.0
             if status != kn.STATUS_OK:
                 return status
@@ -626,7 +627,7 @@ def arclength_step(
         predicted,
         tangent,
         scale,
-        bool(False),
+        bool(False),  # noqa: UP018 (not a literal: one compiled copy of the callee)
         tolerance,
         max_iterations,
         y,
