@@ -407,8 +407,9 @@ def _run_frf(args: argparse.Namespace) -> int:
     from clearjoint.studies.text import curve_lines, curve_warnings
     from clearjoint.units import parse_quantity
 
+    _rename_value(args, "--parameter", "force", "forcing")
     # a force curve takes its forces from --from/--to, not from the study
-    force_curve = args.parameter == "force"
+    force_curve = args.parameter == "forcing"
     study = load_any_study(
         args.study, optional=("excitation.force_amplitude",) if force_curve else ()
     )
@@ -438,7 +439,7 @@ def _run_frf(args: argparse.Namespace) -> int:
             raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")
     frequency = None
     if args.frequency and not force_curve:
-        raise ParameterError("--frequency goes with --parameter force; drop it or add that")
+        raise ParameterError("--frequency goes with --parameter forcing; drop it or add that")
     if args.frequency:
         frequency = parse_quantity(args.frequency, "frequency", name="--frequency")
         if not (math.isfinite(frequency) and frequency > 0.0):
@@ -449,7 +450,7 @@ def _run_frf(args: argparse.Namespace) -> int:
             study,
             start,
             stop,
-            parameter=args.parameter,
+            parameter="force" if force_curve else "frequency",  # the Python API's name
             frequency=frequency,
             method=args.method,
             harmonics=args.harmonics,
@@ -467,6 +468,29 @@ def _run_frf(args: argparse.Namespace) -> int:
     wrote = f"wrote {args.out}" + (f" and {args.plot}" if args.plot else "")
     print("\n".join([*curve_lines(curve, study.source), wrote]))
     return 0
+
+
+#: Deprecation lines when main() is called from Python rather than run as the command: off,
+#: so that a caller's stderr holds what the old spelling did (the command says it).
+DEPRECATION_LINES_IN_PROCESS = False
+
+
+def _rename_value(args: argparse.Namespace, option: str, old: str, new: str) -> None:
+    """Take ``option old``, a value's old spelling, as ``option new``, saying so in one line.
+
+    One meaning per option name (issue 28): ``--force`` overwrites, so ``--parameter force``
+    became ``--parameter forcing``; the old spelling keeps working.
+    """
+    name = option.removeprefix("--").replace("-", "_")
+    if getattr(args, name) != old:
+        return
+    setattr(args, name, new)
+    if getattr(args, "as_command", False) or DEPRECATION_LINES_IN_PROCESS:
+        print(
+            f"clearjoint {args.command}: warning: {option} {old} is now {option} {new} "
+            f"(--force means overwrite); write {option} {new}",
+            file=sys.stderr,
+        )
 
 
 def _warn_rpm(command: str, option: str, text: str, hz: float) -> None:
@@ -631,6 +655,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     args.progress_lines = argv is None or cli_progress.PROGRESS_LINES_IN_PROCESS
+    args.as_command = argv is None
     started = time.time()
     runners = {
         "stiffness": _run_stiffness,

@@ -288,7 +288,7 @@ def _frf_parser(sub: Any) -> None:
         description=(
             "Follow the exact period-1 orbit of the joint in STUDY.toml (joint, force, losses; "
             "its frequency is not used) by continuation from --from to --to, through folds; "
-            "report folds, period doublings and grazings. With --parameter force, --from and "
+            "report folds, period doublings and grazings. With --parameter forcing, --from and "
             "--to are forces and --frequency (default: the study's) is held fixed. A structure "
             "study (clearjoint structure's file: [structure], [joint], [excitation]) is followed "
             "by exact shooting too (its frequency only), or by harmonic balance (--method "
@@ -303,12 +303,14 @@ def _frf_parser(sub: Any) -> None:
     _flags(p, json="print the curve as one JSON object")
     p.add_argument(
         "--parameter",
-        choices=["frequency", "force"],
+        choices=["frequency", "forcing", "force"],
+        metavar="{frequency,forcing}",
         default="frequency",
-        help="what varies along the curve (default frequency)",
+        help="what varies along the curve: frequency, or forcing (the force amplitude; "
+        "'force', its old name, still works) (default frequency)",
     )
     _options(
-        p, frequency="fixed frequency with --parameter force, e.g. 400Hz (default: the study's)"
+        p, frequency="fixed frequency with --parameter forcing, e.g. 400Hz (default: the study's)"
     )
     p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
     _flags(p, allow_long=_ALLOW_LONG)
