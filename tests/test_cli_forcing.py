@@ -75,5 +75,6 @@ def test_help_and_errors_name_forcing(tmp_path: Path, capsys: pytest.CaptureFixt
     args = ["frf", str(EXAMPLE), "--from", "20Hz", "--to", "90Hz", "--frequency", "5Hz"]
     assert cli.main([*args, "--out", str(tmp_path / "x.nc")]) == 2
     assert capsys.readouterr().err == (
-        "clearjoint frf: error: --frequency goes with --parameter forcing; drop it or add that\n"
+        "clearjoint frf: error: --frequency goes with --parameter forcing (formerly "
+        "--parameter force); drop it or add that\n"
     )

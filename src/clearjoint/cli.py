@@ -439,7 +439,10 @@ def _run_frf(args: argparse.Namespace) -> int:
             raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")
     frequency = None
     if args.frequency and not force_curve:
-        raise ParameterError("--frequency goes with --parameter forcing; drop it or add that")
+        raise ParameterError(
+            "--frequency goes with --parameter forcing (formerly --parameter force); "
+            "drop it or add that"
+        )
     if args.frequency:
         frequency = parse_quantity(args.frequency, "frequency", name="--frequency")
         if not (math.isfinite(frequency) and frequency > 0.0):
