@@ -125,7 +125,8 @@ def _run_simulate(args: argparse.Namespace) -> int:
         out = netcdf_target(args.out, "simulate", force=args.force, example="result.nc")
         out.parent.mkdir(parents=True, exist_ok=True)
     plot = _plot_target(args)
-    motion = run_study(study)
+    with cli_progress.shown_progress(args, f"simulating {study.source}"):  # says a compile
+        motion = run_study(study)
     _save_plot(motion, plot, quiet=args.json)
     result = summary(study, motion)
     if args.out:

@@ -226,7 +226,7 @@ def _simulate_parser(sub: Any) -> None:
         force="overwrite --out or --plot if it exists",
     )
     _add_plot_option(p, force=False)
-    _flags(p, allow_long=_ALLOW_LONG)
+    _flags(p, allow_long=_ALLOW_LONG, quiet=_QUIET)
 
 
 def _rig_parser(sub: Any) -> None:
