@@ -17,6 +17,8 @@ seconds it took and the line that called it.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import statistics
 import subprocess
@@ -73,7 +75,8 @@ def where(command: list[str]) -> None:
     old = sys.argv
     sys.argv = ["clearjoint", *command, "--quiet"]
     try:
-        runpy.run_module("clearjoint", run_name="__main__")
+        with contextlib.redirect_stdout(io.StringIO()):  # the command's own output
+            runpy.run_module("clearjoint", run_name="__main__")
     except SystemExit:
         pass
     finally:
