@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from clearjoint import cli
+from clearjoint import cli, cli_parser
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "frf.toml"
@@ -39,7 +39,7 @@ def test_forcing_follows_the_force_amplitude(
 def test_the_old_spelling_runs_the_same_curve_with_one_deprecation_line(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    monkeypatch.setattr(cli, "DEPRECATION_LINES_IN_PROCESS", True)  # as the command says it
+    monkeypatch.setattr(cli_parser, "DEPRECATION_LINES_IN_PROCESS", True)  # as the command says it
     runs = {}
     for value in ("forcing", "force"):
         out = tmp_path / f"{value}.nc"

@@ -35,6 +35,7 @@ from clearjoint.cli_parser import (
     OPTION_NAMES,
     amplitude_values,
     build_parser,
+    rename_value,
     study_values,
 )
 from clearjoint.errors import ClearjointError, ParameterError
@@ -408,7 +409,7 @@ def _run_frf(args: argparse.Namespace) -> int:
     from clearjoint.studies.text import curve_lines, curve_warnings
     from clearjoint.units import parse_quantity
 
-    _rename_value(args, "--parameter", "force", "forcing")
+    rename_value(args, "--parameter", "force", "forcing")
     # a force curve takes its forces from --from/--to, not from the study
     force_curve = args.parameter == "forcing"
     study = load_any_study(
@@ -472,29 +473,6 @@ def _run_frf(args: argparse.Namespace) -> int:
     wrote = f"wrote {args.out}" + (f" and {args.plot}" if args.plot else "")
     print("\n".join([*curve_lines(curve, study.source), wrote]))
     return 0
-
-
-#: Deprecation lines when main() is called from Python rather than run as the command: off,
-#: so that a caller's stderr holds what the old spelling did (the command says it).
-DEPRECATION_LINES_IN_PROCESS = False
-
-
-def _rename_value(args: argparse.Namespace, option: str, old: str, new: str) -> None:
-    """Take ``option old``, a value's old spelling, as ``option new``, saying so in one line.
-
-    One meaning per option name (issue 28): ``--force`` overwrites, so ``--parameter force``
-    became ``--parameter forcing``; the old spelling keeps working.
-    """
-    name = option.removeprefix("--").replace("-", "_")
-    if getattr(args, name) != old:
-        return
-    setattr(args, name, new)
-    if getattr(args, "as_command", False) or DEPRECATION_LINES_IN_PROCESS:
-        print(
-            f"clearjoint {args.command}: warning: {option} {old} is now {option} {new} "
-            f"(--force means overwrite); write {option} {new}",
-            file=sys.stderr,
-        )
 
 
 def _warn_rpm(command: str, option: str, text: str, hz: float) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 from typing import Any, NoReturn
 
 import numpy as np
@@ -21,6 +22,7 @@ __all__ = [
     "STUDY_OPTIONS",
     "amplitude_values",
     "build_parser",
+    "rename_value",
     "study_values",
 ]
 
@@ -535,3 +537,26 @@ def amplitude_values(args: argparse.Namespace) -> Any:
         return parse_amplitude_range(args.amplitude, args.points)
     values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
     return np.array(values)
+
+
+#: Deprecation lines when main() is called from Python rather than run as the command: off,
+#: so that a caller's stderr holds what the old spelling did (the command says it).
+DEPRECATION_LINES_IN_PROCESS = False
+
+
+def rename_value(args: argparse.Namespace, option: str, old: str, new: str) -> None:
+    """Take ``option old``, a value's old spelling, as ``option new``, saying so in one line.
+
+    One meaning per option name (issue 28): ``--force`` overwrites, so ``--parameter force``
+    became ``--parameter forcing``; the old spelling keeps working.
+    """
+    name = option.removeprefix("--").replace("-", "_")
+    if getattr(args, name) != old:
+        return
+    setattr(args, name, new)
+    if getattr(args, "as_command", False) or DEPRECATION_LINES_IN_PROCESS:
+        print(
+            f"clearjoint {args.command}: warning: {option} {old} is now {option} {new} "
+            f"(--force means overwrite); write {option} {new}",
+            file=sys.stderr,
+        )
