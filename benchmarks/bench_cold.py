@@ -7,11 +7,18 @@ one run: cold, with NUMBA_CACHE_DIR a fresh empty folder (numba compiles every k
 stores it there), then warm, with the same folder (every kernel loads). Wall times, and
 their ratio cold / warm, are printed per round and as medians. Other sessions may load the
 machine: compare the ratio, measured in one run, not the seconds.
+
+``--where`` then runs the command once more in this process, cold (a fresh cache folder),
+and prints where the compile time goes: each kernel compiled from Python (with what it
+compiles inside it: its callees, linked and optimised again into its own code), the
+seconds it took and the line that called it.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import statistics
 import subprocess
@@ -19,6 +26,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT = ["frf", "examples/frf.toml", "--from", "10Hz", "--to", "360Hz"]
@@ -37,9 +45,55 @@ def _timed(command: list[str], cache: Path, out: Path) -> float:
     return time.perf_counter() - start
 
 
+def where(command: list[str]) -> None:
+    """Run ``command`` cold in this process; print each compile started from Python."""
+    import runpy
+    import traceback
+
+    from numba.core import event
+
+    stack: list[tuple[str, float, str]] = []
+    tops: list[tuple[float, str, str]] = []
+
+    class Timer(event.Listener):  # type: ignore[misc]
+        def on_start(self, ev: Any) -> None:
+            caller = ""
+            if not stack:  # the Python line that asked for the kernel
+                for frame in reversed(traceback.extract_stack()):
+                    if "clearjoint" in frame.filename and "numba" not in frame.filename:
+                        caller = f"{frame.filename.split('src/')[-1]}:{frame.lineno}"
+                        break
+            stack.append((ev.data["dispatcher"].py_func.__qualname__, time.perf_counter(), caller))
+
+        def on_end(self, ev: Any) -> None:
+            name, start, caller = stack.pop()
+            if not stack:
+                tops.append((time.perf_counter() - start, name, caller))
+
+    event.register("numba:compile", Timer())
+    start = time.perf_counter()
+    old = sys.argv
+    sys.argv = ["clearjoint", *command, "--quiet"]
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):  # the command's own output
+            runpy.run_module("clearjoint", run_name="__main__")
+    except SystemExit:
+        pass
+    finally:
+        sys.argv = old
+    total = time.perf_counter() - start
+    compiled = sum(t for t, _, _ in tops)
+    print(f"cold run in this process: {total:.1f} s, of which compiling {compiled:.1f} s:")
+    for seconds, name, caller in sorted(tops, reverse=True):
+        print(f"  {seconds:5.1f} s  {name}  (called at {caller})")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=1, help="cold + warm pairs (default 1)")
+    parser.add_argument(
+        "--where", action="store_true", help="then show where a cold run's compile time goes"
+    )
     parser.add_argument("command", nargs="*", help="clearjoint arguments (default: the frf)")
     args = parser.parse_args()
     command = args.command or DEFAULT
@@ -62,6 +116,11 @@ def main() -> None:
         f"warm {statistics.median(warms):.1f} s, cold / warm {statistics.median(ratios):.1f} "
         "(target: at most 3)"
     )
+    if args.where:
+        with tempfile.TemporaryDirectory(prefix="bench-cold-where-") as folder:
+            os.environ["NUMBA_CACHE_DIR"] = folder  # before numba is imported here
+            out = Path(folder) / "out.nc"
+            where([*command, "--out", str(out), "--force"])
 
 
 if __name__ == "__main__":

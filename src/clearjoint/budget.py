@@ -11,7 +11,15 @@ from __future__ import annotations
 
 from clearjoint.errors import ParameterError
 
-__all__ = ["LIMIT_S", "SECONDS_PER", "check_budget", "estimate_s", "for_people"]
+__all__ = [
+    "LIMIT_S",
+    "SECONDS_PER",
+    "STRUCTURE_PERIOD_S_PER_DOF2",
+    "check_budget",
+    "estimate_s",
+    "for_people",
+    "structure_period_s",
+]
 
 #: Estimated seconds above which a request is refused unless allowed: one hour.
 LIMIT_S = 3600.0
@@ -26,7 +34,19 @@ SECONDS_PER = {
     "joint curve point": 0.01,
     # a structure's curve by harmonic balance: several times a joint's point
     "structure curve point": 0.1,
+    # clearjoint simulate examples/study.toml as a transient of 2000 periods: 0.63 s
+    "joint forcing period": 1e-4,
 }
+
+#: Seconds one period of a structure's exact motion costs, per DOF squared (the march's
+#: matrices): examples/chain.toml (5 DOF) 0.003 s a period, examples/mast.toml (40 DOF)
+#: 0.28 s a period (clearjoint.structure.time_response, machine loaded), rounded down.
+STRUCTURE_PERIOD_S_PER_DOF2 = 1e-4
+
+
+def structure_period_s(n_dof: int) -> float:
+    """Estimated seconds of one period of the exact motion of an ``n_dof``-DOF structure."""
+    return STRUCTURE_PERIOD_S_PER_DOF2 * float(n_dof) ** 2
 
 
 def estimate_s(count: float, kind: str) -> float:
@@ -45,8 +65,20 @@ def for_people(seconds: float) -> str:
     return f"{seconds / 86400.0:.0f} days"
 
 
-def check_budget(count: int, kind: str, *, option: str, allow: str = "--allow-long") -> None:
+def check_budget(
+    count: float,
+    kind: str,
+    *,
+    option: str,
+    allow: str = "--allow-long",
+    each: float | None = None,
+    given: str | None = None,
+) -> None:
     """Refuse ``count`` units of ``kind`` (given by ``option``) if they would take too long.
+
+    ``each`` is the seconds a unit costs when it is not :data:`SECONDS_PER` [``kind``] (a
+    structure's period, :func:`structure_period_s`); ``given`` says how the request was
+    written when not as ``option count`` (a product of several options, a study value).
 
     Raises
     ------
@@ -54,11 +86,12 @@ def check_budget(count: int, kind: str, *, option: str, allow: str = "--allow-lo
         The estimate exceeds :data:`LIMIT_S`; the message gives the estimate, the limit,
         and ``allow``, the option that runs it anyway.
     """
-    seconds = estimate_s(count, kind)
+    each = SECONDS_PER[kind] if each is None else each
+    seconds = float(count) * each
     if seconds > LIMIT_S:
-        each = SECONDS_PER[kind]
+        asked = f"{option} {count}" if given is None else given
         raise ParameterError(
-            f"{option} {count}: about {for_people(seconds)} of computing "
+            f"{asked}: about {for_people(seconds)} of computing "
             f"({each:g} s per {kind}), above the limit of {for_people(LIMIT_S)}; "
             f"ask for fewer, or pass {allow} to run it anyway"
         )

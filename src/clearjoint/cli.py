@@ -35,6 +35,7 @@ from clearjoint.cli_parser import (
     OPTION_NAMES,
     amplitude_values,
     build_parser,
+    rename_value,
     study_values,
 )
 from clearjoint.errors import ClearjointError, ParameterError
@@ -119,11 +120,14 @@ def _run_simulate(args: argparse.Namespace) -> int:
     from clearjoint.studies.text import simulation_lines
 
     study = load_study(args.study)
+    if study.mode == "transient" and not args.allow_long:  # a runaway duration, refused
+        _check_transient(study)
     if args.out:  # before the run, not after
         out = netcdf_target(args.out, "simulate", force=args.force, example="result.nc")
         out.parent.mkdir(parents=True, exist_ok=True)
     plot = _plot_target(args)
-    motion = run_study(study)
+    with cli_progress.shown_progress(args, f"simulating {study.source}"):  # says a compile
+        motion = run_study(study)
     _save_plot(motion, plot, quiet=args.json)
     result = summary(study, motion)
     if args.out:
@@ -134,6 +138,19 @@ def _run_simulate(args: argparse.Namespace) -> int:
     lines = simulation_lines(study.source, study.mode, result)
     print("\n".join(lines + ([f"wrote {args.out}"] if args.out else [])))
     return 0
+
+
+def _check_transient(study: Any) -> None:
+    """Refuse a transient whose [excitation] duration would take above the budget's limit."""
+    from clearjoint.budget import check_budget
+
+    periods = study.duration * study.omega / (2.0 * math.pi)
+    check_budget(
+        periods,
+        "joint forcing period",
+        option="[excitation] duration",
+        given=f"[excitation] duration {study.duration:g} s ({periods:.3g} forcing periods)",
+    )
 
 
 def _run_rig(args: argparse.Namespace) -> int:
@@ -392,8 +409,9 @@ def _run_frf(args: argparse.Namespace) -> int:
     from clearjoint.studies.text import curve_lines, curve_warnings
     from clearjoint.units import parse_quantity
 
+    rename_value(args, "--parameter", "force", "forcing")
     # a force curve takes its forces from --from/--to, not from the study
-    force_curve = args.parameter == "force"
+    force_curve = args.parameter == "forcing"
     study = load_any_study(
         args.study, optional=("excitation.force_amplitude",) if force_curve else ()
     )
@@ -423,7 +441,10 @@ def _run_frf(args: argparse.Namespace) -> int:
             raise ParameterError(f"{option} goes with --method harmonic; drop it or add that")
     frequency = None
     if args.frequency and not force_curve:
-        raise ParameterError("--frequency goes with --parameter force; drop it or add that")
+        raise ParameterError(
+            "--frequency goes with --parameter forcing (formerly --parameter force); "
+            "drop it or add that"
+        )
     if args.frequency:
         frequency = parse_quantity(args.frequency, "frequency", name="--frequency")
         if not (math.isfinite(frequency) and frequency > 0.0):
@@ -434,7 +455,7 @@ def _run_frf(args: argparse.Namespace) -> int:
             study,
             start,
             stop,
-            parameter=args.parameter,
+            parameter="force" if force_curve else "frequency",  # the Python API's name
             frequency=frequency,
             method=args.method,
             harmonics=args.harmonics,
@@ -523,6 +544,34 @@ def _amplitude_range(args: argparse.Namespace) -> Any:
     return parse_amplitude_range(args.amplitude, args.points)
 
 
+def _check_structure_budget(args: argparse.Namespace, study: Any) -> None:
+    """Refuse a structure task whose periods of exact motion would take above the limit."""
+    from clearjoint.budget import check_budget, structure_period_s
+    from clearjoint.studies import marched_periods
+
+    periods = marched_periods(
+        study,
+        args.task,
+        points=args.points * (2 if args.direction == "both" else 1),  # up, then down
+        settle_periods=args.settle_periods,
+        record_periods=args.record_periods,
+    )
+    n_dof = study.structure.n_dof
+    given = {
+        "respond": f"[excitation] periods {periods:.0f}",
+        "decay": f"[decay] duration {study.decay_duration or 0.0:g} s "
+        f"({periods:.3g} periods of closed mode 1)",
+        "stepped-sine": f"--points {args.points} x (--settle-periods {args.settle_periods} "
+        f"+ --record-periods {args.record_periods}) periods"
+        + (" x 2 directions" if args.direction == "both" else ""),
+    }.get(args.task)
+    if given is not None:
+        each = structure_period_s(n_dof)
+        check_budget(
+            periods, f"period of this {n_dof}-DOF structure", option="", each=each, given=given
+        )
+
+
 def _run_structure(args: argparse.Namespace) -> int:
     from clearjoint.structure.study import load_structure_study
     from clearjoint.studies import run_structure_task, write_structure_result
@@ -536,6 +585,8 @@ def _run_structure(args: argparse.Namespace) -> int:
     out = _netcdf_target(args)
     plot_path = _plot_target(args)
     study = load_structure_study(args.study)
+    if not args.allow_long:
+        _check_structure_budget(args, study)
     with cli_progress.shown_progress(args, f"{args.task} of {study.source}"):
         if stepped:
             from clearjoint.parallel import optional_client
@@ -586,6 +637,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     args.progress_lines = argv is None or cli_progress.PROGRESS_LINES_IN_PROCESS
+    args.as_command = argv is None
     started = time.time()
     runners = {
         "stiffness": _run_stiffness,

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 from typing import Any, NoReturn
 
 import numpy as np
@@ -21,6 +22,7 @@ __all__ = [
     "STUDY_OPTIONS",
     "amplitude_values",
     "build_parser",
+    "rename_value",
     "study_values",
 ]
 
@@ -226,6 +228,7 @@ def _simulate_parser(sub: Any) -> None:
         force="overwrite --out or --plot if it exists",
     )
     _add_plot_option(p, force=False)
+    _flags(p, allow_long=_ALLOW_LONG, quiet=_QUIET)
 
 
 def _rig_parser(sub: Any) -> None:
@@ -287,7 +290,7 @@ def _frf_parser(sub: Any) -> None:
         description=(
             "Follow the exact period-1 orbit of the joint in STUDY.toml (joint, force, losses; "
             "its frequency is not used) by continuation from --from to --to, through folds; "
-            "report folds, period doublings and grazings. With --parameter force, --from and "
+            "report folds, period doublings and grazings. With --parameter forcing, --from and "
             "--to are forces and --frequency (default: the study's) is held fixed. A structure "
             "study (clearjoint structure's file: [structure], [joint], [excitation]) is followed "
             "by exact shooting too (its frequency only), or by harmonic balance (--method "
@@ -302,12 +305,14 @@ def _frf_parser(sub: Any) -> None:
     _flags(p, json="print the curve as one JSON object")
     p.add_argument(
         "--parameter",
-        choices=["frequency", "force"],
+        choices=["frequency", "forcing", "force"],
+        metavar="{frequency,forcing}",
         default="frequency",
-        help="what varies along the curve (default frequency)",
+        help="what varies along the curve: frequency, or forcing (the force amplitude; "
+        "'force', its old name, still works) (default frequency)",
     )
     _options(
-        p, frequency="fixed frequency with --parameter force, e.g. 400Hz (default: the study's)"
+        p, frequency="fixed frequency with --parameter forcing, e.g. 400Hz (default: the study's)"
     )
     p.add_argument("--max-points", type=int, default=2000, help="points at most (default 2000)")
     _flags(p, allow_long=_ALLOW_LONG)
@@ -434,6 +439,7 @@ def _structure_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="netCDF results file (.nc)")
     _add_plot_option(p, force=False)
     _flags(p, json="print a JSON summary", force="overwrite existing output", quiet=_QUIET)
+    _flags(p, allow_long=_ALLOW_LONG)
     g = p.add_argument_group("stepped-sine")
     g.add_argument("--from", dest="start", help="first frequency, e.g. 2Hz")
     g.add_argument("--to", dest="stop", help="last frequency, e.g. 60Hz")
@@ -531,3 +537,26 @@ def amplitude_values(args: argparse.Namespace) -> Any:
         return parse_amplitude_range(args.amplitude, args.points)
     values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
     return np.array(values)
+
+
+#: Deprecation lines when main() is called from Python rather than run as the command: off,
+#: so that a caller's stderr holds what the old spelling did (the command says it).
+DEPRECATION_LINES_IN_PROCESS = False
+
+
+def rename_value(args: argparse.Namespace, option: str, old: str, new: str) -> None:
+    """Take ``option old``, a value's old spelling, as ``option new``, saying so in one line.
+
+    One meaning per option name (issue 28): ``--force`` overwrites, so ``--parameter force``
+    became ``--parameter forcing``; the old spelling keeps working.
+    """
+    name = option.removeprefix("--").replace("-", "_")
+    if getattr(args, name) != old:
+        return
+    setattr(args, name, new)
+    if getattr(args, "as_command", False) or DEPRECATION_LINES_IN_PROCESS:
+        print(
+            f"clearjoint {args.command}: warning: {option} {old} is now {option} {new} "
+            f"(--force means overwrite); write {option} {new}",
+            file=sys.stderr,
+        )

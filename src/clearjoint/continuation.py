@@ -247,8 +247,11 @@ def tangent_solve(a: FloatArray, previous: FloatArray, t: FloatArray) -> bool:
     """
     d = a.shape[0]
     m = np.zeros((d + 1, d + 2))
-    m[:d, : d + 1] = a
-    m[d, : d + 1] = previous
+    for i in range(d):  # loops, not slices: a slice assignment compiles numba's shape-error text
+        for j in range(d + 1):
+            m[i, j] = a[i, j]
+    for j in range(d + 1):
+        m[d, j] = previous[j]
     m[d, d + 1] = 1.0
     if not _gauss(m):
         return False

@@ -437,8 +437,10 @@ def _next_event(
             d1 = f0 * w * math.cos(theta)
             d2 = -f0 * w * w * math.sin(theta)
             remaining = tau_end - tau
-            h_up = certified_step(ff - net, -d1, -d2, bound, remaining)
-            h_dn = certified_step(ff + net, d1, d2, bound, h_up)  # only: does it come first?
+            h_up = certified_step(ff - net, -d1, -d2, bound, remaining, 0.0, 0.0)
+            h_dn = certified_step(
+                ff + net, d1, d2, bound, h_up, 0.0, 0.0
+            )  # only: does it come first?
             h = min(h_up, h_dn)
             if h >= remaining:
                 return tau_end, EV_PERIOD_END
@@ -475,7 +477,7 @@ def _next_event(
         code = EV_PERIOD_END
         # each later event function is asked only whether it comes before ``best``: a
         # bound that stays positive up to there costs no root search
-        h = certified_step(slip * v, slip * a, slip * j, b4, remaining)
+        h = certified_step(slip * v, slip * a, slip * j, b4, remaining, 0.0, 0.0)
         if h < best:
             best = h
             code = EV_VELOCITY_ZERO

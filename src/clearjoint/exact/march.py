@@ -60,8 +60,13 @@ REACH_MARGIN = 1.0 + 1e-9
 
 #: The law's contact states.
 OPEN, COMPRESSION, TENSION = clearance.OPEN, clearance.COMPRESSION, clearance.TENSION
-#: Status codes of ``march``.
-DONE, CHATTER, NO_CONVERGENCE = 0, 1, 2
+#: Status codes of ``march``: PAUSED when it stopped at ``t_pause``, to be resumed.
+DONE, CHATTER, NO_CONVERGENCE, PAUSED = 0, 1, 2, 3
+#: Places in ``march``'s ``clock``: time reached, next step length, next sample, steps,
+#: impact loss so far (what a paused march resumes from, so that the pieces make exactly
+#: the steps of one whole march).
+C_T, C_H, C_SAMPLE, C_STEPS, C_IMPACT = range(5)
+N_CLOCK = 5
 
 
 @njit(cache=True)
@@ -187,7 +192,7 @@ def first_root(
     low = a0 + min(a1, 0.0) * limit + min(a2, 0.0) * limit * limit - r * limit**3
     if low > 0.0:
         return 2.0
-    if certified_step(a0, a1, 2.0 * a2, 6.0 * r, limit) >= limit:
+    if certified_step(a0, a1, 2.0 * a2, 6.0 * r, limit, 0.0, 0.0) >= limit:
         return 2.0
     # Bernstein coefficients on [0, 1]: beta_k = sum_(i<=k) C(k,i)/C(d,i) a_i
     for k in range(d + 1):
@@ -310,15 +315,27 @@ def march(
     m_eff: np.ndarray,
     norm_a: float,
     max_events: int,
+    out_y: np.ndarray,
+    out_p: np.ndarray,
+    energy: np.ndarray,
+    clock: np.ndarray,
+    t_pause: float,
 ) -> tuple[Any, ...]:
     """Run the exact motion from y_start (scaled) over [0, t_end]; see the module docstring.
 
     ``ap, ai, a_u, a_v``: one CSR pattern holding M^-1 K_plain / omega_ref and M^-1 C;
     ``cp, ci, cd``: C alone (for the viscous loss). ``k_table`` and ``r_table`` (J, 3)
     give each joint's stiffness and offset in state -1, 0, 1 (column state + 1).
-    Returns (y_end, out_y (S, n_aug), out_p (S, J), energy (2,) = (input, viscous),
-    impact, event_times, event_joints, event_states, steps, status), status DONE,
-    CHATTER (more than ``max_events``) or NO_CONVERGENCE.
+    The samples go to ``out_y`` (S, n_aug) and ``out_p`` (S, J), the energy integrals
+    (input, viscous) are added to ``energy`` (2,); ``clock`` (N_CLOCK,) holds where the
+    march starts (t, step length, next sample, steps, impact; (0, h_base, 0, 0, 0) for a
+    new one) and receives where it stopped. The march pauses between two steps once t
+    reaches ``t_pause`` (``inf``: never): called again with what it returned, it goes on
+    with the very steps it would have made, so a march in pieces (for progress reports)
+    gives the whole march's result to the bit. Returns (y_end, states_end, impact,
+    event_times, event_joints, event_states, steps, status) for this piece, impact and
+    steps counted from the start; status DONE, PAUSED, CHATTER (more than
+    ``max_events`` events in this piece) or NO_CONVERGENCE.
     """
     n_aug = 2 * n + 3
     n_j = states_start.shape[0]
@@ -344,10 +361,7 @@ def march(
     norm_v = np.zeros(MAX_TERMS + 1)
     gram = np.zeros(2 * MAX_TERMS + 2)
     prod = np.zeros(2 * MAX_TERMS + 2)
-    out_y = np.zeros((times.shape[0], n_aug))
-    out_p = np.zeros((times.shape[0], n_j), dtype=np.int8)
-    energy = np.zeros(2)
-    impact = 0.0
+    impact = clock[C_IMPACT]
     ev_t = np.empty(64)
     ev_j = np.empty(64, dtype=np.int64)
     ev_s = np.empty(64, dtype=np.int8)
@@ -358,12 +372,15 @@ def march(
     for j in range(n_j):
         for p in range(bp[j], bp[j + 1]):
             b_l1[j] += abs(bd[p])
-    next_sample = 0
-    t = 0.0
-    h_next = h_base
+    next_sample = int(clock[C_SAMPLE])
+    t = clock[C_T]
+    h_next = clock[C_H]
     status = DONE
-    steps = 0
+    steps = int(clock[C_STEPS])
     while t < t_end:
+        if t >= t_pause:  # between two steps: nothing of the next one is computed yet
+            status = PAUSED
+            break
         steps += 1
         y[2 * n] = v_ref * math.sin(omega * t)
         y[2 * n + 1] = v_ref * math.cos(omega * t)
@@ -376,7 +393,8 @@ def march(
             size = max(size, abs(y[q]))
         # the Taylor series of the flow over [t, t + h], with its tail
         while True:
-            terms[0, :] = y
+            for q in range(n_aug):
+                terms[0, q] = y[q]
             n_terms = 0
             rho = 1.0
             top_term = 0.0
@@ -412,9 +430,7 @@ def march(
             if h <= 1e-12 * h_base:
                 return (
                     y,
-                    out_y,
-                    out_p,
-                    energy,
+                    states,
                     impact,
                     ev_t[:n_ev],
                     ev_j[:n_ev],
@@ -473,7 +489,8 @@ def march(
                 for i in range(n_terms - 1, -1, -1):
                     value = value * s + terms[i, q]
                 out_y[next_sample, q] = value
-            out_p[next_sample, :] = states
+            for j in range(n_j):  # loops, not slices: no shape-error text to compile
+                out_p[next_sample, j] = states[j]
             next_sample += 1
         if s_end > 0.0:
             # energy integrals over [0, s_end]: input F.v sin(w t), viscous v^T C v;
@@ -565,7 +582,12 @@ def march(
         if n_ev > max_events:
             status = CHATTER
             break
-    return y, out_y, out_p, energy, impact, ev_t[:n_ev], ev_j[:n_ev], ev_s[:n_ev], steps, status
+    clock[C_T] = t
+    clock[C_H] = h_next
+    clock[C_SAMPLE] = next_sample
+    clock[C_STEPS] = steps
+    clock[C_IMPACT] = impact
+    return y, states, impact, ev_t[:n_ev], ev_j[:n_ev], ev_s[:n_ev], steps, status
 
 
 @njit(cache=True)

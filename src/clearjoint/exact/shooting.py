@@ -155,7 +155,9 @@ def shoot_map(
     v = state[kn.S_V]
     region = int(state[kn.S_REGION])
     slip = int(state[kn.S_SLIP])
-    mono = np.eye(2)
+    mono = np.zeros((2, 2))
+    mono[0, 0] = 1.0
+    mono[1, 1] = 1.0
     phi_m = np.zeros((2, 2))
     sal = np.zeros((2, 2))
     x_max = x
@@ -328,7 +330,7 @@ def shoot(p: FloatArray, z0: FloatArray, n_periods: int) -> Shot:
     else:
         start_state(p, float(z0[0]), float(z0[1]), state)
     out = np.zeros(N_OUT)
-    status = shoot_map(p, state, n_periods, out)
+    status = shoot_map(p, state, n_periods, out, NO_PARAMETER)
     if status != kn.STATUS_OK:
         raise MapError(status)
     return Shot(
@@ -437,7 +439,9 @@ def map_residual(
     state = np.zeros(4)
     start_state(q, x, v, state)
     o1 = np.zeros(N_OUT)
-    status = shoot_map(q, state, 1, o1, parameter if derivative else NO_PARAMETER)
+    # int(1), not 1: numba compiles a callee afresh for a literal argument (Literal[int])
+    once = int(1)  # noqa: UP018, RUF046
+    status = shoot_map(q, state, once, o1, int(parameter if derivative else NO_PARAMETER))
     out[R_EVALS] += 1.0
     if status != kn.STATUS_OK:
         return status
@@ -451,7 +455,7 @@ def map_residual(
             shifted = np.zeros(4)
             start_state(q, x, v, shifted)
             o2 = np.zeros(N_OUT)
-            status = shoot_map(q, shifted, 1, o2)
+            status = shoot_map(q, shifted, once, o2, int(NO_PARAMETER))
             out[R_EVALS] += 1.0
             if status != kn.STATUS_OK:
                 return status
@@ -618,7 +622,17 @@ def arclength_step(
         for i in range(3):
             predicted[i] = points[0, i] + h * tangent[i] + 0.5 * h * h * curvature[i]
     its = correct_orbit(
-        p, parameter, predicted, tangent, scale, False, tolerance, max_iterations, y, system, out
+        p,
+        parameter,
+        predicted,
+        tangent,
+        scale,
+        bool(False),  # noqa: UP018 (not a literal: one compiled copy of the callee)
+        tolerance,
+        max_iterations,
+        y,
+        system,
+        out,
     )
     if its < 0:
         return its

@@ -45,6 +45,7 @@ from clearjoint import checks as _checks
 from clearjoint.errors import ParameterError
 from clearjoint.exact import march, single
 from clearjoint.laws import clearance
+from clearjoint.progress import report
 from clearjoint.results import EnergyLedger
 from clearjoint.simulate.core import SimulationError
 from clearjoint.structure.model import (
@@ -63,6 +64,9 @@ BASE_STEP_PERIODS = 1.0 / 8.0
 
 #: The most events allowed per base step on average before the run is called chattering.
 MAX_EVENTS_PER_STEP = 1000
+#: Pieces a forced response or a free decay is marched in, each ending in a progress
+#: report (clearjoint.progress): the same steps as one march, so the same motion to the bit.
+PROGRESS_PIECES = 100
 
 
 def _dense(matrix: Matrix) -> FloatArray:
@@ -371,10 +375,19 @@ def _run(
     v0: FloatArray,
     duration: float,
     times: FloatArray,
+    *,
+    pieces: int = 1,
 ) -> StructureMotion:
+    """March the exact motion over ``duration`` s, sampled at ``times``.
+
+    With ``pieces`` > 1 the march pauses that many times, at equal stretches of time, to
+    report its progress (:func:`clearjoint.progress.report`, in seconds of motion); the
+    pieces make exactly the steps of one march, so the result is the same to the bit.
+    """
     n = flow.n
     y = flow.scaled(u0, v0, 0.0)
     states = flow.states_at(flow.b @ u0, flow.b @ v0)
+    start_states = states.copy()
     max_events = MAX_EVENTS_PER_STEP * (int(duration / flow.base_step) + 1)
     c, b = flow.c_csr, flow.b_csr
     # one sparsity pattern for the plain stiffness and the damping, M^-1 and scaling in
@@ -383,17 +396,14 @@ def _run(
     rows = np.repeat(np.arange(n), np.diff(a.indptr))
     a_u = flow.k_linear[rows, a.indices] / (flow.m[rows] * flow.omega_ref)
     a_v = flow.c[rows, a.indices] / flow.m[rows]
-    y_end, out_y, out_p, energy, impact, ev_t, ev_j, ev_s, steps, status = march.march(
-        y,
-        states,
-        float(duration),
-        times,
-        flow.base_step,
-        n,
-        float(flow.omega),
-        flow.omega_ref,
-        flow.v_ref,
-        1.0 / flow.m,
+    out_y = np.zeros((times.shape[0], 2 * n + 3))
+    out_p = np.zeros((times.shape[0], states.shape[0]), dtype=np.int8)
+    energy = np.zeros(2)
+    clock = np.zeros(march.N_CLOCK)
+    clock[march.C_H] = flow.base_step
+    events: list[tuple[FloatArray, NDArray[np.int64], NDArray[np.int8]]] = []
+    count = 0
+    fixed = (
         np.asarray(flow.force, dtype=np.float64),
         a.indptr.astype(np.int64),
         a.indices.astype(np.int64),
@@ -405,15 +415,46 @@ def _run(
         b.indptr.astype(np.int64),
         b.indices.astype(np.int64),
         b.data.astype(np.float64),
-        flow.k_table,
-        flow.r_table,
-        flow.g_c,
-        flow.g_t,
-        flow.restitution,
-        flow.m_eff,
-        flow.norm_a,
-        max_events,
     )
+    status = march.PAUSED
+    piece = 0
+    while status == march.PAUSED:
+        piece += 1
+        t_pause = math.inf if piece >= pieces else duration * piece / pieces
+        y, states, impact, ev_t, ev_j, ev_s, steps, status = march.march(
+            y,
+            states,
+            float(duration),
+            times,
+            flow.base_step,
+            n,
+            float(flow.omega),
+            flow.omega_ref,
+            flow.v_ref,
+            1.0 / flow.m,
+            *fixed,
+            flow.k_table,
+            flow.r_table,
+            flow.g_c,
+            flow.g_t,
+            flow.restitution,
+            flow.m_eff,
+            flow.norm_a,
+            max_events - count,
+            out_y,
+            out_p,
+            energy,
+            clock,
+            t_pause,
+        )
+        events.append((ev_t, ev_j, ev_s))
+        count += ev_t.size
+        if pieces > 1:
+            report(min(clock[march.C_T], duration), duration)
+    y_end = y
+    ev_t = np.concatenate([e[0] for e in events])
+    ev_j = np.concatenate([e[1] for e in events])
+    ev_s = np.concatenate([e[2] for e in events])
     if status == march.CHATTER:
         raise SimulationError(
             f"more than {max_events} gap-edge events in {float(ev_t[-1]):.4g} s (chattering "
@@ -444,7 +485,7 @@ def _run(
         events=int(ev_t.size),
         event_times=np.asarray(ev_t, dtype=np.float64),
         event_joints=np.asarray(ev_j, dtype=np.int64),
-        patterns_visited=_patterns_visited(states, ev_j, ev_s),
+        patterns_visited=_patterns_visited(start_states, ev_j, ev_s),
         final_state=(u_end, v_end),
         structure=flow.system.source if isinstance(flow.system.source, Structure) else None,
         omega=flow.omega,
@@ -453,7 +494,7 @@ def _run(
         dof_names=flow.system.dof_names,
         system=flow.system,
         event_states=np.asarray(ev_s, dtype=np.int8),
-        start_pattern=np.asarray(states, dtype=np.int8).copy(),
+        start_pattern=np.asarray(start_states, dtype=np.int8).copy(),
     )
 
 
@@ -506,7 +547,7 @@ def time_response(
     duration = _checks.positive("duration", duration, unit="s")
     u0, v0 = _initial(system, initial)
     times = _sample_times(duration, 2.0 * math.pi / w, samples_per_period)
-    return _run(_Flow(system, f, w), u0, v0, duration, times)
+    return _run(_Flow(system, f, w), u0, v0, duration, times, pieces=PROGRESS_PIECES)
 
 
 def free_decay(
@@ -530,7 +571,8 @@ def free_decay(
     modes = source.modes("closed") if isinstance(source, Structure) else system_modes(system)
     first = float(modes.omega[0])
     times = _sample_times(duration, 2.0 * math.pi / first, samples_per_period)
-    return _run(_Flow(system, np.zeros(system.n_dof), 0.0), u0, v0, duration, times)
+    flow = _Flow(system, np.zeros(system.n_dof), 0.0)
+    return _run(flow, u0, v0, duration, times, pieces=PROGRESS_PIECES)
 
 
 def _system(structure: Any) -> VibrationSystem:

@@ -153,7 +153,7 @@ def _structure_curve(
     if study.force is None or study.omega is None:
         raise ParameterError(
             f"{study.source}: frf needs the [excitation] section (force_dof, force_amplitude; "
-            "frequency for --parameter force); put it in the study file"
+            "frequency for --parameter forcing); put it in the study file"
         )
     if method != "harmonic":
         from clearjoint import structure
@@ -161,7 +161,7 @@ def _structure_curve(
         if parameter == "force":
             raise ParameterError(
                 f"{study.source} is a structure study: its exact curve by shooting follows the "
-                "frequency only; drop --parameter force, or add --method harmonic"
+                "frequency only; drop --parameter forcing, or add --method harmonic"
             )
         return structure.frequency_response(
             study.structure,

@@ -22,6 +22,7 @@ from clearjoint.structure.study import StructureStudy
 __all__ = [
     "STRUCTURE_TASKS",
     "StructureTaskResult",
+    "marched_periods",
     "run_structure_task",
     "stepped_sine_of",
     "write_structure_result",
@@ -41,6 +42,33 @@ class StructureTaskResult:
     data: Any
     summary: dict[str, Any]
     drawn: Any
+
+
+def marched_periods(
+    study: StructureStudy,
+    task: str,
+    *,
+    points: int = 100,
+    settle_periods: int = 200,
+    record_periods: int = 100,
+) -> float:
+    """The periods of exact motion ``task`` will march, for an estimate of its time.
+
+    ``respond``: the study's [excitation] periods; ``decay``: its [decay] duration in
+    periods of the lowest closed mode (the fewest the duration can hold: an estimate rather
+    short than long); ``stepped-sine``: ``points`` x (``settle_periods`` +
+    ``record_periods``), one direction; 0 for ``modes`` and for a task whose section is
+    missing (the task itself then says so).
+    """
+    if task == "respond" and study.omega is not None:
+        return float(study.periods)
+    if task == "decay" and study.decay_duration is not None:
+        s = study.structure
+        modes = s.modes("closed", 1) if isinstance(s, Structure) else system_modes(s, "closed", 1)
+        return study.decay_duration * float(modes.omega[0]) / (2.0 * math.pi)
+    if task == "stepped-sine":
+        return float(points) * (settle_periods + record_periods)
+    return 0.0
 
 
 def run_structure_task(
