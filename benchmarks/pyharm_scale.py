@@ -38,7 +38,6 @@ import argparse
 import json
 import math
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -206,14 +205,21 @@ def describe(name: str, r: dict[str, Any] | None, timeout: float) -> str:
     if r is None:
         return f"{name}: did not finish within {timeout:.0f} s"
     if "error" in r:
+        if "IndexError" in r["error"] and "list index" in r["error"]:
+            return (
+                f"{name}: did not start (its first solve at the start frequency was not "
+                "accepted, and its tangent predictor had no solution to continue from: "
+                f"{r['error']})"
+            )
         return f"{name}: failed ({r['error']})"
     per = r["seconds"] / max(r["points"] - 1, 1)
+    ended = "" if r["points"] >= r.get("asked", 0) else f" (stopped before {r['asked']})"
     span = ""
     if r["omega_first"] is not None:
         span = (
             f", {r['omega_first'] / (2 * math.pi):.3f} to {r['omega_last'] / (2 * math.pi):.3f} Hz"
         )
-    return f"{name}: {r['seconds']:.1f} s, {r['points']} points, {per:.3f} s a point{span}"
+    return f"{name}: {r['seconds']:.1f} s, {r['points']} points{ended}, {per:.3f} s a point{span}"
 
 
 def main() -> None:
@@ -232,12 +238,15 @@ def main() -> None:
             path, case = export(bays, Path(folder))
             unknowns = (2 * H + 1) * case["structure"].n_dof
             print(f"{bays} bays ({unknowns} unknowns):", flush=True)
-            print("  " + describe("clearjoint", ours(case, args.points), args.timeout), flush=True)
+            mine = ours(case, args.points) | {"asked": args.points}
+            print("  " + describe("clearjoint", mine, args.timeout), flush=True)
             result = theirs(args.pyharm, path, args.points, args.timeout)
+            if result is not None:
+                result["asked"] = args.points
             print("  " + describe("pyHarm", result, args.timeout), flush=True)
             if result is None:
                 break  # a larger size would not finish either
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()
