@@ -237,9 +237,45 @@ def test_restitution_is_refused_where_the_jacobian_would_miss_its_jumps():
     s = chain([0.5], [math.inf], [dead], [2.0])
     with pytest.raises(StructureError, match="restitution of 0"):
         stepped_sine(s, [30.0], 2 * math.pi * np.array([40.0, 41.0]))
-    shoot = ShootingMap(s.to_system(), np.array([30.0]), 2 * math.pi * 40)
     with pytest.raises(StructureError, match="restitution of 0"):
-        shoot(np.array([0.0, 0.0]))
+        periodic_orbit(s, [30.0], 2 * math.pi * 40)
+    with pytest.raises(StructureError, match="restitution of 0"):
+        frequency_response(s, [30.0], 2 * math.pi * 40, 2 * math.pi * 41)
+
+
+def test_impacts_at_the_same_instant_each_get_their_saltation_matrix():
+    """A mass between two supports through two equal joints with restitution 0.5: both
+    joints meet their edges at the same displacement, so their impacts come in pairs at
+    the same instant (some at the same float time). The monodromy against central
+    differences of the exact map, and orbits at the frequencies where the pairs tie."""
+    from clearjoint.structure import time_response
+    from clearjoint.structure.model import Member, Structure
+
+    law = cj.ClearanceJoint(0.2e-3, 4e5, gap_stiffness=2e4, restitution=0.5)
+    s = Structure(
+        nodes=[0.0, 1.0, 2.0],
+        masses=[0.0, 0.5, 0.0],
+        members=[
+            Member(0, 1, stiffness=math.inf, joint=law, damping=1.0),
+            Member(1, 2, stiffness=math.inf, joint=law, damping=1.0),
+        ],
+        supports=[0, 2],
+    )
+    f, w = np.array([20.0]), 2 * math.pi * 40
+    z = np.concatenate(time_response(s, f, w, 40 * 2 * math.pi / w).final_state)
+    shoot = ShootingMap(s.to_system(), f, w)
+    _, phi, motion = shoot(z)
+    assert np.min(np.diff(motion.event_times)) < 1e-15  # impacts tie
+    fd = np.empty((2, 2))
+    scale = np.array([w, 1.0])
+    for k in range(2):
+        dz = np.zeros(2)
+        dz[k] = 1e-8 / scale[k]
+        fd[:, k] = (shoot(z + dz)[0] - shoot(z - dz)[0]) / (2 * dz[k])
+    size = np.max(np.abs(phi * scale[:, None] / scale[None, :]))
+    assert np.max(np.abs((fd - phi) * scale[:, None] / scale[None, :])) < 1e-6 * size
+    for hz in (38.0, 39.0, 41.0, 42.0):
+        assert periodic_orbit(s, f, 2 * math.pi * hz).closure < 1e-10
 
 
 def test_lyapunov_exponent_with_impacts_is_the_log_of_the_largest_multiplier():
@@ -460,26 +496,42 @@ def test_impact_oscillator_cascade_against_the_rigid_limit_and_feigenbaum():
 
     start = time_response(structure, force, w_top, 300 * 2 * math.pi / w_top)
     z0, _ = orbit(w_top, 2, np.concatenate(start.final_state))
+
+    def doubled(p: int, w: float, known: dict) -> np.ndarray:
+        """Just below a doubling, the stable orbit of twice the period: Newton from the
+        unstable one pushed along the eigenvector of its multiplier past -1."""
+        shoot = ShootingMap(system, force, w, p)
+        found = newton_orbit(shoot, known[min(known, key=lambda k: abs(k - w))], 1e-12)
+        assert found is not None
+        base, phi = found[0], found[1]
+        values, vectors = np.linalg.eig(phi)
+        push = vectors[:, np.argmin(values.real)].real
+        size = shoot.size(base) / shoot.size(push)
+
+        def seeds():  # pushes, else the motion from there, which settles on the orbit
+            for scale in (1e-3, 1e-2, 3e-2, 1e-1, -3e-2):
+                yield base + scale * size * push
+            start = base + 1e-3 * size * push
+            yield np.concatenate(
+                time_response(
+                    structure, force, w, 400 * p * 2 * math.pi / w, initial=(start[:1], start[1:])
+                ).final_state
+            )
+
+        for seed in seeds():
+            z, mu = orbit(w, 2 * p, seed)
+            if np.abs(mu).max() < 1.0 and shoot.size(z - base) > 1e-6 * shoot.size(base):
+                return z  # stable, and not the orbit of period p run twice
+        pytest.fail(f"no stable period-{2 * p} orbit just below the doubling at {w}")
+
     first, known = doubling(2, w_top, z0, -0.01)
-    # just below it, the stable orbit of twice the period, from the unstable one pushed
-    # along the eigenvector of its multiplier past -1
-    w = first - 1e-3
-    shoot = ShootingMap(system, force, w, 2)
-    found = newton_orbit(shoot, known[min(known, key=lambda k: abs(k - w))], 1e-12)
-    assert found is not None
-    base, phi = found[0], found[1]
-    values, vectors = np.linalg.eig(phi)
-    push = vectors[:, np.argmin(values.real)].real
-    size = shoot.size(base) / shoot.size(push)
-    for scale in (1e-3, 3e-3, 1e-2, 3e-2, 1e-1, -1e-2, -3e-2, -1e-1):
-        z4, mu4 = orbit(w, 4, base + scale * size * push)
-        if np.abs(mu4).max() < 1.0 and shoot.size(z4 - base) > 1e-6 * shoot.size(base):
-            break  # stable, and not the period-2 orbit run twice
-    else:
-        pytest.fail("no stable period-4 orbit just below the first doubling")
-    second, _ = doubling(4, w, z4, -0.05)
-    assert first == pytest.approx(reference[0], abs=2e-3)
-    assert second == pytest.approx(reference[1], abs=2e-3)
+    second, known = doubling(4, first - 1e-3, doubled(2, first - 1e-3, known), -0.05)
+    w = second - 0.02 * (first - second)
+    third, _ = doubling(8, w, doubled(4, w, known), -(first - second) / 50)
+    found = np.array([first, second, third])
+    np.testing.assert_allclose(found, reference[:3], atol=2e-3)
+    ratio = (first - second) / (second - third)
+    assert ratio == pytest.approx(ratios[0], rel=0.01)
 
     # the one-joint solver on the same joint finds the first doubling at the same frequency
     j, losses = system.to_joint()

@@ -10,7 +10,6 @@ from pathlib import Path
 import pytest
 
 from clearjoint.errors import ParameterError
-from clearjoint.structure import StructureError
 from clearjoint.structure.study import load_structure_study
 from clearjoint.studies import (
     checked_samples,
@@ -144,7 +143,7 @@ def test_harmonic_balance_refuses_an_impact_and_free_play_friction(tmp_path: Pat
     refuse_harmonic_losses(load_study(_study(tmp_path)), "frf")  # no loss it cannot carry
 
 
-def test_a_structure_study_with_impacts_is_refused_and_needs_harmonic_balance(
+def test_a_structure_study_with_impacts_is_refused_by_harmonic_balance_not_by_shooting(
     tmp_path: Path,
 ) -> None:
     path = tmp_path / "chain.toml"
@@ -152,9 +151,10 @@ def test_a_structure_study_with_impacts_is_refused_and_needs_harmonic_balance(
     study = load_structure_study(path)
     with pytest.raises(ParameterError, match=r"restitution = 0\.5 is an impact"):
         refuse_harmonic_structure(study, "frf")
-    # exact shooting refuses impacts too (its Jacobian would miss their jumps)
-    with pytest.raises(StructureError, match=r"restitution of 0\.5"):
-        frequency_response_of(study, 100.0, 900.0, method="shooting")
+    # exact shooting carries the impacts (each one's saltation matrix in its monodromy)
+    curve = frequency_response_of(study, 300.0, 350.0, method="shooting", max_points=3)
+    assert curve.method == "shooting"
+    assert curve.omega.size == 3
 
 
 def test_a_structure_task_is_written_to_netcdf_as_its_dataset(tmp_path: Path) -> None:

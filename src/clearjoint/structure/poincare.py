@@ -35,6 +35,7 @@ from clearjoint.structure.tangent import (
     carry,
     impact_jumps,
     pattern_history,
+    refuse_restitution,
     stretches,
 )
 from clearjoint.system import VibrationSystem
@@ -218,6 +219,8 @@ class ShootingMap:
         self.duration = self.p * self.period
         self.flow = _Flow(system, force, omega)
         self.impacts = bool(np.any(self.flow.restitution < 1.0))
+        if self.impacts:
+            refuse_restitution(system, below=0.0)  # e = 0: no saltation matrix
         self.flows = PatternFlows(system, impacts=self.impacts) if flows is None else flows
 
     def run(self, z: FloatArray, samples_per_period: int = 1) -> StructureMotion:

@@ -63,7 +63,7 @@ def refuse_restitution(system: VibrationSystem, *, below: float = 1.0) -> None:
             "e > 0; give it a small positive restitution (0.01)"
         )
     if np.any(e < below):
-        joint = int(np.flatnonzero(e < 1.0)[0])
+        joint = int(np.flatnonzero(e < below)[0])
         raise StructureError(
             f"joint {joint} has a restitution of {float(e[joint]):g}: the exact tangent "
             "flow (monodromy, Lyapunov exponent) of a structure carries continuous "
@@ -220,8 +220,8 @@ def impact_saltation(
     b = np.asarray(flow.b[joint], dtype=np.float64)
     push = np.asarray(flow.impulse_dirs[joint], dtype=np.float64)  # M^-1 b
     m_eff = float(flow.m_eff[joint])
-    before = float(b @ v_after) / e  # b^T v-
-    v_before = v_after + (1.0 - e) * m_eff * push * before
+    v_before = before_impact(flow, joint, v_after)
+    before = float(b @ v_before)  # b^T v-
     system = flow.system
     delta = flow.b @ u
     f_joint, _ = system.joint_forces(delta)
@@ -233,6 +233,18 @@ def impact_saltation(
     salt[n:, n:] -= (1.0 - e) * m_eff * np.outer(push, b)
     salt[:, :n] += np.outer(np.concatenate((jump_v, jump_a)), b) / before
     return salt
+
+
+def before_impact(flow: Any, joint: int, v_after: FloatArray) -> FloatArray:
+    """The velocity just before an impact of ``joint`` from the one just after it.
+
+    The impulse along M^-1 b takes the joint's relative speed s = b^T v to e s
+    (MODEL.md 5.2): b^T v+ = e b^T v-, so v- = v+ + (1 - e) m_eff M^-1 b (b^T v+ / e).
+    """
+    e = float(flow.restitution[joint])
+    push = np.asarray(flow.impulse_dirs[joint], dtype=np.float64)
+    speed = float(np.asarray(flow.b[joint], dtype=np.float64) @ v_after) / e
+    return np.asarray(v_after + (1.0 - e) * float(flow.m_eff[joint]) * push * speed)
 
 
 def impact_jumps(
@@ -250,7 +262,11 @@ def impact_jumps(
     (``flow`` from (u0, v0) over its ``duration``, s) sampled at the impacts' times: the
     march's steps do not depend on where it samples, and a sample at an event's time is
     taken at the start of the step after the event. That run's events are checked to be
-    the first run's, bit for bit.
+    the first run's, bit for bit. Impacts at the same instant (the march meets them one
+    after the other, in the order of their events, with no step between) are read back
+    from the state after the last of them, one impulse at a time, each with its own
+    saltation matrix, multiplied in in the march's order. An impact at the very end of
+    the run takes the run's final state.
 
     Raises
     ------
@@ -266,16 +282,23 @@ def impact_jumps(
     hits = np.flatnonzero(entering & (flow.restitution[joints] < 1.0))
     if hits.size == 0:
         return {}
-    after = _run(flow, u0, v0, duration, times[hits])
+    sampled = hits[times[hits] < duration]
+    after = _run(flow, u0, v0, duration, np.unique(times[sampled]))
     if not np.array_equal(np.asarray(after.event_times), times):
         raise SimulationError(
             "the exact motion met its gap edges differently when sampled at its impacts; "
             "its Jacobian with impacts cannot be formed (please report this)"
         )
-    return {
-        int(i): impact_saltation(flow, int(joints[i]), float(times[i]), after.u[k], after.v[k])
-        for k, i in enumerate(hits)
-    }
+    states = {float(t): (after.u[k], after.v[k]) for k, t in enumerate(np.unique(times[sampled]))}
+    end_u, end_v = motion.final_state
+    jumps: dict[int, FloatArray] = {}
+    for t in np.unique(times[hits]):
+        u, v = states.get(float(t), (np.asarray(end_u), np.asarray(end_v)))
+        for i in hits[times[hits] == t][::-1]:  # the last impact of the instant first
+            joint = int(joints[i])
+            jumps[int(i)] = impact_saltation(flow, joint, float(t), u, v)
+            v = before_impact(flow, joint, v)
+    return jumps
 
 
 def carry(
@@ -291,22 +314,27 @@ def carry(
 
     The product of the stretches' exponentials (identity ``vectors`` by default), with
     each impact's saltation matrix in ``jumps`` (:func:`impact_jumps`) multiplied in at
-    its event.
+    its event: those at start < t <= stop (an impact at a boundary of consecutive spans
+    belongs to the span it ends), in the order of their events.
     """
     phi = np.eye(2 * flows.n) if vectors is None else vectors
     times = np.asarray(motion.event_times, dtype=np.float64)
     inside = [] if not jumps else [
         i for i in range(
             int(np.searchsorted(times, start, side="right")),
-            int(np.searchsorted(times, stop, side="left")),
+            int(np.searchsorted(times, stop, side="right")),
         ) if i in jumps
     ]  # fmt: skip
     for i in inside:
-        widths, patterns = stretches(motion, start, float(times[i]), history)
-        phi = jumps[i] @ flows.product(widths, patterns, start=phi)  # type: ignore[index]
+        if times[i] > start:
+            widths, patterns = stretches(motion, start, float(times[i]), history)
+            phi = flows.product(widths, patterns, start=phi)
+        phi = jumps[i] @ phi  # type: ignore[index]
         start = float(times[i])
-    widths, patterns = stretches(motion, start, stop, history)
-    return flows.product(widths, patterns, start=phi)
+    if stop > start:
+        widths, patterns = stretches(motion, start, stop, history)
+        phi = flows.product(widths, patterns, start=phi)
+    return phi
 
 
 def stretches(
