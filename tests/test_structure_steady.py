@@ -436,13 +436,16 @@ def test_impact_oscillator_cascade_against_the_rigid_limit_and_feigenbaum():
 
     The reference (tests/impact_oscillator.py) is the rigid limit in closed form, sharing no
     code with clearjoint; its cascade converges at Feigenbaum's rate (delta = 4.6692...,
-    Feigenbaum 1978, J. Stat. Phys. 19, 25-52), as a smooth cascade must: the ratio of
-    successive intervals falls from 10.8 to 4.74 at the fifth doubling.
+    Feigenbaum 1978, J. Stat. Phys. 19, 25-52), as a smooth cascade must: the ratios of
+    successive intervals fall, the last within 2 % of delta.
     clearjoint's structure solver models the stop as a one-sided clearance joint with a
     contact stiffness 1e6 times the spring's and the same restitution, and carries the
-    impacts' saltation matrices in its monodromy: its first two doublings fall within 2e-3
-    of the rigid limit's (the contact's finite stiffness), and its first one where the
-    one-joint solver (clearjoint.periodic, its own kernel and saltation) finds it.
+    impacts' saltation matrices in its monodromy: its first three doublings fall within
+    2e-3 of the rigid limit's (the contact's finite stiffness), the first ratio of their
+    intervals within 1 % of the reference's, and its first doubling where the one-joint
+    solver (clearjoint.periodic, its own kernel and saltation) finds it. No published
+    table of the doublings is compared (none was within reach): the literature gives the
+    model and Feigenbaum's constant, and the constant checks the reference.
     """
     from scipy.optimize import brentq
 
