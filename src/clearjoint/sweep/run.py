@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
@@ -34,7 +33,7 @@ from clearjoint.parallel import (
     point_seed,
     run_batches,
 )
-from clearjoint.store import StoreWarning
+from clearjoint.store import Grid, StoreWarning, status_counts
 from clearjoint.sweep.file import Sweep
 from clearjoint.sweep.tasks import Task
 
@@ -121,34 +120,39 @@ def _column_names(sweep: Sweep) -> tuple[str, ...]:
 
 
 def _attrs(sweep: Sweep) -> dict[str, Any]:
+    """The Dataset's attributes (and the store's): what the sweep was, and how many points."""
     return {
         "title": f"clearjoint sweep: {sweep.task.name}",
         "task": sweep.task.name,
         "sweep_file": sweep.source,
         "base": str(getattr(sweep.base, "source", "")),
         "seed": sweep.seed,
-        "dims": json.dumps(list(sweep.dims)),
-        "shape": json.dumps(list(sweep.shape)),
-        "axes": json.dumps(
-            {a.name: {"values": list(a.values), "units": a.unit} for a in sweep.axes}
-        ),
-        "draws": json.dumps([d.name for d in sweep.draws]),
         "fixed": json.dumps(dict(sweep.fixed)),
-        "files": json.dumps(list(getattr(sweep.base, "files", []))),
+        "clearjoint_sweep_fingerprint": sweep.fingerprint,
+        "points": sweep.n_points,
     }
+
+
+def _grid(sweep: Sweep) -> Grid:
+    """The sweep's labelled grid: ``sample`` (with draws) and one dimension per axis, each
+    with its values; drawn values as coordinates over ``sample`` (and ``joint``)."""
+    coords: dict[str, tuple[tuple[str, ...], Any, dict[str, Any]]] = {}
+    if sweep.samples:
+        coords["sample"] = (("sample",), np.arange(sweep.samples), {})
+    for axis in sweep.axes:
+        coords[axis.name] = ((axis.name,), np.asarray(axis.values), {"units": axis.unit})
+    files = list(getattr(sweep.base, "files", []))
+    if files:  # a record set: its files beside the record index
+        coords["record"] = (("record",), np.arange(len(files)), {})
+        coords["file"] = (("record",), np.asarray(files, dtype=str), {})
+    for d, values in zip(sweep.draws, sweep.drawn().values(), strict=True):
+        dims = ("sample", "joint")[: values.ndim]
+        coords[d.name] = (dims, values, {"units": d.unit, "distribution": d.distribution})
+    return Grid(sweep.dims, sweep.shape, coords)
 
 
 def _variables(sweep: Sweep) -> list[Variable]:
     out = [Variable(name, "f8", {"units": sweep.task.outputs[name]}) for name in sweep.outputs]
-    out += [
-        Variable(
-            d.name,
-            "f8",
-            {"units": d.unit, "distribution": d.distribution},
-            shape=(d.per_joint,) if d.per_joint else (),
-        )
-        for d in sweep.draws
-    ]
     out.append(Variable("status", "str", {"description": "ok, or why the point failed"}))
     return out
 
@@ -233,7 +237,7 @@ def _open_or_create(sweep: Sweep, path: Path, *, resume: bool, force: bool) -> R
     """The sweep's store at ``path`` (its lock held): resumed and repaired, or made anew."""
     if resume and path.exists():
         store = ResultStore.open(path, fingerprint=sweep.fingerprint)
-        _repair(store)
+        _repair(store, sweep)
         return store
     return ResultStore.create(
         path,
@@ -243,6 +247,7 @@ def _open_or_create(sweep: Sweep, path: Path, *, resume: bool, force: bool) -> R
         variables=_variables(sweep),
         attrs=_attrs(sweep),
         force=force,
+        grid=_grid(sweep),
     )
 
 
@@ -281,9 +286,11 @@ def _run(
         progress(finished, sweep.n_points)
     in_memory: dict[int, dict[str, NDArray[Any]]] = {}
     failures: list[str] = []
-    sample = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
-    if chunks:
-        with _runner(client, workers) as runner:
+    with contextlib.ExitStack() as stack:
+        if store is not None:  # its attributes count the points however the run ends
+            stack.callback(store.write_counts)
+        if chunks:
+            runner = stack.enter_context(_runner(client, workers))
             batches = run_batches(
                 _evaluate_chunk, chunks, runner, retries=retries, every=_WRITE_EVERY_S
             )
@@ -295,11 +302,7 @@ def _run(
                         error = outcome.error
                         failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
                         continue
-                    values = dict(outcome.result)
-                    a, b = bounds[chunk]
-                    for d in sweep.draws:
-                        values[d.name] = drawn[d.name][sample[a:b]]
-                    written.append((chunk, values))
+                    written.append((chunk, outcome.result))
                 if store is not None and lock is not None:
                     lock.check()
                     store.write_many(written)
@@ -316,19 +319,31 @@ def _run(
             f"{len(failures)} of {len(bounds)} chunks did not finish ({failures[0]}){where}"
         )
     if store is not None:
-        return _dataset(store.read(), store.attrs)
-    flat: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
-    for var in _variables(sweep):
-        if var.name in drawn:
-            array = drawn[var.name][sample]
-        else:
-            array = np.concatenate([in_memory[i][var.name] for i in range(len(bounds))])
-        flat[var.name] = (array, dict(var.attrs))
-    return _dataset(flat, {**_attrs(sweep), "clearjoint_sweep_fingerprint": sweep.fingerprint})
+        return _read_store(store)
+    flat = {
+        var.name: (
+            np.concatenate([in_memory[i][var.name] for i in range(len(bounds))]),
+            dict(var.attrs),
+        )
+        for var in _variables(sweep)
+    }
+    return _dataset(_grid(sweep), flat, _attrs(sweep))
 
 
-def _repair(store: ResultStore) -> None:
-    """Unflag the store's damaged chunks, so that they are computed again; say so in one line."""
+def _repair(store: ResultStore, sweep: Sweep) -> None:
+    """Unflag the store's damaged chunks, so that they are computed again, and write its
+    damaged coordinates again; say so in one line each."""
+    coordinates = store.damaged_coordinates()
+    if coordinates:
+        store.write_coordinates(_grid(sweep))
+        name = min(coordinates)
+        warnings.warn(
+            StoreWarning(
+                f"{store.path}: writing {len(coordinates)} damaged coordinates again "
+                f"(first: {name}: it {coordinates[name]})"
+            ),
+            stacklevel=3,
+        )
     damaged = store.check()
     if not damaged:
         return
@@ -432,59 +447,48 @@ def run_sweep_file(
 
 
 def _dataset(
-    flat: Mapping[str, tuple[NDArray[Any], dict[str, Any]]], attrs: Mapping[str, Any]
+    grid: Grid, flat: Mapping[str, tuple[NDArray[Any], dict[str, Any]]], attrs: Mapping[str, Any]
 ) -> Any:
+    """The results as an xarray.Dataset: each variable over the grid, its coordinates, and
+    the counts of failed and missing points (as the store holds them)."""
     import xarray as xr
 
-    dims = tuple(json.loads(attrs["dims"]))
-    shape = tuple(json.loads(attrs["shape"]))
-    axes = json.loads(attrs["axes"])
-    drawn = set(json.loads(attrs["draws"]))
-    coords: dict[str, Any] = {
-        name: (name, np.asarray(spec["values"]), {"units": spec["units"]})
-        for name, spec in axes.items()
+    variables = {
+        name: (grid.dims, values.reshape(grid.shape), var_attrs)
+        for name, (values, var_attrs) in flat.items()
     }
-    if "sample" in dims:
-        coords["sample"] = ("sample", np.arange(shape[0]))
-    files = json.loads(attrs.get("files", "[]"))
-    if files:  # a record set: its files beside the record index
-        coords["record"] = ("record", np.arange(len(files)))
-        coords["file"] = ("record", np.asarray(files, dtype=str))
-    variables: dict[str, Any] = {}
-    for name, (values, var_attrs) in flat.items():
-        if name in drawn:
-            extra = values.shape[1:]  # (n_joints,) for a per-joint draw
-            full = values.reshape(shape + extra)
-            first = full.reshape(shape[0], -1, *extra)[:, 0]
-            coords[name] = (("sample", "joint")[: 1 + len(extra)], first, var_attrs)
-        else:
-            variables[name] = (dims, values.reshape(shape), var_attrs)
-    status = flat["status"][0]
-    ok = np.char.startswith(status.astype(str), "ok")
-    failed = int(np.count_nonzero(~ok & (status != "")))
-    missing = int(np.count_nonzero(status == ""))
-    keep = {
-        k: v
-        for k, v in attrs.items()
-        if k not in ("dims", "shape", "axes", "draws", "chunk_size", "files")
-    }
+    failed, missing = status_counts(flat["status"][0])
     return xr.Dataset(
         variables,
-        coords=coords,
-        attrs={
-            **keep,
-            "points": math.prod(shape),
-            "points_failed": failed,
-            "points_missing": missing,
-        },
+        coords={name: (dims, values, dict(a)) for name, (dims, values, a) in grid.coords.items()},
+        attrs={**attrs, "points_failed": failed, "points_missing": missing},
     )
+
+
+def _read_store(store: ResultStore) -> Any:
+    """The store's Dataset as ``xarray.open_zarr`` reads it, once the store is checked.
+
+    ``status`` as fixed-width strings (zarr gives numpy's StringDType) and the counts of
+    failed and missing points from ``status`` (the attributes hold them as of the end of
+    the last run).
+    """
+    import xarray as xr
+
+    store.read()  # a StoreError naming the first damaged chunk or coordinate
+    with xr.open_zarr(store.path) as opened:
+        data = opened.load()
+    status = np.array(data["status"].values.tolist(), dtype=str)
+    data["status"] = (data["status"].dims, status, data["status"].attrs)
+    failed, missing = status_counts(status)
+    data.attrs.update(points_failed=failed, points_missing=missing)
+    return data
 
 
 def open_sweep(path: str | Path) -> Any:
     """Return the results in a sweep's zarr store as an xarray.Dataset (as :func:`run_sweep`).
 
-    Points of chunks not yet computed are NaN with an empty ``status``
-    (``points_missing`` in the attributes counts them).
+    The store is checked first (a damaged chunk is one StoreError line), then read as
+    ``xarray.open_zarr(path)`` reads it. Points of chunks not yet computed are NaN with
+    an empty ``status`` (``points_missing`` in the attributes counts them).
     """
-    store = ResultStore.open(path)
-    return _dataset(store.read(), store.attrs)
+    return _read_store(ResultStore.open(path))
