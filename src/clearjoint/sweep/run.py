@@ -292,7 +292,12 @@ def _run(
         if chunks:
             runner = stack.enter_context(_runner(client, workers))
             batches = run_batches(
-                _evaluate_chunk, chunks, runner, retries=retries, every=_WRITE_EVERY_S
+                _evaluate_chunk,
+                chunks,
+                runner,
+                retries=retries,
+                every=_WRITE_EVERY_S,
+                group=None,  # short chunks share a Dask task (parallel.auto_group)
             )
             for batch in batches:
                 written: list[tuple[int, dict[str, NDArray[Any]]]] = []
