@@ -499,42 +499,33 @@ class ResultStore:
     def write_many(self, chunks: Sequence[tuple[int, Mapping[str, NDArray[Any]]]]) -> None:
         """Write several chunks' values, their digests, then their done flags.
 
-        Chunks next to each other are written as one run of points (whole rows of the
-        grid in one slice, zarr writing their files concurrently); flags go last, so a
-        cut leaves no chunk flagged done without its values.
+        One zarr write per array for the whole batch (zarr reads and rewrites each file
+        it touches once, several at a time); flags go last, so a cut leaves no chunk
+        flagged done without its values.
         """
         if not chunks:
             return
         order = sorted(chunks, key=lambda item: item[0])
         bounds = _bounds(self.n_points, self.chunk_size)
-        runs: list[list[tuple[int, Mapping[str, NDArray[Any]]]]] = []
-        for item in order:
-            if runs and runs[-1][-1][0] + 1 == item[0]:
-                runs[-1].append(item)
-            else:
-                runs.append([item])
-        digests = np.zeros((len(order), len(self._names)), dtype=np.uint64)
-        row = 0
-        for run in runs:
-            a = bounds[run[0][0]][0]
-            b = bounds[run[-1][0]][1]
-            for k, name in enumerate(self._names):
-                parts = [_as_stored(self._dtypes[name], values[name]) for _, values in run]
-                for j, (chunk, _) in enumerate(run):
-                    digests[row + j, k] = _digest(chunk, name, parts[j])
-                data = np.concatenate(parts)
-                if len(data) != b - a:
-                    raise StoreError(
-                        f"{self.path}: {name} holds {len(data)} values for points {a}-{b - 1}"
-                    )
-                _write_points(self._group[name], self.grid_shape, a, b, data)
-            row += len(run)
         index = np.asarray([chunk for chunk, _ in order])
-        for run_index in _runs(index):
-            rows = np.flatnonzero(np.isin(index, run_index))
-            self._meta[_DIGEST][run_index[0] : run_index[-1] + 1] = digests[rows]
-        for run_index in _runs(index):
-            self._meta[_DONE][run_index[0] : run_index[-1] + 1] = True
+        points = np.concatenate([np.arange(*bounds[chunk]) for chunk in index.tolist()])
+        digests = np.zeros((len(order), len(self._names)), dtype=np.uint64)
+        for k, name in enumerate(self._names):
+            parts = [_as_stored(self._dtypes[name], values[name]) for _, values in order]
+            for j, (chunk, _) in enumerate(order):
+                a, b = bounds[chunk]
+                if len(parts[j]) != b - a:
+                    raise StoreError(
+                        f"{self.path}: {name} holds {len(parts[j])} values for points {a}-{b - 1}"
+                    )
+                digests[j, k] = _digest(chunk, name, parts[j])
+            _write_points(self._group[name], self.grid_shape, points, np.concatenate(parts))
+        if index[-1] - index[0] + 1 == len(index):  # one run of chunks: slices
+            self._meta[_DIGEST][index[0] : index[-1] + 1] = digests
+            self._meta[_DONE][index[0] : index[-1] + 1] = True
+        else:
+            self._meta[_DIGEST].oindex[index, :] = digests
+            self._meta[_DONE].oindex[index] = True
 
     def read(self) -> dict[str, tuple[NDArray[Any], dict[str, Any]]]:
         """Every variable in point order (C order over the grid) with its attributes (not
@@ -609,27 +600,27 @@ def _flat(values: NDArray[Any], grid_ndim: int = 0) -> NDArray[Any]:
     return values.reshape(-1, *values.shape[grid_ndim:])
 
 
-def _write_points(array: Any, shape: tuple[int, ...], a: int, b: int, data: NDArray[Any]) -> None:
-    """Write points ``a`` to ``b - 1`` (C order over the grid ``shape``) of ``array``.
+def _write_points(
+    array: Any, shape: tuple[int, ...], points: NDArray[np.int64], data: NDArray[Any]
+) -> None:
+    """Write the values of ``points`` (sorted indices, C order over the grid ``shape``).
 
-    Whole rows of the first dimension go in one slice; a part row at either end by
-    coordinates (zarr reads and rewrites the files it shares with other points).
+    One run of whole rows of the first dimension goes in one slice; anything else by
+    coordinates, in one call (zarr reads and rewrites each file it shares with other
+    points once).
     """
     inner = math.prod(shape[1:])
     extra = data.shape[1:]
-    head = min(b, -(-a // inner) * inner)  # the end of the part row that a starts in
-    tail = max(head, b // inner * inner)  # the start of the part row that b ends in
-    for lo, hi in ((a, head), (tail, b)):
-        if hi > lo:
-            index = np.unravel_index(np.arange(lo, hi), shape)
-            if extra:  # a per-joint variable: every value of each point
-                n = math.prod(extra)
-                rest = np.unravel_index(np.tile(np.arange(n), hi - lo), extra)
-                index = (*(np.repeat(i, n) for i in index), *rest)
-            array.vindex[index] = data[lo - a : hi - a].reshape(-1)
-    if tail > head:
-        rows = data[head - a : tail - a]
-        array[head // inner : tail // inner] = rows.reshape(-1, *shape[1:], *extra)
+    a, b = int(points[0]), int(points[-1]) + 1
+    if b - a == len(points) and a % inner == 0 and b % inner == 0:
+        array[a // inner : b // inner] = data.reshape(-1, *shape[1:], *extra)
+        return
+    index = np.unravel_index(points, shape)
+    if extra:  # a per-point vector: every value of each point
+        n = math.prod(extra)
+        rest = np.unravel_index(np.tile(np.arange(n), len(points)), extra)
+        index = (*(np.repeat(i, n) for i in index), *rest)
+    array.vindex[index] = data.reshape(-1)
 
 
 def _runs(index: NDArray[Any]) -> list[list[int]]:

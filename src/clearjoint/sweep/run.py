@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
+import time
 import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
@@ -50,6 +52,30 @@ SERIAL = "serial"
 #: Seconds at least between two writes to the store on a Dask client (results in between
 #: are held by the client, their futures let go): a few large writes, not one a chunk.
 _WRITE_EVERY_S = 1.0
+
+#: Seconds of waiting at least per second spent writing the store: writes of many chunks
+#: cost about as much as writes of few (a zarr file is rewritten whole), so the pause
+#: between two grows with what the last one took, keeping the client free for Dask.
+_WRITE_SHARE = 4.0
+
+
+class _Pace:
+    """When the next batch of results is due to be written (see :data:`_WRITE_SHARE`)."""
+
+    def __init__(self) -> None:
+        self.last = -math.inf  # the first batch is written at once
+        self.cost = 0.0
+
+    def due(self) -> bool:
+        return time.monotonic() - self.last >= max(_WRITE_EVERY_S, _WRITE_SHARE * self.cost)
+
+    @contextlib.contextmanager
+    def timed(self) -> Iterator[None]:
+        start = time.monotonic()
+        yield
+        self.last = time.monotonic()
+        self.cost = self.last - start
+
 
 #: Longest reason kept in ``status`` for a failed point.
 _REASON_CHARS = 300
@@ -266,14 +292,14 @@ def _run(
     if store is not None:
         done = store.done_chunks()
         todo = [i for i in todo if i not in done]
-    drawn = sweep.drawn()
     names = _column_names(sweep)
+    points = _point_values(sweep, sweep.drawn(), 0, sweep.n_points)  # once: O(n), not O(n^2)
     chunks = [
         _Chunk(
             task=sweep.task,
             base=sweep.base,
             names=names,
-            values=_point_values(sweep, drawn, *bounds[i]),
+            values=points[bounds[i][0] : bounds[i][1]],
             first=bounds[i][0],
             seed=sweep.seed,
             outputs=sweep.outputs,
@@ -299,23 +325,39 @@ def _run(
                 every=_WRITE_EVERY_S,
                 group=None,  # short chunks share a Dask task (parallel.auto_group)
             )
-            for batch in batches:
-                written: list[tuple[int, dict[str, NDArray[Any]]]] = []
-                for outcome in batch:
-                    chunk = todo[outcome.index]
-                    if outcome.error is not None or outcome.result is None:
-                        error = outcome.error
-                        failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
-                        continue
-                    written.append((chunk, outcome.result))
+            pending: list[tuple[int, dict[str, NDArray[Any]]]] = []
+            pace = _Pace()
+
+            def store_pending() -> None:
+                nonlocal finished
+                written = list(pending)
+                pending.clear()
                 if store is not None and lock is not None:
                     lock.check()
-                    store.write_many(written)
+                    with pace.timed():
+                        store.write_many(written)
                 else:
                     in_memory.update(written)
                 finished += sum(bounds[c][1] - bounds[c][0] for c, _ in written)
                 if progress and written:
                     progress(finished, sweep.n_points)
+
+            try:
+                for batch in batches:
+                    for outcome in batch:
+                        chunk = todo[outcome.index]
+                        if outcome.error is not None or outcome.result is None:
+                            error = outcome.error
+                            failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
+                            continue
+                        pending.append((chunk, outcome.result))
+                    if store is None or pace.due():
+                        store_pending()
+            except KeyboardInterrupt:  # what has come back is kept: stored before stopping
+                if pending:
+                    store_pending()
+                raise
+            store_pending()
     if failures:
         where = (
             f"; the others are in {store.path}: finish with --resume" if store is not None else ""
