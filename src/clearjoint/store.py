@@ -565,14 +565,15 @@ class ResultStore:
             for name in self._names
         }
 
-    def write_counts(self) -> None:
-        """Write ``points_failed`` and ``points_missing`` (from ``status``) into the store's
-        attributes, and consolidate its metadata again, so that a plain ``xarray.open_zarr``
-        reads them as of now."""
-        try:
-            status = _flat(np.asarray(self._group["status"][...]), self.grid_ndim)
-        except Exception:  # damaged: the next resume or open says so
-            return
+    def write_counts(self, status: NDArray[Any] | None = None) -> None:
+        """Write ``points_failed`` and ``points_missing`` (from ``status``, read from the
+        store if not given) into the store's attributes, and consolidate its metadata
+        again, so that a plain ``xarray.open_zarr`` reads them as of now."""
+        if status is None:
+            try:
+                status = np.asarray(self._group["status"][...])
+            except Exception:  # damaged: the next resume or open says so
+                return
         failed, missing = status_counts(status)
         self._group.attrs.update({"points_failed": failed, "points_missing": missing})
         _consolidate(self.path)
