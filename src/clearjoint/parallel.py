@@ -54,6 +54,7 @@ __all__ = [
     "auto_group",
     "chunk_bounds",
     "dask_client",
+    "is_dask_client",
     "jobqueue_client",
     "point_seed",
     "probe_scheduler",
@@ -112,7 +113,7 @@ class Finished(Generic[R]):
     error: BaseException | None = None
 
 
-def _is_dask_client(runner: Any) -> bool:
+def is_dask_client(runner: Any) -> bool:
     """True for a distributed.Client or any subclass of it (never imports distributed)."""
     distributed = sys.modules.get("distributed")
     return distributed is not None and isinstance(runner, distributed.Client)
@@ -194,7 +195,7 @@ def run_batches(
         raise ParameterError(f"window must be >= 1, got {window}")
     if group is not None and group < 1:
         raise ParameterError(f"group must be >= 1, got {group}")
-    if not _is_dask_client(runner):
+    if not is_dask_client(runner):
         for outcome in run_unordered(function, arguments, runner):
             yield [outcome]
         return
@@ -310,7 +311,7 @@ def run_unordered(
             except Exception as exc:
                 yield Finished(index, None, exc)
         return
-    if _is_dask_client(runner):
+    if is_dask_client(runner):
         for batch in run_batches(function, arguments, runner):
             yield from batch
         return

@@ -31,6 +31,7 @@ from clearjoint.parallel import (
     Variable,
     chunk_bounds,
     dask_client,
+    is_dask_client,
     jobqueue_client,
     point_seed,
     run_batches,
@@ -75,6 +76,62 @@ class _Pace:
         yield
         self.last = time.monotonic()
         self.cost = self.last - start
+
+
+class _Writer:
+    """Writes batches of results in a thread of its own, in order, one at a time.
+
+    The first error it meets (a store in use by another client, a full disk) is raised
+    by the next :meth:`put` or by :meth:`close`; batches after it are not written.
+    """
+
+    def __init__(self, write: Callable[[Any], None]) -> None:
+        import queue
+        import threading
+
+        self._write = write
+        self._queue: queue.Queue[Any] = queue.Queue()
+        self._busy = threading.Event()
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._loop, name="clearjoint-store", daemon=True)
+        self._thread.start()
+
+    def _loop(self) -> None:
+        while True:
+            batch = self._queue.get()
+            if batch is None:
+                return
+            try:
+                if self._error is None:
+                    self._write(batch)
+            except BaseException as exc:  # raised in the caller's thread
+                self._error = exc
+            finally:
+                self._busy.clear()
+
+    def _raise(self) -> None:
+        if self._error is not None:
+            error, self._error = self._error, None
+            raise error
+
+    def idle(self) -> bool:
+        """True when no batch is being written."""
+        return not self._busy.is_set()
+
+    def put(self, batch: Any) -> None:
+        """Hand over a batch (raising a past write's error first)."""
+        self._raise()
+        if batch:
+            self._busy.set()
+            self._queue.put(batch)
+
+    def close(self, *, quiet: bool = False) -> None:
+        """Write what was handed over, stop the thread, raise a write's error (not if
+        ``quiet``: the caller is ending with an error of its own)."""
+        self._queue.put(None)
+        self._thread.join()
+        if not quiet:
+            self._raise()
 
 
 #: Longest reason kept in ``status`` for a failed point.
@@ -329,10 +386,8 @@ def _run(
             pending: list[tuple[int, dict[str, NDArray[Any]]]] = []
             pace = _Pace()
 
-            def store_pending() -> None:
+            def store_batch(written: list[tuple[int, dict[str, NDArray[Any]]]]) -> None:
                 nonlocal finished
-                written = list(pending)
-                pending.clear()
                 if store is not None and lock is not None:
                     lock.check()
                     with pace.timed():
@@ -343,6 +398,15 @@ def _run(
                 if progress and written:
                     progress(finished, sweep.n_points)
 
+            def take() -> list[tuple[int, dict[str, NDArray[Any]]]]:
+                written = list(pending)
+                pending.clear()
+                return written
+
+            # on a Dask client the store is written by a thread of its own, so that the
+            # client goes on fetching results (and the scheduler, in this process for a
+            # LocalCluster, on scheduling) while zarr writes
+            writer = _Writer(store_batch) if store is not None and is_dask_client(runner) else None
             try:
                 for batch in batches:
                     for outcome in batch:
@@ -352,13 +416,26 @@ def _run(
                             failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
                             continue
                         pending.append((chunk, outcome.result))
-                    if store is None or pace.due():
-                        store_pending()
-            except KeyboardInterrupt:  # what has come back is kept: stored before stopping
-                if pending:
-                    store_pending()
+                    if writer is not None:
+                        if pace.due() and writer.idle():
+                            writer.put(take())
+                    elif store is None or pace.due():
+                        store_batch(take())
+                if writer is not None:
+                    writer.put(take())
+                else:
+                    store_batch(take())
+            except BaseException as exc:
+                if isinstance(exc, KeyboardInterrupt) and pending:  # what has come back is
+                    if writer is None:  # kept: stored before stopping
+                        store_batch(take())
+                    else:
+                        writer.put(take())
+                if writer is not None:  # what was handed over is written, then the error
+                    writer.close(quiet=True)  # the run ends with, never one of the writer's
                 raise
-            store_pending()
+            if writer is not None:
+                writer.close()
         if store is not None and not failures:  # checked once, and counted from that read
             flat = store.read()
             store.write_counts(flat["status"][0])
