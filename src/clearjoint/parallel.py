@@ -237,11 +237,7 @@ def run_batches(
             for i, (ok, value) in enumerate(result)
         ]
 
-    # results fetched by the client's event loop as each task ends, not by a blocking
-    # gather in this thread: a slow fetch never holds up the next batch
-    queue = dask_as_completed(  # type: ignore[no-untyped-call]
-        submit(min(window, len(starts))), with_results=True, raise_errors=False
-    )
+    queue = dask_as_completed(submit(min(window, len(starts))))  # type: ignore[no-untyped-call]
     collected: list[Finished[R]] = []
     last = time.monotonic()
     try:
@@ -253,15 +249,17 @@ def run_batches(
             else:
                 time.sleep(0.005)
                 batch = []
-            for f, result in batch:  # a status read once: it may change meanwhile
-                if f.status == "finished":
-                    collected += outcomes(where.pop(f.key), result, None)
-                else:  # lost, cancelled or raised
-                    collected += outcomes(where.pop(f.key), None, _failure(f))
+            finished = [f for f in batch if f.status == "finished"]
+            keys = {f.key for f in finished}  # (a status read once: it may change meanwhile)
+            failed = [f for f in batch if f.key not in keys]  # lost, cancelled or raised
+            results = runner.gather(finished) if finished else []  # one message a batch
+            for f, result in zip(finished, results, strict=True):
+                collected += outcomes(where.pop(f.key), result, None)
+            for f in failed:
+                collected += outcomes(where.pop(f.key), None, _failure(f))
             # the futures: let go once their results are here (no name left holding one,
             # or the scheduler keeps its result and recomputes it if its worker dies)
-            del batch
-            f = result = None
+            del batch, finished, failed, results
             if submitted < len(starts) and len(where) < window // 2 + 1:
                 queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
             if collected and (not where or time.monotonic() - last >= every):
