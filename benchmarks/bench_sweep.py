@@ -25,6 +25,7 @@ about 50 ms; a sweep killed midway and resumed equal, bit for bit, to one run wh
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -200,14 +201,32 @@ def _timed_store_run(sweep: Sweep, client: object) -> tuple[float, float]:
         return time.perf_counter() - t0, time.process_time() - c0
 
 
-def store_targets(scale: float = 1.0) -> None:
-    """Issue 27's targets side by side in one run: client overhead, 2 workers, 200 threads."""
+def _median(values: list[float]) -> float:
+    return float(np.median(values))
+
+
+def _worker_threads_env() -> dict[str, str | None]:
+    """What a worker process's BLAS / OpenMP / numba thread counts are set to."""
+    keys = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
+    return {k: os.environ.get(k) for k in keys}
+
+
+def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
+    """Issue 27's targets side by side in one run: client overhead, 2 workers, 200 threads.
+
+    A *task* here is what the issue counts: one chunk of the sweep (``chunk_size`` points;
+    at ``chunk_size = 1``, one point). The client groups short chunks into fewer Dask tasks
+    (clearjoint.parallel.auto_group): both counts are printed. Every figure is the median
+    of ``rounds`` runs, the configurations alternating within a round, so that a change
+    of the machine's load falls on all of them alike.
+    """
     from dataclasses import replace
 
+    from clearjoint.parallel import auto_group
     from clearjoint.sweep.run import _Chunk, _column_names, _evaluate_chunk, _point_values
 
-    load = os.getloadavg()[0]
-    print(f"load average before: {load:.1f} on {os.cpu_count()} cores (shared machine)")
+    print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (shared)")
+    print(f"each figure: the median of {rounds} rounds")
     # 1. overhead a task: examples/tolerance.toml at chunk_size = 1 against a plain loop
     sweep = replace(Sweep.from_toml(EXAMPLES / "tolerance.toml"), chunk_size=1)
     if scale < 1:
@@ -225,58 +244,99 @@ def store_targets(scale: float = 1.0) -> None:
         sweep.fixed,
     )
     _evaluate_chunk(replace(every, values=every.values[:4]))  # compiled and warm
-    t0 = time.perf_counter()
-    _evaluate_chunk(every)
-    loop = time.perf_counter() - t0
     n = sweep.n_points
-    print(f"1. {n} points of tolerance.toml (chunk_size = 1): plain loop {loop:.2f} s")
-    for workers in (1, 2):
-        with dask_client(workers=workers) as client:
+    loops: list[float] = []
+    walls: dict[int, list[float]] = {1: [], 2: []}
+    cpus: dict[int, list[float]] = {1: [], 2: []}
+    bare: dict[int, list[float]] = {1: [], 2: []}
+    with dask_client(workers=1) as one, dask_client(workers=2) as two:
+        clients = {1: one, 2: two}
+        for workers, client in clients.items():
             client.wait_for_workers(workers)
-            warm = replace(sweep, samples=2 * workers)
-            _timed_store_run(warm, client)  # workers and the store's imports warm
-            wall, cpu = _timed_store_run(sweep, client)
-            # Dask alone, side by side: as many no-op tasks, one client.map and one gather
-            c0, t0 = time.process_time(), time.perf_counter()
-            client.gather(client.map(_noop, range(n), pure=False))
-            bare, bare_cpu = time.perf_counter() - t0, time.process_time() - c0
+            _timed_store_run(replace(sweep, samples=2 * workers), client)  # warm
+        env = two.run(_worker_threads_env)
+        for _ in range(rounds):
+            t0 = time.perf_counter()
+            _evaluate_chunk(every)
+            loops.append(time.perf_counter() - t0)
+            for workers, client in clients.items():
+                wall, cpu = _timed_store_run(sweep, client)
+                walls[workers].append(wall)
+                cpus[workers].append(cpu)
+                t0 = time.perf_counter()  # Dask alone: one no-op Dask task per chunk
+                client.gather(client.map(_noop, range(n), pure=False))
+                bare[workers].append(time.perf_counter() - t0)
+    loop = _median(loops)
+    print(f"   worker processes' thread settings: {sorted(set(map(str, env.values())))}")
+    print(f"1. {n} tasks (chunks of 1 point) of tolerance.toml: plain loop {loop:.2f} s")
+    for workers in (1, 2):
+        wall = _median(walls[workers])
         over = (wall - loop / workers) / n
+        group = auto_group(n, workers)
         print(
-            f"   {workers} worker(s) with the store: {wall:.2f} s, {n / wall:.0f} points/s; "
-            f"overhead {over * 1e3:.2f} ms a task (wall - loop/{workers}), client CPU "
-            f"{cpu / n * 1e3:.2f} ms a task; target <= 2 ms"
+            f"   {workers} worker(s), with the store: {wall:.2f} s, {n / wall:.0f} tasks/s, "
+            f"as {-(-n // group)} Dask tasks of {group} chunks; overhead "
+            f"{over * 1e3:.2f} ms a task (wall - loop/{workers}), client CPU "
+            f"{_median(cpus[workers]) / n * 1e3:.2f} ms a task; target <= 2 ms"
         )
         print(
-            f"   Dask alone, {n} no-op tasks (map + gather): {bare:.2f} s, "
-            f"{bare / n * 1e3:.2f} ms a task, client CPU {bare_cpu / n * 1e3:.2f} ms a task"
+            f"   {workers} worker(s), Dask alone ({n} no-op Dask tasks, map + gather): "
+            f"{_median(bare[workers]) / n * 1e3:.2f} ms a Dask task"
         )
-    # 2. a CPU-bound study, chunks of 0.5 s: 2 workers against 1
+    # 2. a CPU-bound study, chunks of 0.5 s: 2 workers against 1, with a control
     spin = spin_sweep(max(40, int(200 * scale)), 0.050, 10)
-    walls = {}
-    for workers in (1, 2):
-        with dask_client(workers=workers) as client:
-            client.wait_for_workers(workers)
-            client.run(_warm)
-            walls[workers], _ = _timed_store_run(spin, client)
+    times: dict[str, list[float]] = {"1 worker": [], "2 workers": [], "pool 1": [], "pool 2": []}
+    with contextlib.ExitStack() as stack:
+        runners: dict[str, object] = {
+            "1 worker": stack.enter_context(dask_client(workers=1)),
+            "2 workers": stack.enter_context(dask_client(workers=2)),
+            "pool 1": stack.enter_context(ProcessPoolExecutor(1)),
+            "pool 2": stack.enter_context(ProcessPoolExecutor(2)),
+        }
+        for key, runner in runners.items():
+            if key.endswith(("worker", "workers")):
+                runner.wait_for_workers(1 if key == "1 worker" else 2)  # type: ignore[attr-defined]
+                runner.run(_warm)  # type: ignore[attr-defined]
+            run_sweep(spin_sweep(4, 0.0, 1), client=runner)  # warm, end to end
+        loads = []
+        for _ in range(rounds):
+            for key, runner in runners.items():
+                times[key].append(_timed_store_run(spin, runner)[0])
+            loads.append(os.getloadavg()[0])
+    ratio = [a / b for a, b in zip(times["1 worker"], times["2 workers"], strict=True)]
+    control = [a / b for a, b in zip(times["pool 1"], times["pool 2"], strict=True)]
+    chunks = -(-spin.n_points // spin.chunk_size)
     print(
-        f"2. {spin.n_points} points of 50 ms CPU in chunks of 0.5 s, with the store: "
-        f"1 worker {walls[1]:.2f} s, 2 workers {walls[2]:.2f} s, "
-        f"{walls[1] / walls[2]:.2f}x; target >= 1.7x"
+        f"2. {chunks} tasks of 0.5 s CPU (10 points of 50 ms), with the store: 1 worker "
+        f"{_median(times['1 worker']):.2f} s, 2 workers {_median(times['2 workers']):.2f} s; "
+        f"2 workers / 1: median {_median(ratio):.2f}x (rounds: "
+        f"{', '.join(f'{r:.2f}' for r in ratio)}); target >= 1.7x"
+    )
+    print(
+        f"   control, the same sweep on a ProcessPoolExecutor (no Dask): 2 processes / 1: "
+        f"median {_median(control):.2f}x (rounds: {', '.join(f'{r:.2f}' for r in control)}); "
+        f"load average after each round: {', '.join(f'{x:.1f}' for x in loads)}"
     )
     # 3. a simulated cluster of 200 threads on 50 ms sleeps, chunk_size = 1
     sleeps = replace(spin_sweep(int(10_000 * scale), 0.050, 1), task=SLEEP)
+    m = sleeps.n_points
     with dask_client(workers=2, threads=100) as client:
         client.wait_for_workers(2)
         _timed_store_run(replace(sleeps, axes=(Axis("task.index", (0.0, 1.0), ""),)), client)
-        wall, cpu = _timed_store_run(sleeps, client)
-        t0 = time.perf_counter()
-        run_sweep(sleeps, client=client)
-        bare = time.perf_counter() - t0
+        stored, cpu, plain = [], [], []
+        for _ in range(rounds):
+            wall, used = _timed_store_run(sleeps, client)
+            stored.append(wall)
+            cpu.append(used)
+            t0 = time.perf_counter()
+            run_sweep(sleeps, client=client)
+            plain.append(time.perf_counter() - t0)
+    group = auto_group(m, 200)
     print(
-        f"3. {sleeps.n_points} tasks of 50 ms sleep on 2 workers x 100 threads: with the store "
-        f"{sleeps.n_points / wall:.0f} tasks/s (client CPU {cpu / sleeps.n_points * 1e3:.2f} ms "
-        f"a task), without it {sleeps.n_points / bare:.0f} tasks/s; target >= 2,000/s "
-        f"(4,000/s if the 200 threads were never idle)"
+        f"3. {m} tasks (chunks of 1 point) of a 50 ms sleep on 2 workers x 100 threads, as "
+        f"{-(-m // group)} Dask tasks of {group}: with the store {m / _median(stored):.0f} "
+        f"tasks/s (client CPU {_median(cpu) / m * 1e3:.2f} ms a task), without it "
+        f"{m / _median(plain):.0f} tasks/s; target >= 2,000/s (4,000/s: 200 threads never idle)"
     )
     print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
@@ -352,9 +412,12 @@ if __name__ == "__main__":  # LocalCluster workers are spawned processes: keep t
     parser.add_argument(
         "--smoke", action="store_true", help="tiny sizes: checks it runs, no figures"
     )
+    parser.add_argument(
+        "--rounds", type=int, default=3, help="--store-targets: rounds per figure (median kept)"
+    )
     options = parser.parse_args()
     if options.store_targets:
-        store_targets(0.05 if options.smoke else 1.0)
+        store_targets(0.05 if options.smoke else 1.0, 1 if options.smoke else options.rounds)
         raise SystemExit(0)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     sizes = [(cost, points // 20, chunk // 10) for cost, points, chunk in CASES]

@@ -182,7 +182,7 @@ def test_a_damaged_done_flag_is_recomputed_and_never_read_as_done(
     sweep_file, whole, reference = finished
     copy = tmp_path / "copy.zarr"
     shutil.copytree(whole, copy)
-    _chunk_file(copy, "chunk_done", 2).write_bytes(b"\x00")
+    _chunk_file(copy, "clearjoint/chunk_done", 2).write_bytes(b"\x00")  # in its subgroup
     with pytest.raises(StoreError, match=r"chunk 2 \(point 4\) is damaged: its done flag"):
         open_sweep(copy)
     with warnings.catch_warnings(record=True):

@@ -44,13 +44,17 @@ __all__ = [
     "DASK_WINDOW",
     "DEFAULT_SCHEDULER_PORT",
     "JOB_QUEUES",
+    "MAX_GROUP",
     "PROBE_TIMEOUT_S",
+    "TASKS_PER_THREAD",
     "ChunkFailedError",
     "Finished",
     "Runner",
     "SchedulerError",
+    "auto_group",
     "chunk_bounds",
     "dask_client",
+    "is_dask_client",
     "jobqueue_client",
     "point_seed",
     "probe_scheduler",
@@ -109,7 +113,7 @@ class Finished(Generic[R]):
     error: BaseException | None = None
 
 
-def _is_dask_client(runner: Any) -> bool:
+def is_dask_client(runner: Any) -> bool:
     """True for a distributed.Client or any subclass of it (never imports distributed)."""
     distributed = sys.modules.get("distributed")
     return distributed is not None and isinstance(runner, distributed.Client)
@@ -117,6 +121,35 @@ def _is_dask_client(runner: Any) -> bool:
 
 #: Most tasks a Dask client keeps submitted at once (more are submitted as these end).
 DASK_WINDOW = 20_000
+
+#: With ``group=None``: Dask tasks per worker thread at least, when arguments are grouped
+#: (enough for the threads to share the work evenly as tasks end at different times).
+TASKS_PER_THREAD = 4
+
+#: With ``group=None``: arguments per Dask task at most.
+MAX_GROUP = 64
+
+
+def auto_group(n_arguments: int, threads: int) -> int:
+    """Arguments per Dask task: ``n // (TASKS_PER_THREAD * threads)``, within 1..MAX_GROUP.
+
+    Dask costs a few milliseconds a task on the client and the scheduler (more on a
+    loaded machine); grouping many short tasks divides that cost, while every thread
+    still gets :data:`TASKS_PER_THREAD` tasks or more to balance the load.
+    """
+    return max(1, min(MAX_GROUP, n_arguments // (TASKS_PER_THREAD * max(1, threads))))
+
+
+def _call_each(function: Callable[[A], R], part: Sequence[A]) -> list[tuple[bool, Any]]:
+    """One Dask task of several arguments: ``(True, result)`` or ``(False, error)`` each,
+    so that an argument that raises leaves the others' results whole."""
+    out: list[tuple[bool, Any]] = []
+    for argument in part:
+        try:
+            out.append((True, function(argument)))
+        except Exception as exc:
+            out.append((False, exc))
+    return out
 
 
 def run_batches(
@@ -127,6 +160,7 @@ def run_batches(
     retries: int = 0,
     window: int = DASK_WINDOW,
     every: float = 0.0,
+    group: int | None = 1,
 ) -> Iterator[list[Finished[R]]]:
     """Yield the tasks' :class:`Finished` outcomes in batches, as they end.
 
@@ -144,35 +178,66 @@ def run_batches(
         On a Dask client: times a task is run again after its worker is lost or it
         raises (``client.map(retries=...)``). Ignored elsewhere.
     window : int
-        On a Dask client: most tasks submitted and not yet yielded.
+        On a Dask client: most Dask tasks submitted and not yet yielded.
     every : float
         On a Dask client: seconds at least between two batches (the results that
         came meanwhile are fetched and held), so that a caller writing each batch
         writes few large ones; the last batch comes as soon as the last task ends.
+    group : int or None
+        On a Dask client: consecutive arguments run in one Dask task (default 1);
+        None chooses by :func:`auto_group` from the client's worker threads. Each
+        argument keeps its own outcome (one that raises fails alone), but a worker
+        lost fails (or, with ``retries``, runs again) its whole task.
     """
     if retries < 0:
         raise ParameterError(f"retries must be >= 0 (--retries), got {retries}")
     if window < 1:
         raise ParameterError(f"window must be >= 1, got {window}")
-    if not _is_dask_client(runner):
+    if group is not None and group < 1:
+        raise ParameterError(f"group must be >= 1, got {group}")
+    if not is_dask_client(runner):
         for outcome in run_unordered(function, arguments, runner):
             yield [outcome]
         return
+    from functools import partial
+
     from distributed import as_completed as dask_as_completed
 
-    where: dict[str, int] = {}  # key -> index, of the futures submitted and not yet yielded
-    submitted = 0
+    if group is None:
+        group = auto_group(len(arguments), sum(runner.nthreads().values()))
+    starts = range(0, len(arguments), group)  # the first argument of each Dask task
+    grouped = group > 1
+    task = partial(_call_each, function) if grouped else function
+    where: dict[str, int] = {}  # key -> Dask task, of the futures submitted and not yet yielded
+    submitted = 0  # Dask tasks
 
     def submit(count: int) -> list[Any]:
         nonlocal submitted
-        part = arguments[submitted : submitted + count]
-        futures = runner.map(function, part, pure=False, retries=retries or None)
+        first = starts[submitted : submitted + count]
+        if grouped:
+            part: Sequence[Any] = [arguments[a : a + group] for a in first]
+        else:
+            part = arguments[first[0] : first[-1] + 1] if len(first) else []
+        futures = runner.map(task, part, pure=False, retries=retries or None)
         for i, future in enumerate(futures):
             where[future.key] = submitted + i
         submitted += len(part)
         return list(futures)
 
-    queue = dask_as_completed(submit(min(window, len(arguments))))  # type: ignore[no-untyped-call]
+    def outcomes(index: int, result: Any, error: BaseException | None) -> list[Finished[R]]:
+        """The outcome of each argument of Dask task ``index``."""
+        first = starts[index]
+        if not grouped:
+            return [Finished(first, result, error)]
+        if error is not None:
+            count = min(group, len(arguments) - first)
+            return [Finished(first + i, None, error) for i in range(count)]
+        return [
+            Finished(first + i, value if ok else None, None if ok else value)
+            for i, (ok, value) in enumerate(result)
+        ]
+
+    queue = dask_as_completed(submit(min(window, len(starts))))  # type: ignore[no-untyped-call]
     collected: list[Finished[R]] = []
     last = time.monotonic()
     try:
@@ -188,15 +253,14 @@ def run_batches(
             keys = {f.key for f in finished}  # (a status read once: it may change meanwhile)
             failed = [f for f in batch if f.key not in keys]  # lost, cancelled or raised
             results = runner.gather(finished) if finished else []  # one message a batch
-            collected += [
-                Finished(where.pop(f.key), result)
-                for f, result in zip(finished, results, strict=True)
-            ]
-            collected += [Finished(where.pop(f.key), None, _failure(f)) for f in failed]
+            for f, result in zip(finished, results, strict=True):
+                collected += outcomes(where.pop(f.key), result, None)
+            for f in failed:
+                collected += outcomes(where.pop(f.key), None, _failure(f))
             # the futures: let go once their results are here (no name left holding one,
             # or the scheduler keeps its result and recomputes it if its worker dies)
             del batch, finished, failed, results
-            if submitted < len(arguments) and len(where) < window // 2 + 1:
+            if submitted < len(starts) and len(where) < window // 2 + 1:
                 queue.update(submit(window - len(where)))  # type: ignore[no-untyped-call]
             if collected and (not where or time.monotonic() - last >= every):
                 yield collected
@@ -247,7 +311,7 @@ def run_unordered(
             except Exception as exc:
                 yield Finished(index, None, exc)
         return
-    if _is_dask_client(runner):
+    if is_dask_client(runner):
         for batch in run_batches(function, arguments, runner):
             yield from batch
         return

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import time
 import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
@@ -30,11 +31,12 @@ from clearjoint.parallel import (
     Variable,
     chunk_bounds,
     dask_client,
+    is_dask_client,
     jobqueue_client,
     point_seed,
     run_batches,
 )
-from clearjoint.store import StoreWarning
+from clearjoint.store import Grid, StoreWarning, status_counts
 from clearjoint.sweep.file import Sweep
 from clearjoint.sweep.tasks import Task
 
@@ -51,6 +53,86 @@ SERIAL = "serial"
 #: Seconds at least between two writes to the store on a Dask client (results in between
 #: are held by the client, their futures let go): a few large writes, not one a chunk.
 _WRITE_EVERY_S = 1.0
+
+#: Seconds of waiting at least per second spent writing the store: writes of many chunks
+#: cost about as much as writes of few (a zarr file is rewritten whole), so the pause
+#: between two grows with what the last one took, keeping the client free for Dask.
+_WRITE_SHARE = 4.0
+
+
+class _Pace:
+    """When the next batch of results is due to be written (see :data:`_WRITE_SHARE`)."""
+
+    def __init__(self) -> None:
+        self.last = -math.inf  # the first batch is written at once
+        self.cost = 0.0
+
+    def due(self) -> bool:
+        return time.monotonic() - self.last >= max(_WRITE_EVERY_S, _WRITE_SHARE * self.cost)
+
+    @contextlib.contextmanager
+    def timed(self) -> Iterator[None]:
+        start = time.monotonic()
+        yield
+        self.last = time.monotonic()
+        self.cost = self.last - start
+
+
+class _Writer:
+    """Writes batches of results in a thread of its own, in order, one at a time.
+
+    The first error it meets (a store in use by another client, a full disk) is raised
+    by the next :meth:`put` or by :meth:`close`; batches after it are not written.
+    """
+
+    def __init__(self, write: Callable[[Any], None]) -> None:
+        import queue
+        import threading
+
+        self._write = write
+        self._queue: queue.Queue[Any] = queue.Queue()
+        self._busy = threading.Event()
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._loop, name="clearjoint-store", daemon=True)
+        self._thread.start()
+
+    def _loop(self) -> None:
+        while True:
+            batch = self._queue.get()
+            if batch is None:
+                return
+            try:
+                if self._error is None:
+                    self._write(batch)
+            except BaseException as exc:  # raised in the caller's thread
+                self._error = exc
+            finally:
+                self._busy.clear()
+
+    def _raise(self) -> None:
+        if self._error is not None:
+            error, self._error = self._error, None
+            raise error
+
+    def idle(self) -> bool:
+        """True when no batch is being written."""
+        return not self._busy.is_set()
+
+    def put(self, batch: Any) -> None:
+        """Hand over a batch (raising a past write's error first)."""
+        self._raise()
+        if batch:
+            self._busy.set()
+            self._queue.put(batch)
+
+    def close(self, *, quiet: bool = False) -> None:
+        """Write what was handed over, stop the thread, raise a write's error (not if
+        ``quiet``: the caller is ending with an error of its own)."""
+        self._queue.put(None)
+        self._thread.join()
+        if not quiet:
+            self._raise()
+
 
 #: Longest reason kept in ``status`` for a failed point.
 _REASON_CHARS = 300
@@ -121,34 +203,39 @@ def _column_names(sweep: Sweep) -> tuple[str, ...]:
 
 
 def _attrs(sweep: Sweep) -> dict[str, Any]:
+    """The Dataset's attributes (and the store's): what the sweep was, and how many points."""
     return {
         "title": f"clearjoint sweep: {sweep.task.name}",
         "task": sweep.task.name,
         "sweep_file": sweep.source,
         "base": str(getattr(sweep.base, "source", "")),
         "seed": sweep.seed,
-        "dims": json.dumps(list(sweep.dims)),
-        "shape": json.dumps(list(sweep.shape)),
-        "axes": json.dumps(
-            {a.name: {"values": list(a.values), "units": a.unit} for a in sweep.axes}
-        ),
-        "draws": json.dumps([d.name for d in sweep.draws]),
         "fixed": json.dumps(dict(sweep.fixed)),
-        "files": json.dumps(list(getattr(sweep.base, "files", []))),
+        "clearjoint_sweep_fingerprint": sweep.fingerprint,
+        "points": sweep.n_points,
     }
+
+
+def _grid(sweep: Sweep) -> Grid:
+    """The sweep's labelled grid: ``sample`` (with draws) and one dimension per axis, each
+    with its values; drawn values as coordinates over ``sample`` (and ``joint``)."""
+    coords: dict[str, tuple[tuple[str, ...], Any, dict[str, Any]]] = {}
+    if sweep.samples:
+        coords["sample"] = (("sample",), np.arange(sweep.samples), {})
+    for axis in sweep.axes:
+        coords[axis.name] = ((axis.name,), np.asarray(axis.values), {"units": axis.unit})
+    files = list(getattr(sweep.base, "files", []))
+    if files:  # a record set: its files beside the record index
+        coords["record"] = (("record",), np.arange(len(files)), {})
+        coords["file"] = (("record",), np.asarray(files, dtype=str), {})
+    for d, values in zip(sweep.draws, sweep.drawn().values(), strict=True):
+        dims = ("sample", "joint")[: values.ndim]
+        coords[d.name] = (dims, values, {"units": d.unit, "distribution": d.distribution})
+    return Grid(sweep.dims, sweep.shape, coords)
 
 
 def _variables(sweep: Sweep) -> list[Variable]:
     out = [Variable(name, "f8", {"units": sweep.task.outputs[name]}) for name in sweep.outputs]
-    out += [
-        Variable(
-            d.name,
-            "f8",
-            {"units": d.unit, "distribution": d.distribution},
-            shape=(d.per_joint,) if d.per_joint else (),
-        )
-        for d in sweep.draws
-    ]
     out.append(Variable("status", "str", {"description": "ok, or why the point failed"}))
     return out
 
@@ -233,7 +320,7 @@ def _open_or_create(sweep: Sweep, path: Path, *, resume: bool, force: bool) -> R
     """The sweep's store at ``path`` (its lock held): resumed and repaired, or made anew."""
     if resume and path.exists():
         store = ResultStore.open(path, fingerprint=sweep.fingerprint)
-        _repair(store)
+        _repair(store, sweep)
         return store
     return ResultStore.create(
         path,
@@ -243,6 +330,7 @@ def _open_or_create(sweep: Sweep, path: Path, *, resume: bool, force: bool) -> R
         variables=_variables(sweep),
         attrs=_attrs(sweep),
         force=force,
+        grid=_grid(sweep),
     )
 
 
@@ -261,14 +349,14 @@ def _run(
     if store is not None:
         done = store.done_chunks()
         todo = [i for i in todo if i not in done]
-    drawn = sweep.drawn()
     names = _column_names(sweep)
+    points = _point_values(sweep, sweep.drawn(), 0, sweep.n_points)  # once: O(n), not O(n^2)
     chunks = [
         _Chunk(
             task=sweep.task,
             base=sweep.base,
             names=names,
-            values=_point_values(sweep, drawn, *bounds[i]),
+            values=points[bounds[i][0] : bounds[i][1]],
             first=bounds[i][0],
             seed=sweep.seed,
             outputs=sweep.outputs,
@@ -281,33 +369,77 @@ def _run(
         progress(finished, sweep.n_points)
     in_memory: dict[int, dict[str, NDArray[Any]]] = {}
     failures: list[str] = []
-    sample = np.unravel_index(np.arange(sweep.n_points), sweep.shape)[0]
-    if chunks:
-        with _runner(client, workers) as runner:
+    counted = False  # the store's attributes count the points as stored
+    with contextlib.ExitStack() as stack:
+        if store is not None:  # its attributes count the points however the run ends
+            stack.callback(lambda: None if counted else store.write_counts())
+        if chunks:
+            runner = stack.enter_context(_runner(client, workers))
             batches = run_batches(
-                _evaluate_chunk, chunks, runner, retries=retries, every=_WRITE_EVERY_S
+                _evaluate_chunk,
+                chunks,
+                runner,
+                retries=retries,
+                every=_WRITE_EVERY_S,
+                group=None,  # short chunks share a Dask task (parallel.auto_group)
             )
-            for batch in batches:
-                written: list[tuple[int, dict[str, NDArray[Any]]]] = []
-                for outcome in batch:
-                    chunk = todo[outcome.index]
-                    if outcome.error is not None or outcome.result is None:
-                        error = outcome.error
-                        failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
-                        continue
-                    values = dict(outcome.result)
-                    a, b = bounds[chunk]
-                    for d in sweep.draws:
-                        values[d.name] = drawn[d.name][sample[a:b]]
-                    written.append((chunk, values))
+            pending: list[tuple[int, dict[str, NDArray[Any]]]] = []
+            pace = _Pace()
+
+            def store_batch(written: list[tuple[int, dict[str, NDArray[Any]]]]) -> None:
+                nonlocal finished
                 if store is not None and lock is not None:
                     lock.check()
-                    store.write_many(written)
+                    with pace.timed():
+                        store.write_many(written)
                 else:
                     in_memory.update(written)
                 finished += sum(bounds[c][1] - bounds[c][0] for c, _ in written)
                 if progress and written:
                     progress(finished, sweep.n_points)
+
+            def take() -> list[tuple[int, dict[str, NDArray[Any]]]]:
+                written = list(pending)
+                pending.clear()
+                return written
+
+            # on a Dask client the store is written by a thread of its own, so that the
+            # client goes on fetching results (and the scheduler, in this process for a
+            # LocalCluster, on scheduling) while zarr writes
+            writer = _Writer(store_batch) if store is not None and is_dask_client(runner) else None
+            try:
+                for batch in batches:
+                    for outcome in batch:
+                        chunk = todo[outcome.index]
+                        if outcome.error is not None or outcome.result is None:
+                            error = outcome.error
+                            failures.append(f"chunk {chunk}: {type(error).__name__}: {error}")
+                            continue
+                        pending.append((chunk, outcome.result))
+                    if writer is not None:
+                        if pace.due() and writer.idle():
+                            writer.put(take())
+                    elif store is None or pace.due():
+                        store_batch(take())
+                if writer is not None:
+                    writer.put(take())
+                else:
+                    store_batch(take())
+            except BaseException as exc:
+                if isinstance(exc, KeyboardInterrupt) and pending:  # what has come back is
+                    if writer is None:  # kept: stored before stopping
+                        store_batch(take())
+                    else:
+                        writer.put(take())
+                if writer is not None:  # what was handed over is written, then the error
+                    writer.close(quiet=True)  # the run ends with, never one of the writer's
+                raise
+            if writer is not None:
+                writer.close()
+        if store is not None and not failures:  # checked once, and counted from that read
+            flat = store.read()
+            store.write_counts(flat["status"][0])
+            counted = True
     if failures:
         where = (
             f"; the others are in {store.path}: finish with --resume" if store is not None else ""
@@ -316,19 +448,32 @@ def _run(
             f"{len(failures)} of {len(bounds)} chunks did not finish ({failures[0]}){where}"
         )
     if store is not None:
-        return _dataset(store.read(), store.attrs)
-    flat: dict[str, tuple[NDArray[Any], dict[str, Any]]] = {}
-    for var in _variables(sweep):
-        if var.name in drawn:
-            array = drawn[var.name][sample]
-        else:
-            array = np.concatenate([in_memory[i][var.name] for i in range(len(bounds))])
-        flat[var.name] = (array, dict(var.attrs))
-    return _dataset(flat, {**_attrs(sweep), "clearjoint_sweep_fingerprint": sweep.fingerprint})
+        # the values just checked, on the grid: what xarray.open_zarr reads (tested)
+        return _dataset(_grid(sweep), flat, store.attrs)
+    flat = {
+        var.name: (
+            np.concatenate([in_memory[i][var.name] for i in range(len(bounds))]),
+            dict(var.attrs),
+        )
+        for var in _variables(sweep)
+    }
+    return _dataset(_grid(sweep), flat, _attrs(sweep))
 
 
-def _repair(store: ResultStore) -> None:
-    """Unflag the store's damaged chunks, so that they are computed again; say so in one line."""
+def _repair(store: ResultStore, sweep: Sweep) -> None:
+    """Unflag the store's damaged chunks, so that they are computed again, and write its
+    damaged coordinates again; say so in one line each."""
+    coordinates = store.damaged_coordinates()
+    if coordinates:
+        store.write_coordinates(_grid(sweep))
+        name = min(coordinates)
+        warnings.warn(
+            StoreWarning(
+                f"{store.path}: writing {len(coordinates)} damaged coordinates again "
+                f"(first: {name}: it {coordinates[name]})"
+            ),
+            stacklevel=3,
+        )
     damaged = store.check()
     if not damaged:
         return
@@ -432,59 +577,48 @@ def run_sweep_file(
 
 
 def _dataset(
-    flat: Mapping[str, tuple[NDArray[Any], dict[str, Any]]], attrs: Mapping[str, Any]
+    grid: Grid, flat: Mapping[str, tuple[NDArray[Any], dict[str, Any]]], attrs: Mapping[str, Any]
 ) -> Any:
+    """The results as an xarray.Dataset: each variable over the grid, its coordinates, and
+    the counts of failed and missing points (as the store holds them)."""
     import xarray as xr
 
-    dims = tuple(json.loads(attrs["dims"]))
-    shape = tuple(json.loads(attrs["shape"]))
-    axes = json.loads(attrs["axes"])
-    drawn = set(json.loads(attrs["draws"]))
-    coords: dict[str, Any] = {
-        name: (name, np.asarray(spec["values"]), {"units": spec["units"]})
-        for name, spec in axes.items()
+    variables = {
+        name: (grid.dims, values.reshape(grid.shape), var_attrs)
+        for name, (values, var_attrs) in flat.items()
     }
-    if "sample" in dims:
-        coords["sample"] = ("sample", np.arange(shape[0]))
-    files = json.loads(attrs.get("files", "[]"))
-    if files:  # a record set: its files beside the record index
-        coords["record"] = ("record", np.arange(len(files)))
-        coords["file"] = ("record", np.asarray(files, dtype=str))
-    variables: dict[str, Any] = {}
-    for name, (values, var_attrs) in flat.items():
-        if name in drawn:
-            extra = values.shape[1:]  # (n_joints,) for a per-joint draw
-            full = values.reshape(shape + extra)
-            first = full.reshape(shape[0], -1, *extra)[:, 0]
-            coords[name] = (("sample", "joint")[: 1 + len(extra)], first, var_attrs)
-        else:
-            variables[name] = (dims, values.reshape(shape), var_attrs)
-    status = flat["status"][0]
-    ok = np.char.startswith(status.astype(str), "ok")
-    failed = int(np.count_nonzero(~ok & (status != "")))
-    missing = int(np.count_nonzero(status == ""))
-    keep = {
-        k: v
-        for k, v in attrs.items()
-        if k not in ("dims", "shape", "axes", "draws", "chunk_size", "files")
-    }
+    failed, missing = status_counts(flat["status"][0])
     return xr.Dataset(
         variables,
-        coords=coords,
-        attrs={
-            **keep,
-            "points": math.prod(shape),
-            "points_failed": failed,
-            "points_missing": missing,
-        },
+        coords={name: (dims, values, dict(a)) for name, (dims, values, a) in grid.coords.items()},
+        attrs={**attrs, "points_failed": failed, "points_missing": missing},
     )
+
+
+def _read_store(store: ResultStore) -> Any:
+    """The store's Dataset as ``xarray.open_zarr`` reads it, once the store is checked.
+
+    ``status`` as fixed-width strings (zarr gives numpy's StringDType) and the counts of
+    failed and missing points from ``status`` (the attributes hold them as of the end of
+    the last run).
+    """
+    import xarray as xr
+
+    store.read()  # a StoreError naming the first damaged chunk or coordinate
+    with xr.open_zarr(store.path) as opened:
+        data = opened.load()
+    status = np.array(data["status"].values.tolist(), dtype=str)
+    data["status"] = (data["status"].dims, status, data["status"].attrs)
+    failed, missing = status_counts(status)
+    data.attrs.update(points_failed=failed, points_missing=missing)
+    return data
 
 
 def open_sweep(path: str | Path) -> Any:
     """Return the results in a sweep's zarr store as an xarray.Dataset (as :func:`run_sweep`).
 
-    Points of chunks not yet computed are NaN with an empty ``status``
-    (``points_missing`` in the attributes counts them).
+    The store is checked first (a damaged chunk is one StoreError line), then read as
+    ``xarray.open_zarr(path)`` reads it. Points of chunks not yet computed are NaN with
+    an empty ``status`` (``points_missing`` in the attributes counts them).
     """
-    store = ResultStore.open(path)
-    return _dataset(store.read(), store.attrs)
+    return _read_store(ResultStore.open(path))
