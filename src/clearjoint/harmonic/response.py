@@ -542,9 +542,15 @@ def _response(
     defect = np.zeros(n_pts)
     unresolved: list[int] = []
     disagree: list[tuple[int, float, float]] = []
+    block: FloatArray | None = None  # the leading invariant subspace at the last point
+    full: list[int] = []
     for i in range(n_pts):
         if not by_hill:  # the exact monodromy of the orbit's linearisation
-            multipliers[i] = _verdicts(model, basis, coef[i], float(omega[i]))
+            found_block = _verdicts(model, basis, coef[i], float(omega[i]), block)
+            multipliers[i] = found_block.multipliers
+            block = found_block.block
+            if found_block.full:
+                full.append(i)
             continue
         ev = evaluations[i] if i < len(evaluations) else None
         if not isinstance(ev, aft.Evaluation):  # a point the continuation did not evaluate
@@ -569,6 +575,14 @@ def _response(
                 disagree.append((i, mine, exact))
     if jacobians is not None:
         multipliers[:] = aft.hill_determinant_multipliers(model, basis, jacobians, omega)
+    if full:  # the leading block did not converge there: the whole monodromy was used
+        settings["monodromy_full"] = full
+        LOGGER.warning(
+            "the leading Floquet multipliers did not converge at %d point(s) (first: %d); "
+            "the whole monodromy was decomposed there instead (slower, same verdict)",
+            len(full),
+            full[0],
+        )
     if by_hill:
         settings["hill_defect"] = defect
     stable = np.max(np.abs(multipliers), axis=1) < 1.0
@@ -626,12 +640,17 @@ def _response(
 
 
 def _verdicts(
-    model: LinearSystem, basis: aft.Basis, coefficients: FloatArray, omega: float
-) -> NDArray[np.complex128]:
+    model: LinearSystem,
+    basis: aft.Basis,
+    coefficients: FloatArray,
+    omega: float,
+    start: FloatArray | None = None,
+) -> monodromy.LeadingBlock:
     """One point's multipliers for the stability verdict: the exact monodromy's leading
-    ones (:func:`clearjoint.harmonic.monodromy.leading_multipliers`: its product applied
-    to a few columns, never formed, on a large structure; all 2N on a small one)."""
-    return monodromy.leading_multipliers(model, basis, coefficients, omega)
+    ones (:func:`clearjoint.harmonic.monodromy.leading_block`: its product applied to a few
+    columns, never formed, on a large structure, started from the last point's block
+    ``start``; all 2N on a small one)."""
+    return monodromy.leading_block(model, basis, coefficients, omega, start)
 
 
 def _dof_names(settings: dict[str, Any], n_dof: int) -> tuple[str, ...] | None:
