@@ -186,12 +186,16 @@ class _Cache:
 
 _FLOWS = _Cache(_FLOW_BYTES)
 _TRANSITIONS = _Cache(_TRANSITION_BYTES)
+#: The short patterns met so far (each counted as 1 "byte": up to 65536 of them), marked
+#: by the orbit that met them first.
+_SEEN_SHORT = _Cache(2**16)
 
 
 def clear_cache() -> None:
     """Free the cached decompositions and transitions (up to 768 MiB; module docstring)."""
     _FLOWS.clear()
     _TRANSITIONS.clear()
+    _SEEN_SHORT.clear()
 
 
 def _fingerprint(system: LinearSystem) -> bytes:
@@ -292,17 +296,24 @@ def _product(
     for key, width in zip(keys, widths, strict=True):
         longest[key] = max(longest.get(key, 0.0), float(width) / omega)
     bound = _short_bound(system) if eigen and short else math.inf
-    short: dict[bytes, ShortFlow] = {}
+    taylor: dict[bytes, ShortFlow] = {}
+    token = object()  # this orbit's mark in _SEEN_SHORT
 
     def flow_of(i: int) -> Stretch:
         if eigen:
             found, cached = _FLOWS.get((system_key, keys[i]))
             if not found and bound * longest[keys[i]] <= SHORT_LIMIT:
-                if keys[i] not in short:
-                    short[keys[i]] = ShortFlow.for_structure(
-                        inv_m, _pattern_stiffness(system, states[i]), system.damping
-                    )
-                return short[keys[i]]
+                # Taylor the first orbit a short pattern is met in; decomposed (and cached)
+                # when another orbit meets it again: a pattern that recurs along the curve
+                # costs one decomposition, one that does not costs none
+                seen, mark = _SEEN_SHORT.get((system_key, keys[i]))
+                if not seen or mark is token:
+                    _SEEN_SHORT.put((system_key, keys[i]), token, 1)
+                    if keys[i] not in taylor:
+                        taylor[keys[i]] = ShortFlow.for_structure(
+                            inv_m, _pattern_stiffness(system, states[i]), system.damping
+                        )
+                    return taylor[keys[i]]
             if not found:
                 a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
                 cached = _decompose(a)
