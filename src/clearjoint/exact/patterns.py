@@ -158,9 +158,7 @@ class ShortFlow:
     velocity_scale: float
 
     @classmethod
-    def for_structure(
-        cls, inverse_mass: FloatArray, stiffness: Any, damping: Any
-    ) -> ShortFlow:
+    def for_structure(cls, inverse_mass: FloatArray, stiffness: Any, damping: Any) -> ShortFlow:
         """The flow of M y'' + C y' + K y = 0 (M diagonal, its inverse given as a vector).
 
         With sigma^2 = ||M^-1 K||_inf, A in the coordinates (y, y' / sigma) is
@@ -223,8 +221,9 @@ def chain(
     key_to, flow_to)`` = V_to^-1 V_from (the caller caches it), and a closed-form
     scaling per stretch. Stretch i lasts ``times[i]`` (s; those not positive are
     skipped) in the pattern ``keys[i]``, whose ``flow_of(i)`` is a :class:`PatternFlow`,
-    a :class:`ShortFlow` or, where V is ill-conditioned, the generator A itself (its exponential then by
-    ``scipy.linalg.expm``; A is used at once, so the caller may reuse its array).
+    a :class:`ShortFlow` or, where V is ill-conditioned, the generator A itself (its
+    exponential then by ``scipy.linalg.expm``; A is used at once, so the caller may reuse
+    its array).
 
     Parameters
     ----------
