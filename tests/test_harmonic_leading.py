@@ -200,3 +200,36 @@ def test_newton_that_stalls_is_given_up_early() -> None:
         found = newton(root, np.array([3.0]), 1.0, stall=stall)
         assert found is not None
         assert found[0][0] == pytest.approx(2.0, rel=1e-12)
+
+
+def test_an_orbit_too_big_for_the_caches_keeps_the_block_route(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With no room in either cache (as the 80-bay mast's orbits), the block route holds its
+    decompositions for the orbit alone and passes between patterns through y instead of
+    forming transitions: its multipliers still equal the eigenvalues of the monodromy
+    matrix, which then is the plain product of scipy.linalg.expm (no decomposition)."""
+    structure, fr, basis = curve
+    model = build(structure, None, 1.0)
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)
+    monkeypatch.setattr(monodromy._FLOWS, "limit", 0)
+    monkeypatch.setattr(monodromy._TRANSITIONS, "limit", 0)
+    monodromy.clear_cache()
+    formed = []
+    original = monodromy._transition
+
+    def counted(*args: object) -> np.ndarray:
+        formed.append(1)
+        return original(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(monodromy, "_transition", counted)
+    coef, w = fr.coefficients[-1], float(fr.omega[-1])
+    found = monodromy.leading_block(model, basis, coef, w)
+    assert not formed
+    assert not found.full
+    exact = monodromy.multipliers(model, basis, coef, w)
+    k = found.block.shape[1]
+    np.testing.assert_allclose(
+        np.abs(found.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
+    )
+    monodromy.clear_cache()

@@ -212,18 +212,19 @@ def chain(
     times: Sequence[float] | FloatArray,
     keys: Sequence[bytes],
     flow_of: Callable[[int], Stretch],
-    transition: Callable[[bytes, PatternFlow, bytes, PatternFlow], FloatArray],
+    transition: Callable[[bytes, PatternFlow, bytes, PatternFlow], FloatArray | None],
 ) -> FloatArray:
     """Return expm(A_k t_k) ... expm(A_1 t_1) @ start over stretches of the given patterns.
 
     The product is carried in the patterns' eigen-coordinates (module docstring): one
     change of coordinates where the pattern changes, ``transition(key_from, flow_from,
     key_to, flow_to)`` = V_to^-1 V_from (the caller caches it), and a closed-form
-    scaling per stretch. Stretch i lasts ``times[i]`` (s; those not positive are
-    skipped) in the pattern ``keys[i]``, whose ``flow_of(i)`` is a :class:`PatternFlow`,
-    a :class:`ShortFlow` or, where V is ill-conditioned, the generator A itself (its
-    exponential then by ``scipy.linalg.expm``; A is used at once, so the caller may reuse
-    its array).
+    scaling per stretch (where ``transition`` returns None, the change goes through y
+    and y' instead: two products, V_to^-1 (V_from phi)). Stretch i lasts ``times[i]``
+    (s; those not positive are skipped) in the pattern ``keys[i]``, whose ``flow_of(i)``
+    is a :class:`PatternFlow`, a :class:`ShortFlow` or, where V is ill-conditioned, the
+    generator A itself (its exponential then by ``scipy.linalg.expm``; A is used at once,
+    so the caller may reuse its array).
 
     Parameters
     ----------
@@ -259,7 +260,8 @@ def chain(
         if here is None:
             phi = flow.inverse @ phi
         elif here_key != key:
-            phi = transition(here_key, here, key, flow) @ phi
+            change = transition(here_key, here, key, flow)  # None: not formed, through y
+            phi = flow.inverse @ (here.vectors @ phi) if change is None else change @ phi
         phi = flow.propagate(float(t), phi)
         here, here_key = flow, key
     if here is not None:

@@ -52,6 +52,7 @@ so does an orbit whose patterns would not fit in the cache.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import math
 import threading
 from collections import OrderedDict
@@ -286,38 +287,53 @@ def _product(
     a[:n, n:] = np.eye(n)
     a[n:, n:] = -inv_m[:, None] * system.damping
     keys = [state.tobytes() for state in states]
-    # each decomposition holds two (2N, 2N) matrices; if the orbit's own would not fit,
-    # they would evict each other at every segment: expm is cheaper then
-    eigen = method == "eigen" and 2 * len(set(keys)) * a.nbytes <= _FLOWS.limit
-    system_key = _fingerprint(system) if eigen else b""
     # a pattern whose every stretch is short: Taylor's series on the block (ShortFlow),
     # no decomposition (module docstring, "Speed")
     longest: dict[bytes, float] = {}
     for key, width in zip(keys, widths, strict=True):
         longest[key] = max(longest.get(key, 0.0), float(width) / omega)
-    bound = _short_bound(system) if eigen and short else math.inf
+    bound = _short_bound(system) if short and method == "eigen" else math.inf
+    decomposed = [key for key, t in longest.items() if not short or bound * t > SHORT_LIMIT]
+    # each decomposition holds two (2N, 2N) matrices; if the orbit's own would not fit,
+    # they would evict each other at every segment: on the whole Phi expm is cheaper then,
+    # on a block they are held for this orbit alone (``local``)
+    fits = 2 * len(decomposed) * a.nbytes <= _FLOWS.limit
+    eigen = method == "eigen" and (fits or short)
+    local: dict[bytes, _Flow | None] | None = None if fits else {}
+    system_key = _fingerprint(system) if eigen else b""
+    # on a block, a transition V_q^-1 V_p costs (2N)^3 to form against 2 (2N)^2 k to pass
+    # through y: formed and cached only if the orbit's would fit in the cache
+    pairs = len(set(itertools.pairwise(keys)))
+    transitions = not short or pairs * a.nbytes <= _TRANSITIONS.limit
     taylor: dict[bytes, ShortFlow] = {}
     token = object()  # this orbit's mark in _SEEN_SHORT
 
     def flow_of(i: int) -> Stretch:
+        key = keys[i]
         if eigen:
-            found, cached = _FLOWS.get((system_key, keys[i]))
-            if not found and bound * longest[keys[i]] <= SHORT_LIMIT:
+            if local is None:
+                found, cached = _FLOWS.get((system_key, key))
+            else:
+                found, cached = key in local, local.get(key)
+            if not found and bound * longest[key] <= SHORT_LIMIT:
                 # Taylor the first orbit a short pattern is met in; decomposed (and cached)
                 # when another orbit meets it again: a pattern that recurs along the curve
                 # costs one decomposition, one that does not costs none
-                seen, mark = _SEEN_SHORT.get((system_key, keys[i]))
-                if not seen or mark is token:
-                    _SEEN_SHORT.put((system_key, keys[i]), token, 1)
-                    if keys[i] not in taylor:
-                        taylor[keys[i]] = ShortFlow.for_structure(
+                seen, mark = _SEEN_SHORT.get((system_key, key))
+                if local is not None or not seen or mark is token:
+                    _SEEN_SHORT.put((system_key, key), token, 1)
+                    if key not in taylor:
+                        taylor[key] = ShortFlow.for_structure(
                             inv_m, _pattern_stiffness(system, states[i]), system.damping
                         )
-                    return taylor[keys[i]]
+                    return taylor[key]
             if not found:
                 a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
                 cached = _decompose(a)
-                _FLOWS.put((system_key, keys[i]), cached, 2 * a.nbytes if cached else 0)
+                if local is None:
+                    _FLOWS.put((system_key, key), cached, 2 * a.nbytes if cached else 0)
+                else:
+                    local[key] = cached
             if isinstance(cached, _Flow):
                 return cached
         # the plain exponential (the reference and the fallback): chain uses a at once
@@ -329,7 +345,9 @@ def _product(
 
     def transition(
         source_key: bytes, source: _Flow, target_key: bytes, target: _Flow
-    ) -> FloatArray:
+    ) -> FloatArray | None:
+        if not transitions:
+            return None
         return _transition(system_key, source_key, source, target_key, target)
 
     return apply
