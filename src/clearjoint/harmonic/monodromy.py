@@ -140,11 +140,13 @@ def _pattern_stiffness(system: LinearSystem, state: NDArray[np.int64]) -> FloatA
     return np.asarray(system.stiffness + (b.T * k_j) @ b, dtype=np.float64)
 
 
-#: Bytes the decompositions may hold (the 40-bay mast's orbits need about 200 MiB each),
-#: and the transitions between patterns; each store drops its least recently used entries
-#: first. An orbit whose own patterns' decompositions would not fit keeps scipy.linalg.expm
-#: (a transition that does not fit only costs its one matrix product again).
-_FLOW_BYTES = 512 * 2**20
+#: Bytes the decompositions may hold (the 40-bay mast's orbits need about 200 MiB each;
+#: 1 GiB since issue 25 holds about 160 of the 80-bay mast's, 6.5 MB each), and the
+#: transitions between patterns; each store drops its least recently used entries first.
+#: An orbit whose own patterns' decompositions would not fit keeps scipy.linalg.expm for
+#: the whole Phi, and holds them for itself alone on the leading block's route (a
+#: transition that does not fit only costs its one matrix product again).
+_FLOW_BYTES = 1024 * 2**20
 _TRANSITION_BYTES = 256 * 2**20
 
 
@@ -193,7 +195,7 @@ _SEEN_SHORT = _Cache(2**16)
 
 
 def clear_cache() -> None:
-    """Free the cached decompositions and transitions (up to 768 MiB; module docstring)."""
+    """Free the cached decompositions and transitions (up to 1.25 GiB; module docstring)."""
     _FLOWS.clear()
     _TRANSITIONS.clear()
     _SEEN_SHORT.clear()
