@@ -227,6 +227,11 @@ def fit(rows: list[dict[str, Any]], key: str) -> float:
     return float(np.polyfit(x, y, 1)[0])
 
 
+def fitted_exponent(rows: list[dict[str, Any]]) -> float:
+    """:func:`fit` of the cost per point, NaN with fewer than two sizes."""
+    return fit(rows, "per_point") if len(rows) >= 2 else math.nan
+
+
 def compare(rows: list[dict[str, Any]], path: str) -> None:
     """Print how far each size's orbits and verdicts are from those saved in ``path``."""
     old = np.load(path)
@@ -382,13 +387,18 @@ def main() -> None:
         except ClearjointError as error:  # e.g. no start found: say so, go on
             print(f"{bays:3d} bays: no curve: {error}", flush=True)
             failed.append({"bays": bays, "error": str(error)})
+            if args.json:
+                done = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows
+                write_json(args.json, rows, failed, done, fitted_exponent(done), started)
             continue
         report(row)
         rows.append(row)
+        if args.json:  # after each size: a long run stopped later keeps what it measured
+            done = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows
+            write_json(args.json, rows, failed, done, fitted_exponent(done), started)
     fitted = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows
-    p = math.nan
+    p = fitted_exponent(fitted)
     if len(fitted) >= 2:
-        p = fit(fitted, "per_point")
         first, last = fitted[0], fitted[-1]
         print(
             f"cost per point ~ unknowns^{p:.2f} ({first['unknowns']} to {last['unknowns']} "
