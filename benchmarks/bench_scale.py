@@ -4,6 +4,7 @@ Run on demand:
 
     python benchmarks/bench_scale.py [--bays 5,10,20,40:30,80:10] [--points 100]
         [--save FILE.npz] [--compare FILE.npz] [--modes 40] [--pyharm PYTHON]
+        [--json FILE.json] [--exact] [--plot FILE.png]
 
 The issue's case: the planar mast of ``clearjoint.structure.mast`` (width and bay 0.5 m,
 member rigidity 2e7 N, node mass 0.5 kg), a hinge ``ClearanceJoint(50e-6, 5e7,
@@ -16,6 +17,11 @@ of the rest of the curve, the share of it spent in the stability verdict and in 
 LU factorizations (scipy's ``splu``, wherever it is called), the peak resident memory so
 far, then the growth exponent p of the cost per point ~ unknowns^p fitted (least squares
 in log-log) over the sizes from 10 bays up.
+
+``--json FILE`` writes the measured table (each size's row, the fitted exponent, the
+command, the date and the load) to a JSON file: ``examples/bench_scale.json`` is the one
+the gallery script ``examples/gallery/plot_harmonic_scale.py`` draws docs/harmonic.md's
+growth plot from (rerun with ``--json examples/bench_scale.json`` to redraw it).
 
 ``--save`` writes every size's orbits (the harmonic coefficients), frequencies and
 verdicts to an .npz file; ``--compare`` reads such a file (written by another source
@@ -221,6 +227,11 @@ def fit(rows: list[dict[str, Any]], key: str) -> float:
     return float(np.polyfit(x, y, 1)[0])
 
 
+def fitted_exponent(rows: list[dict[str, Any]]) -> float:
+    """:func:`fit` of the cost per point, NaN with fewer than two sizes."""
+    return fit(rows, "per_point") if len(rows) >= 2 else math.nan
+
+
 def compare(rows: list[dict[str, Any]], path: str) -> None:
     """Print how far each size's orbits and verdicts are from those saved in ``path``."""
     old = np.load(path)
@@ -288,6 +299,64 @@ def plot(rows: list[dict[str, Any]], exponent: float, path: str) -> None:
     print(f"plot written to {path}")
 
 
+#: The scalar numbers of a size's row that go to the JSON table (all SI: s, MiB).
+TABLE_KEYS = (
+    "bays",
+    "unknowns",
+    "points",
+    "total",
+    "start",
+    "per_point",
+    "verdict",
+    "splu",
+    "splu_calls",
+    "rss_mib",
+    "load",
+    "reason",
+    "exact_disagree",
+)
+
+
+def write_json(
+    path: str,
+    rows: list[dict[str, Any]],
+    failed: list[dict[str, Any]],
+    fitted: list[dict[str, Any]],
+    exponent: float,
+    started: str,
+) -> None:
+    """The measured table as JSON: one object per size (``TABLE_KEYS``, plus the verdict's
+    time per point and share, the unstable points), the sizes without a curve, the fit."""
+    import json
+
+    table = []
+    for r in rows:
+        row = {k: r[k] for k in TABLE_KEYS if k in r}
+        for k, v in row.items():
+            row[k] = v if isinstance(v, str) else float(v) if isinstance(v, float) else int(v)
+        row["verdict_per_point"] = r["verdict"] / max(r["points"], 1)
+        row["verdict_share"] = r["verdict"] / max(r["total"] - r["start"], 1e-12)
+        row["unstable"] = int(np.sum(~r["stable"]))
+        table.append(row)
+    out = {
+        "what": "harmonic balance on the issue-25 mast: cost per curve point against unknowns",
+        "command": "python " + " ".join(sys.argv),
+        "date": started,
+        "source": str(Path(_response.__file__).parents[2]),
+        "harmonics": H,
+        "machine": f"{os.cpu_count()} cores shared with other sessions; BLAS on one thread",
+        "sizes": table,
+        "no_curve": failed,
+        "fit": {
+            "exponent": None if math.isnan(exponent) else exponent,
+            "bays": [r["bays"] for r in fitted],
+            "of": "per_point ~ unknowns^exponent, least squares in log-log",
+        },
+    }
+    Path(path).write_text(json.dumps(out, indent=1) + "\n")
+    print(f"table written to {path}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -300,7 +369,10 @@ def main() -> None:
     parser.add_argument("--modes", type=int, default=0, help="time EPMC at this many bays")
     parser.add_argument("--plot", help="write the growth plot to this .png")
     parser.add_argument("--pyharm", help="pyHarm's interpreter: run bench_harmonic --pyharm")
+    parser.add_argument("--json", help="write the measured table to this .json")
     args = parser.parse_args()
+    started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    failed: list[dict[str, Any]] = []
     sizes = [tuple(int(v) for v in b.split(":")) for b in args.bays.split(",") if b]
     print(
         f"mast, H = {H}, 0.1 N at the tip, {args.points} points from 0.8 x open to 1.2 x closed "
@@ -314,12 +386,19 @@ def main() -> None:
             row = run_size(bays, min(args.points, *cap) if cap else args.points, args.exact)
         except ClearjointError as error:  # e.g. no start found: say so, go on
             print(f"{bays:3d} bays: no curve: {error}", flush=True)
+            failed.append({"bays": bays, "error": str(error)})
+            if args.json:
+                done = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows
+                write_json(args.json, rows, failed, done, fitted_exponent(done), started)
             continue
         report(row)
         rows.append(row)
+        if args.json:  # after each size: a long run stopped later keeps what it measured
+            done = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows
+            write_json(args.json, rows, failed, done, fitted_exponent(done), started)
     fitted = [r for r in rows if r["bays"] >= 10] if len(rows) > 2 else rows
+    p = fitted_exponent(fitted)
     if len(fitted) >= 2:
-        p = fit(fitted, "per_point")
         first, last = fitted[0], fitted[-1]
         print(
             f"cost per point ~ unknowns^{p:.2f} ({first['unknowns']} to {last['unknowns']} "
@@ -328,6 +407,8 @@ def main() -> None:
         )
         if args.plot:
             plot(fitted, p, args.plot)
+    if args.json:
+        write_json(args.json, rows, failed, fitted, p, started)
     if args.save:
         arrays: dict[str, Any] = {}
         for r in rows:

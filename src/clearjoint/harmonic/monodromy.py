@@ -52,10 +52,12 @@ so does an orbit whose patterns would not fit in the cache.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import math
 import threading
 from collections import OrderedDict
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -64,7 +66,7 @@ from scipy.integrate import solve_ivp
 
 from clearjoint.errors import ParameterError
 from clearjoint.exact.patterns import PatternFlow as _Flow
-from clearjoint.exact.patterns import Stretch, chain
+from clearjoint.exact.patterns import ShortFlow, Stretch, chain
 from clearjoint.exact.patterns import decompose as _decompose
 from clearjoint.harmonic.aft import Basis
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
@@ -138,11 +140,13 @@ def _pattern_stiffness(system: LinearSystem, state: NDArray[np.int64]) -> FloatA
     return np.asarray(system.stiffness + (b.T * k_j) @ b, dtype=np.float64)
 
 
-#: Bytes the decompositions may hold (the 40-bay mast's orbits need about 200 MiB each),
-#: and the transitions between patterns; each store drops its least recently used entries
-#: first. An orbit whose own patterns' decompositions would not fit keeps scipy.linalg.expm
-#: (a transition that does not fit only costs its one matrix product again).
-_FLOW_BYTES = 512 * 2**20
+#: Bytes the decompositions may hold (the 40-bay mast's orbits need about 200 MiB each;
+#: 1 GiB since issue 25 holds about 160 of the 80-bay mast's, 6.5 MB each), and the
+#: transitions between patterns; each store drops its least recently used entries first.
+#: An orbit whose own patterns' decompositions would not fit keeps scipy.linalg.expm for
+#: the whole Phi, and holds them for itself alone on the leading block's route (a
+#: transition that does not fit only costs its one matrix product again).
+_FLOW_BYTES = 1024 * 2**20
 _TRANSITION_BYTES = 256 * 2**20
 
 
@@ -185,12 +189,16 @@ class _Cache:
 
 _FLOWS = _Cache(_FLOW_BYTES)
 _TRANSITIONS = _Cache(_TRANSITION_BYTES)
+#: The short patterns met so far (each counted as 1 "byte": up to 65536 of them), marked
+#: by the orbit that met them first.
+_SEEN_SHORT = _Cache(2**16)
 
 
 def clear_cache() -> None:
-    """Free the cached decompositions and transitions (up to 768 MiB; module docstring)."""
+    """Free the cached decompositions and transitions (up to 1.25 GiB; module docstring)."""
     _FLOWS.clear()
     _TRANSITIONS.clear()
+    _SEEN_SHORT.clear()
 
 
 def _fingerprint(system: LinearSystem) -> bytes:
@@ -266,10 +274,14 @@ def _product(
     coefficients: FloatArray,
     omega: float,
     method: Literal["eigen", "expm"] = "eigen",
+    short: bool = False,
 ) -> Callable[[FloatArray], FloatArray]:
     """Return x -> Phi @ x for x (2N, m): the orbit's segments found once, the product
     applied to any block (the identity for Phi itself, a few columns for
-    :func:`leading_multipliers`), as :func:`monodromy` describes."""
+    :func:`leading_multipliers`), as :func:`monodromy` describes. ``short``: a pattern
+    whose stretches are all short (``SHORT_LIMIT``) is not decomposed but taken by
+    Taylor's series on the block (:class:`~clearjoint.exact.patterns.ShortFlow`: cheap on
+    a few columns; on the 2N columns of Phi itself the decomposition is cheaper)."""
     n = system.n_dof
     inv_m = 1.0 / np.diag(system.mass)
     widths, states = _segments(system, basis, coefficients)
@@ -277,18 +289,53 @@ def _product(
     a[:n, n:] = np.eye(n)
     a[n:, n:] = -inv_m[:, None] * system.damping
     keys = [state.tobytes() for state in states]
+    # a pattern whose every stretch is short: Taylor's series on the block (ShortFlow),
+    # no decomposition (module docstring, "Speed")
+    longest: dict[bytes, float] = {}
+    for key, width in zip(keys, widths, strict=True):
+        longest[key] = max(longest.get(key, 0.0), float(width) / omega)
+    bound = _short_bound(system) if short and method == "eigen" else math.inf
+    decomposed = [key for key, t in longest.items() if not short or bound * t > SHORT_LIMIT]
     # each decomposition holds two (2N, 2N) matrices; if the orbit's own would not fit,
-    # they would evict each other at every segment: expm is cheaper then
-    eigen = method == "eigen" and 2 * len(set(keys)) * a.nbytes <= _FLOWS.limit
+    # they would evict each other at every segment: on the whole Phi expm is cheaper then,
+    # on a block they are held for this orbit alone (``local``)
+    fits = 2 * len(decomposed) * a.nbytes <= _FLOWS.limit
+    eigen = method == "eigen" and (fits or short)
+    local: dict[bytes, _Flow | None] | None = None if fits else {}
     system_key = _fingerprint(system) if eigen else b""
+    # on a block, a transition V_q^-1 V_p costs (2N)^3 to form against 2 (2N)^2 k to pass
+    # through y: formed and cached only if the orbit's would fit in the cache
+    pairs = len(set(itertools.pairwise(keys)))
+    transitions = not short or pairs * a.nbytes <= _TRANSITIONS.limit
+    taylor: dict[bytes, ShortFlow] = {}
+    token = object()  # this orbit's mark in _SEEN_SHORT
 
     def flow_of(i: int) -> Stretch:
+        key = keys[i]
         if eigen:
-            found, cached = _FLOWS.get((system_key, keys[i]))
+            if local is None:
+                found, cached = _FLOWS.get((system_key, key))
+            else:
+                found, cached = key in local, local.get(key)
+            if not found and bound * longest[key] <= SHORT_LIMIT:
+                # Taylor the first orbit a short pattern is met in; decomposed (and cached)
+                # when another orbit meets it again: a pattern that recurs along the curve
+                # costs one decomposition, one that does not costs none
+                seen, mark = _SEEN_SHORT.get((system_key, key))
+                if local is not None or not seen or mark is token:
+                    _SEEN_SHORT.put((system_key, key), token, 1)
+                    if key not in taylor:
+                        taylor[key] = ShortFlow.for_structure(
+                            inv_m, _pattern_stiffness(system, states[i]), system.damping
+                        )
+                    return taylor[key]
             if not found:
                 a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
                 cached = _decompose(a)
-                _FLOWS.put((system_key, keys[i]), cached, 2 * a.nbytes if cached else 0)
+                if local is None:
+                    _FLOWS.put((system_key, key), cached, 2 * a.nbytes if cached else 0)
+                else:
+                    local[key] = cached
             if isinstance(cached, _Flow):
                 return cached
         # the plain exponential (the reference and the fallback): chain uses a at once
@@ -300,10 +347,31 @@ def _product(
 
     def transition(
         source_key: bytes, source: _Flow, target_key: bytes, target: _Flow
-    ) -> FloatArray:
+    ) -> FloatArray | None:
+        if not transitions:
+            return None
         return _transition(system_key, source_key, source, target_key, target)
 
     return apply
+
+
+#: A pattern none of whose stretches in an orbit exceeds this many units of the scaled
+#: norm bound (``ShortFlow.bound * t``; about 30 sparse products per unit of 4) is not
+#: decomposed: its stretches are taken by Taylor's series on the block. On the 40-bay mast
+#: half the patterns of an orbit last below 4 units (two joints crossing their edges
+#: within 0.2 ms), the others above 64.
+SHORT_LIMIT = 16.0
+
+
+def _short_bound(system: LinearSystem) -> float:
+    """ShortFlow's norm bound for the stiffest pattern (every joint at its stiffer contact
+    stiffness), 1/s: a bound for each pattern's own, cheap to find once."""
+    inv_m = 1.0 / np.diag(system.mass)
+    b = system.directions
+    k_j = system.k0 + np.maximum(system.k_c, system.k_t)
+    stiffest = np.abs(system.stiffness) + (np.abs(b.T) * k_j) @ np.abs(b)
+    sigma = math.sqrt(max(float(np.max(inv_m * stiffest.sum(axis=1))), 1e-300))
+    return sigma + float(np.max(inv_m * np.abs(system.damping).sum(axis=1)))
 
 
 #: :func:`leading_multipliers` starts from this many columns (doubled until they hold an
@@ -344,6 +412,7 @@ def leading_multipliers(
     outside the block are below the resolved ones by the residual test's margin and are
     returned as 0 (the stability verdict and the events see only the leading ones).
     At or below ``LEADING_ABOVE`` states, and with friction, it is :func:`multipliers`.
+    Along a curve, :func:`leading_block` starts each point from the last one's block.
 
     Parameters
     ----------
@@ -359,26 +428,104 @@ def leading_multipliers(
     (2N,) complex ndarray
         Largest modulus first.
     """
+    return leading_block(system, basis, coefficients, omega).multipliers
+
+
+@dataclass(frozen=True)
+class LeadingBlock:
+    """What :func:`leading_block` found at one orbit.
+
+    Attributes
+    ----------
+    multipliers : (2N,) complex ndarray
+        Largest modulus first; those outside the block 0.
+    block : (2N, k) ndarray or None
+        An orthonormal basis of Phi's leading invariant subspace (the next point's start);
+        None where all 2N multipliers were computed.
+    full : bool
+        True where the block did not become invariant at any size and the whole monodromy
+        was decomposed instead (the fallback: the caller says so).
+    passes : int
+        Applications of Phi to a block.
+    """
+
+    multipliers: NDArray[np.complex128]
+    block: FloatArray | None
+    full: bool
+    passes: int
+
+    def __repr__(self) -> str:
+        k = 0 if self.block is None else self.block.shape[1]
+        top = float(np.abs(self.multipliers[0])) if self.multipliers.size else math.nan
+        return f"LeadingBlock(|mu_1|={top:.6g}, k={k}, full={self.full}, passes={self.passes})"
+
+
+def leading_block(
+    system: LinearSystem,
+    basis: Basis,
+    coefficients: FloatArray,
+    omega: float,
+    start: FloatArray | None = None,
+) -> LeadingBlock:
+    """:func:`leading_multipliers`, started from a block at hand and returning its own.
+
+    ``start`` (2N, k), e.g. the previous curve point's ``block``: the first pass applies
+    Phi to it and tests its invariance at once, so where the orbit moved little one or
+    two passes replace the cold start's three to five. If it is not invariant after
+    ``_PASSES`` passes, the cold start from random columns follows, as
+    :func:`leading_multipliers` describes (the verdict never rests on the start).
+
+    Parameters
+    ----------
+    system : LinearSystem
+    basis : Basis
+    coefficients : (2H + 1, N) ndarray
+        The HB orbit, m.
+    omega : float
+        w, rad/s.
+    start : (2N, k) ndarray, optional
+
+    Returns
+    -------
+    LeadingBlock
+    """
     size = 2 * system.n_dof
     if system.friction_force is not None or size <= LEADING_ABOVE:
-        return multipliers(system, basis, coefficients, omega)
-    apply = _product(system, basis, coefficients, omega)
-    rng = np.random.default_rng(0)  # the same start at every point: reproducible
-    k = _LEADING
-    while 2 * k <= size:
-        q = np.linalg.qr(apply(np.linalg.qr(rng.standard_normal((size, k)))[0]))[0]
-        for _ in range(_PASSES):
+        return LeadingBlock(multipliers(system, basis, coefficients, omega), None, False, 0)
+    apply = _product(system, basis, coefficients, omega, short=True)
+    passes = [0]
+
+    def iterate(q: FloatArray, limit: int) -> NDArray[np.complex128] | None:
+        """Up to ``limit`` passes from the orthonormal q; the multipliers once invariant."""
+        for _ in range(limit):
             z = apply(q)
+            passes[0] += 1
             b = q.T @ z
             miss = float(np.linalg.norm(z - q @ b))
             if miss <= _INVARIANT * max(float(np.linalg.norm(z)), 1e-300):
                 mu = np.zeros(size, dtype=np.complex128)
                 ritz = np.linalg.eigvals(b)
-                mu[:k] = ritz[np.argsort(-np.abs(ritz), kind="stable")]
+                mu[: ritz.size] = ritz[np.argsort(-np.abs(ritz), kind="stable")]
+                found[0] = q
                 return mu
             q = np.linalg.qr(z)[0]  # not invariant yet: one more pass
+        return None
+
+    found: list[FloatArray | None] = [None]
+    if start is not None and start.ndim == 2 and start.shape[0] == size and start.shape[1] >= 1:
+        mu = iterate(np.linalg.qr(start)[0], _PASSES + 1)
+        if mu is not None:
+            return LeadingBlock(mu, found[0], False, passes[0])
+    rng = np.random.default_rng(0)  # the same start at every point: reproducible
+    k = _LEADING
+    while 2 * k <= size:
+        first = np.linalg.qr(apply(np.linalg.qr(rng.standard_normal((size, k)))[0]))[0]
+        passes[0] += 1
+        mu = iterate(first, _PASSES)
+        if mu is not None:
+            return LeadingBlock(mu, found[0], False, passes[0])
         k *= 2
-    return multipliers(system, basis, coefficients, omega)
+    return LeadingBlock(multipliers(system, basis, coefficients, omega), None, True, passes[0])
 
 
 def _transition(

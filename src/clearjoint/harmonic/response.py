@@ -58,12 +58,19 @@ FloatArray = NDArray[np.float64]
 LOGGER = logging.getLogger("clearjoint.harmonic")
 
 #: The start's force continuation takes at most this many unknown-points (points times
-#: unknowns), between ``START_POINTS`` (40 and 2000) points. On the sparse path (above
-#: solve.SPARSE_ABOVE unknowns) a 160-DOF mast at H = 7 (2400 unknowns) gets 200 points
-#: (its start needs about 100), and the example mast at 20 N and H = 15 (1240 unknowns, 387
-#: points, no orbit to reach) gives up after about 60 s on 2 cores (docs/harmonic.md).
+#: unknowns), between ``START_POINTS`` (400 and 2000) points. The example mast at 20 N and
+#: H = 15 (1240 unknowns, 387 points, no orbit to reach) gives up after about 60 s on 2
+#: cores (docs/harmonic.md). The floor of 400 is for the large masts, whose homotopy needs
+#: more points as they grow (the 40-bay mast at H = 7, 2400 unknowns: 102 points; the
+#: budget alone gave it 200 and the 80-bay mast 100, too few: issue 25).
 START_BUDGET = 480_000
-START_POINTS = (40, 2000)
+START_POINTS = (400, 2000)
+
+#: On the sparse path, Newton from a linear response is given up when its residual has
+#: not halved in this many iterations (solve.newton's ``stall``): on the 20- and 40-bay
+#: masts at 0.8 x the first open mode both guesses stall at 1e-6 to 1e-4 within 5
+#: iterations and used to run all 80, 7 s of the 40-bay start's 29 s.
+START_STALL = 10
 
 
 class NoPeriodicResponse(HarmonicError):
@@ -400,6 +407,11 @@ def linear_start(
         jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
         return ev.residual / k_ref, jac / k_ref
 
+    def residual(q: FloatArray) -> FloatArray:
+        # a halved trial step needs no Jacobian (the same R as ``function``'s)
+        ev = aft.evaluate(model, basis, q, omega, force, jacobian=False)
+        return np.asarray(ev.residual / k_ref, dtype=np.float64)
+
     for stiffness in (model.open_stiffness(), model.closed_stiffness()):
         guess = linear_guess(model, basis, omega, force, stiffness)
         try:
@@ -408,6 +420,10 @@ def linear_start(
                 guess,
                 max(scale, float(np.max(np.abs(guess)))),
                 max_iterations=max_iterations,
+                # a large structure: no Jacobians for the halved steps, and a Newton
+                # that stalls is given up (the force continuation follows)
+                residual=None if sparse is None else residual,
+                stall=None if sparse is None else START_STALL,
             )
         except tolerate:
             found = None
@@ -542,9 +558,15 @@ def _response(
     defect = np.zeros(n_pts)
     unresolved: list[int] = []
     disagree: list[tuple[int, float, float]] = []
+    block: FloatArray | None = None  # the leading invariant subspace at the last point
+    full: list[int] = []
     for i in range(n_pts):
         if not by_hill:  # the exact monodromy of the orbit's linearisation
-            multipliers[i] = _verdicts(model, basis, coef[i], float(omega[i]))
+            found_block = _verdicts(model, basis, coef[i], float(omega[i]), block)
+            multipliers[i] = found_block.multipliers
+            block = found_block.block
+            if found_block.full:
+                full.append(i)
             continue
         ev = evaluations[i] if i < len(evaluations) else None
         if not isinstance(ev, aft.Evaluation):  # a point the continuation did not evaluate
@@ -569,6 +591,14 @@ def _response(
                 disagree.append((i, mine, exact))
     if jacobians is not None:
         multipliers[:] = aft.hill_determinant_multipliers(model, basis, jacobians, omega)
+    if full:  # the leading block did not converge there: the whole monodromy was used
+        settings["monodromy_full"] = full
+        LOGGER.warning(
+            "the leading Floquet multipliers did not converge at %d point(s) (first: %d); "
+            "the whole monodromy was decomposed there instead (slower, same verdict)",
+            len(full),
+            full[0],
+        )
     if by_hill:
         settings["hill_defect"] = defect
     stable = np.max(np.abs(multipliers), axis=1) < 1.0
@@ -626,12 +656,17 @@ def _response(
 
 
 def _verdicts(
-    model: LinearSystem, basis: aft.Basis, coefficients: FloatArray, omega: float
-) -> NDArray[np.complex128]:
+    model: LinearSystem,
+    basis: aft.Basis,
+    coefficients: FloatArray,
+    omega: float,
+    start: FloatArray | None = None,
+) -> monodromy.LeadingBlock:
     """One point's multipliers for the stability verdict: the exact monodromy's leading
-    ones (:func:`clearjoint.harmonic.monodromy.leading_multipliers`: its product applied
-    to a few columns, never formed, on a large structure; all 2N on a small one)."""
-    return monodromy.leading_multipliers(model, basis, coefficients, omega)
+    ones (:func:`clearjoint.harmonic.monodromy.leading_block`: its product applied to a few
+    columns, never formed, on a large structure, started from the last point's block
+    ``start``; all 2N on a small one)."""
+    return monodromy.leading_block(model, basis, coefficients, omega, start)
 
 
 def _dof_names(settings: dict[str, Any], n_dof: int) -> tuple[str, ...] | None:

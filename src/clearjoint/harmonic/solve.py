@@ -167,6 +167,7 @@ def newton(
     *,
     max_iterations: int = 80,
     residual: Callable[[FloatArray], FloatArray] | None = None,
+    stall: int | None = None,
 ) -> tuple[FloatArray, int] | None:
     """Damped Newton on a dimensionless residual: ``function(q) -> (R, dR/dq)``.
 
@@ -174,17 +175,23 @@ def newton(
 
     Steps are halved (up to 12 times) until max abs(R) falls; ``scale`` (m) makes q
     dimensionless in the convergence test. ``residual(q) -> R``, if given, is used
-    for the halved trial steps (no Jacobian needed there). Returns (q, iterations)
-    or None.
+    for the halved trial steps (no Jacobian needed there). ``stall``: give up when
+    max abs(R) has not halved in that many iterations (a Newton that creeps: from a
+    poor guess on a large structure it stalls within a few iterations and would spend
+    the rest of ``max_iterations`` with a sparse LU and a dozen evaluations each).
+    Returns (q, iterations) or None.
     """
     q = q0.copy()
     r, jac = function(q)
     size = float(np.max(np.abs(r)))
+    history = [size]
     for iteration in range(max_iterations):
         if not np.isfinite(size):
             return None
         if size <= TOLERANCE * scale:
             return q, iteration
+        if stall is not None and iteration >= stall and size > 0.5 * history[-stall - 1]:
+            return None
         dq = linear_solve(jac, -r)
         step = 1.0
         jac_t: FloatArray | None = None
@@ -201,6 +208,7 @@ def newton(
         if jac_t is None:
             r_t, jac_t = function(trial)
         q, r, jac, size = trial, r_t, jac_t, size_t
+        history.append(size)
     return (q, max_iterations) if size <= TOLERANCE * scale else None
 
 

@@ -1,0 +1,83 @@
+"""benchmarks/bench_scale.py's table (--json) and the growth plot drawn from it (issue 25).
+
+The table shipped in examples/ is the one the gallery script draws: it must hold what the
+script reads, say how it was made, and its recorded fit must be the fit of its own rows.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).parents[1]
+
+
+def _bench() -> Any:
+    path = ROOT / "benchmarks" / "bench_scale.py"
+    spec = importlib.util.spec_from_file_location("bench_scale_table", path)
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_shipped_table_is_a_benchmark_run_and_its_fit_is_its_own() -> None:
+    table = json.loads((ROOT / "examples" / "bench_scale.json").read_text())
+    assert table["command"].startswith("python benchmarks/bench_scale.py")
+    assert "--json examples/bench_scale.json" in table["command"]
+    sizes = table["sizes"]
+    assert len(sizes) >= 3
+    for row in sizes:
+        assert row["unknowns"] == (2 * table["harmonics"] + 1) * 4 * row["bays"]
+        assert 0.0 < row["verdict_per_point"] * row["points"] == pytest.approx(row["verdict"])
+        assert row["per_point"] > 0.0
+    fitted = [r for r in sizes if r["bays"] in table["fit"]["bays"]]
+    slope = np.polyfit(
+        np.log([r["unknowns"] for r in fitted]), np.log([r["per_point"] for r in fitted]), 1
+    )[0]
+    assert table["fit"]["exponent"] == pytest.approx(slope, rel=1e-12)
+
+
+def test_write_json_round_trips_a_row(tmp_path: Path) -> None:
+    """A row as run_size makes it (numpy scalars and arrays included) comes back as plain
+    numbers, with the verdict's time per point and share derived from it."""
+    bench = _bench()
+    row = {
+        "bays": 10,
+        "unknowns": 600,
+        "points": np.int64(4),
+        "total": np.float64(3.0),
+        "start": 1.0,
+        "per_point": 0.5,
+        "verdict": 0.8,
+        "splu": 0.1,
+        "splu_calls": 7,
+        "rss_mib": 100.0,
+        "load": 1.5,
+        "reason": "max_points",
+        "stable": np.array([True, False, False, True]),
+        "omega": np.ones(4),
+    }
+    path = tmp_path / "t.json"
+    bench.write_json(str(path), [row], [{"bays": 80, "error": "no start"}], [row], 1.25, "now")
+    table = json.loads(path.read_text())
+    (got,) = table["sizes"]
+    assert got["points"] == 4
+    assert got["verdict_per_point"] == pytest.approx(0.2)
+    assert got["verdict_share"] == pytest.approx(0.4)  # of the 2 s after the start
+    assert got["unstable"] == 2
+    assert "omega" not in got
+    assert table["no_curve"] == [{"bays": 80, "error": "no start"}]
+    assert table["fit"]["exponent"] == 1.25
+    assert table["fit"]["bays"] == [10]
+    bench.write_json(str(path), [row], [], [row], math.nan, "now")
+    assert json.loads(path.read_text())["fit"]["exponent"] is None

@@ -1,0 +1,235 @@
+"""The stability verdict of large structures (issue 25): Taylor stretches, warm starts, fallback.
+
+Each by an independent route: scipy.linalg.expm of the dense generator, the eigenvalues
+of the whole monodromy matrix, or a residual with no root.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from clearjoint import ClearanceJoint
+from clearjoint.exact.patterns import SHORT_STEP, PatternFlow, ShortFlow, chain, decompose
+from clearjoint.harmonic import aft, frequency_response, monodromy
+from clearjoint.harmonic.solve import newton
+from clearjoint.harmonic.system import build
+from clearjoint.structure import mast
+
+BAYS = 4
+
+
+@pytest.fixture(scope="module")
+def curve() -> tuple[object, object, aft.Basis]:
+    """Four points of the 4-bay mast (issue 25's hinges) at 10 N on the tip, from 0.8 x its
+    first open mode: every orbit crosses the gap edges often, and 12 of its 21 contact
+    patterns last under SHORT_LIMIT (two joints crossing their edges moments apart)."""
+    structure = mast(
+        BAYS, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), rayleigh=(0.0, 2e-6)
+    )
+    force = np.zeros(structure.n_dof)
+    force[list(structure.dof_names).index(f"n{2 * BAYS + 1}x")] = 10.0
+    w = float(structure.modes("open").omega[0])
+    fr = frequency_response(
+        structure, force, 0.8 * w, 2.0 * w, max_points=4, max_step=0.05, check_points=0
+    )
+    basis = aft.Basis.make(fr.settings["harmonics"], fr.settings["samples"])
+    return structure, fr, basis
+
+
+def _generator(model: object, state: np.ndarray) -> np.ndarray:
+    n = model.n_dof  # type: ignore[attr-defined]
+    inv_m = 1.0 / np.diag(model.mass)  # type: ignore[attr-defined]
+    a = np.zeros((2 * n, 2 * n))
+    a[:n, n:] = np.eye(n)
+    a[n:, n:] = -inv_m[:, None] * model.damping  # type: ignore[attr-defined]
+    a[n:, :n] = -inv_m[:, None] * monodromy._pattern_stiffness(model, state)  # type: ignore[arg-type]
+    return a
+
+
+@pytest.mark.parametrize("units", [1e-6, 0.3, 3.9, 14.5])
+def test_a_short_flow_is_the_exponential(
+    curve: tuple[object, object, aft.Basis], units: float
+) -> None:
+    """ShortFlow.propagate = scipy.linalg.expm(A t) @ X (dense Pade, an independent route) on
+    a block of 5 columns, for stretches from a millionth of a substep to four substeps."""
+    structure, _, _ = curve
+    model = build(structure, None, 1.0)
+    state = np.ones(model.directions.shape[0], dtype=np.int64)  # every joint closed
+    state[::2] = 0
+    a = _generator(model, state)
+    flow = ShortFlow.for_structure(
+        1.0 / np.diag(model.mass), monodromy._pattern_stiffness(model, state), model.damping
+    )
+    t = units * SHORT_STEP / flow.bound
+    assert flow.steps(t) == max(1, math.ceil(units))
+    x = np.random.default_rng(1).standard_normal((a.shape[0], 5))
+    x[model.n_dof :] *= 100.0  # velocities of the size the orbits' have
+    exact = scipy.linalg.expm(a * t) @ x
+    got = flow.propagate(t, x)
+    assert np.linalg.norm(got - exact) <= 1e-12 * np.linalg.norm(exact)
+
+
+def test_a_chain_mixing_short_and_decomposed_stretches_is_the_product(
+    curve: tuple[object, object, aft.Basis],
+) -> None:
+    """chain over long (decomposed), short (Taylor) and long stretches again equals the
+    product of dense exponentials."""
+    structure, _, _ = curve
+    model = build(structure, None, 1.0)
+    n_j = model.directions.shape[0]
+    states = [np.zeros(n_j, np.int64), np.ones(n_j, np.int64), -np.ones(n_j, np.int64)]
+    states.append(states[0])
+    generators = [_generator(model, s) for s in states]
+    short = ShortFlow.for_structure(
+        1.0 / np.diag(model.mass), monodromy._pattern_stiffness(model, states[1]), model.damping
+    )
+    times = [0.01, 2.0 / short.bound, 3e-3, 5e-3]
+    flows = [decompose(generators[0]), short, decompose(generators[2]), decompose(generators[3])]
+    assert isinstance(flows[0], PatternFlow)
+    assert isinstance(flows[2], PatternFlow)
+    keys = [s.tobytes() for s in states]
+    x = np.random.default_rng(2).standard_normal((generators[0].shape[0], 3))
+    got = chain(
+        x,
+        times,
+        keys,
+        lambda i: flows[i],  # type: ignore[return-value]
+        lambda _k, source, _l, target: target.inverse @ source.vectors,
+    )
+    exact = x
+    for a, t in zip(generators, times, strict=True):
+        exact = scipy.linalg.expm(a * t) @ exact
+    assert np.linalg.norm(got - exact) <= 1e-10 * np.linalg.norm(exact)
+
+
+def test_the_leading_block_gives_the_whole_monodromys_multipliers_cold_and_warm(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """At each point, cold (random columns, the short patterns taken by Taylor) and warm
+    (the last point's block, the short patterns met again: decomposed): the leading
+    multipliers equal the eigenvalues of the whole monodromy matrix (formed by the
+    decompositions alone) to 1e-9 of the largest; the warm start needs no more passes
+    than the cold one."""
+    structure, fr, basis = curve
+    model = build(structure, None, 1.0)
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)  # 2N = 32: forced onto the block
+    monodromy.clear_cache()
+    block = None
+    taylor = []
+    original = ShortFlow.propagate
+
+    def counted(self: ShortFlow, t: float, phi: np.ndarray) -> np.ndarray:
+        taylor.append(t)
+        return original(self, t, phi)
+
+    monkeypatch.setattr(ShortFlow, "propagate", counted)
+    for i in range(fr.omega.size):
+        coef, w = fr.coefficients[i], float(fr.omega[i])
+        monodromy.clear_cache()  # the cold start meets the short patterns first: Taylor
+        cold = monodromy.leading_block(model, basis, coef, w)
+        met = len(taylor)
+        warm = monodromy.leading_block(model, basis, coef, w, block)
+        assert len(taylor) == met  # met again by another orbit: decomposed, not Taylor
+        exact = monodromy.multipliers(model, basis, coef, w)
+        for found in (cold, warm):
+            assert not found.full
+            k = found.block.shape[1]
+            np.testing.assert_allclose(
+                np.abs(found.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
+            )
+            assert (abs(found.multipliers[0]) < 1.0) == (abs(exact[0]) < 1.0)
+        assert warm.passes <= cold.passes
+        block = warm.block
+    assert taylor  # the short patterns went through Taylor's series
+    monodromy.clear_cache()
+
+
+def test_a_block_that_never_converges_falls_back_to_the_whole_monodromy_and_says_so(
+    curve: tuple[object, object, aft.Basis],
+    monkeypatch: pytest.MonkeyPatch,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """With an invariance test no block can pass, every point takes the whole monodromy:
+    its multipliers are exactly those of monodromy.multipliers, the point is listed in
+    settings["monodromy_full"] and a warning is logged."""
+    structure, fr, basis = curve
+    model = build(structure, None, 1.0)
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)
+    monkeypatch.setattr(monodromy, "_INVARIANT", -1.0)
+    coef, w = fr.coefficients[0], float(fr.omega[0])
+    found = monodromy.leading_block(model, basis, coef, w)
+    assert found.full
+    assert found.block is None
+    np.testing.assert_array_equal(found.multipliers, monodromy.multipliers(model, basis, coef, w))
+    assert "full=True" in repr(found)
+    force = np.zeros(structure.n_dof)
+    force[list(structure.dof_names).index(f"n{2 * BAYS + 1}x")] = 10.0
+    with caplog.at_level(logging.WARNING, logger="clearjoint.harmonic"):
+        again = frequency_response(
+            structure, force, fr.omega[0], 2.0 * fr.omega[0], max_points=2, check_points=0
+        )
+    assert again.settings["monodromy_full"] == [0, 1]
+    assert any("did not converge at 2 point(s)" in r.getMessage() for r in caplog.records)
+
+
+def test_newton_that_stalls_is_given_up_early() -> None:
+    """R(q) = q^2 + 1 has no real root: Newton's residual never halves. With stall=10 it
+    stops after about 10 iterations (counted evaluations), without after max_iterations;
+    on R(q) = q^2 - 4 from 3 it converges to 2 either way."""
+    calls = []
+
+    def no_root(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(1)
+        return q**2 + 1.0, np.diag(2.0 * q + 1e-3)
+
+    assert newton(no_root, np.array([0.3]), 1.0, max_iterations=80, stall=10) is None
+    stalled = len(calls)
+    calls.clear()
+    assert newton(no_root, np.array([0.3]), 1.0, max_iterations=80) is None
+    assert stalled < 16 * 13 < len(calls)  # at most ~11 iterations of up to 13 trials
+
+    def root(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return q**2 - 4.0, np.diag(2.0 * q)
+
+    for stall in (None, 10):
+        found = newton(root, np.array([3.0]), 1.0, stall=stall)
+        assert found is not None
+        assert found[0][0] == pytest.approx(2.0, rel=1e-12)
+
+
+def test_an_orbit_too_big_for_the_caches_keeps_the_block_route(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With no room in either cache (as the 80-bay mast's orbits), the block route holds its
+    decompositions for the orbit alone and passes between patterns through y instead of
+    forming transitions: its multipliers still equal the eigenvalues of the monodromy
+    matrix, which then is the plain product of scipy.linalg.expm (no decomposition)."""
+    structure, fr, basis = curve
+    model = build(structure, None, 1.0)
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)
+    monkeypatch.setattr(monodromy._FLOWS, "limit", 0)
+    monkeypatch.setattr(monodromy._TRANSITIONS, "limit", 0)
+    monodromy.clear_cache()
+    formed = []
+    original = monodromy._transition
+
+    def counted(*args: object) -> np.ndarray:
+        formed.append(1)
+        return original(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(monodromy, "_transition", counted)
+    coef, w = fr.coefficients[-1], float(fr.omega[-1])
+    found = monodromy.leading_block(model, basis, coef, w)
+    assert not formed
+    assert not found.full
+    exact = monodromy.multipliers(model, basis, coef, w)
+    k = found.block.shape[1]
+    np.testing.assert_allclose(
+        np.abs(found.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
+    )
+    monodromy.clear_cache()
