@@ -128,3 +128,22 @@ def test_a_transient_of_a_million_seconds_is_refused(
     short = _study(tmp_path, STUDY.replace("[excitation]\n", long.replace("1e6s", "1s")), "t")
     code, err = _run(["simulate", short], capsys)  # 400 periods: 0.04 s, no check in the way
     assert (code, err) == (2, "clearjoint simulate: error: reached the run\n")
+
+
+def test_a_steady_state_written_over_ten_million_periods_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Its cost is memory, not time: 1e7 periods x 256 samples x 110 bytes = 262 GiB
+    (clearjoint.budget's published bytes a sample), against a limit of 4 GiB."""
+    path = _study(tmp_path, STUDY + "\n[output]\nperiods = 10000000\n")
+    assert studies.load_study(path).mode == "steady"  # the example study's default mode
+    out = tmp_path / "s.nc"
+    code, err = _run(["simulate", path, "--out", str(out)], capsys)
+    assert code == 2
+    assert err.count("\n") == 1, err
+    assert err.startswith(
+        "clearjoint simulate: error: [output] periods 10000000 x samples_per_period 256: "
+        "about 262 GiB of series in memory and on disk"
+    ), err
+    assert err.endswith("ask for fewer periods, or pass --allow-long to write it anyway\n")
+    assert not out.exists()

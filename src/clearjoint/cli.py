@@ -122,6 +122,10 @@ def _run_simulate(args: argparse.Namespace) -> int:
     study = load_study(args.study)
     if study.mode == "transient" and not args.allow_long:  # a runaway duration, refused
         _check_transient(study)
+    if study.mode == "steady" and not args.allow_long:  # a runaway output, refused
+        from clearjoint.budget import check_output
+
+        check_output(study.periods, study.samples_per_period)
     if args.out:  # before the run, not after
         out = netcdf_target(args.out, "simulate", force=args.force, example="result.nc")
         out.parent.mkdir(parents=True, exist_ok=True)
