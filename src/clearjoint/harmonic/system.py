@@ -153,8 +153,8 @@ def _refuse_system_losses(system: VibrationSystem) -> None:
         if loss.restitution != 1.0:
             raise HarmonicError(
                 f"restitution {loss.restitution!r} ({where}) is an impact event "
-                "that harmonic balance cannot carry; use clearjoint.structure.time_response for "
-                "the exact motion with impacts, or set restitution=1"
+                "that harmonic balance cannot carry; use clearjoint.structure.frequency_response "
+                "(exact shooting, impacts carried) or time_response, or set restitution=1"
             )
 
 
