@@ -36,7 +36,6 @@ from clearjoint.structure.tangent import (
     impact_jumps,
     pattern_history,
     refuse_restitution,
-    stretches,
 )
 from clearjoint.system import VibrationSystem
 
@@ -235,17 +234,13 @@ class ShootingMap:
         """Return (P(z), Phi, motion)."""
         motion = self.run(z, samples_per_period)
         end = np.concatenate(motion.final_state)
-        if self.impacts:
-            return end, self._with_impacts(z, motion), motion
-        widths, patterns = stretches(motion, 0.0, self.duration)
-        return end, self.flows.product(widths, patterns), motion
-
-    def _with_impacts(self, z: FloatArray, motion: StructureMotion) -> FloatArray:
-        """The monodromy with each impact's saltation matrix between the stretches."""
         history = pattern_history(motion)
-        u0, v0 = z[: self.n], z[self.n :]
-        jumps = impact_jumps(self.flow, motion, history, u0, v0, self.duration)
-        return carry(self.flows, motion, history, 0.0, self.duration, jumps=jumps)
+        jumps = (
+            impact_jumps(self.flow, motion, history, z[: self.n], z[self.n :], self.duration)
+            if self.impacts
+            else None
+        )
+        return end, carry(self.flows, motion, history, 0.0, self.duration, jumps=jumps), motion
 
     def size(self, z: FloatArray) -> float:
         """abs(z) in the norm of (w u, v), m/s."""

@@ -57,11 +57,7 @@ def refuse_restitution(system: VibrationSystem, *, below: float = 1.0) -> None:
     always refused where impacts are carried, :func:`impact_saltation`)."""
     e = system.restitution()
     if below <= 0.0 and np.any(e <= 0.0):
-        joint = int(np.flatnonzero(e <= 0.0)[0])
-        raise StructureError(
-            f"joint {joint} has a restitution of 0: the exact Jacobian of its impacts needs "
-            "e > 0; give it a small positive restitution (0.01)"
-        )
+        raise _no_saltation(int(np.flatnonzero(e <= 0.0)[0]))
     if np.any(e < below):
         joint = int(np.flatnonzero(e < below)[0])
         raise StructureError(
@@ -70,6 +66,14 @@ def refuse_restitution(system: VibrationSystem, *, below: float = 1.0) -> None:
             "contact only; give that joint restitution=1 (its contact stiffness "
             "carries the impact), or study one joint with clearjoint.periodic"
         )
+
+
+def _no_saltation(joint: int) -> StructureError:
+    """The one line for a restitution of 0, whose impacts have no saltation matrix."""
+    return StructureError(
+        f"joint {joint} has a restitution of 0: the exact Jacobian of its impacts needs "
+        "e > 0; give it a small positive restitution (0.01)"
+    )
 
 
 class PatternFlows:
@@ -212,10 +216,7 @@ def impact_saltation(
     """
     e = float(flow.restitution[joint])
     if e <= 0.0:
-        raise StructureError(
-            f"joint {joint} has a restitution of 0: the exact Jacobian of its impacts needs "
-            "e > 0; give it a small positive restitution (0.01)"
-        )
+        raise _no_saltation(joint)
     n = flow.n
     b = np.asarray(flow.b[joint], dtype=np.float64)
     push = np.asarray(flow.impulse_dirs[joint], dtype=np.float64)  # M^-1 b
@@ -282,14 +283,14 @@ def impact_jumps(
     hits = np.flatnonzero(entering & (flow.restitution[joints] < 1.0))
     if hits.size == 0:
         return {}
-    sampled = hits[times[hits] < duration]
-    after = _run(flow, u0, v0, duration, np.unique(times[sampled]))
+    sampled = np.unique(times[hits][times[hits] < duration])
+    after = _run(flow, u0, v0, duration, sampled)
     if not np.array_equal(np.asarray(after.event_times), times):
         raise SimulationError(
             "the exact motion met its gap edges differently when sampled at its impacts; "
             "its Jacobian with impacts cannot be formed (please report this)"
         )
-    states = {float(t): (after.u[k], after.v[k]) for k, t in enumerate(np.unique(times[sampled]))}
+    states = {float(t): (after.u[k], after.v[k]) for k, t in enumerate(sampled)}
     end_u, end_v = motion.final_state
     jumps: dict[int, FloatArray] = {}
     for t in np.unique(times[hits]):
@@ -418,11 +419,8 @@ def largest_exponent(
     growth = np.empty(periods)
     for k in range(periods):
         t0 = k * period
-        widths, patterns = stretches(motion, t0, t0 + period, history)
-        if jumps:
-            w = carry(flows, motion, history, t0, t0 + period, w, jumps)
-        else:
-            w = flows.product(widths, patterns, w)
+        w = carry(flows, motion, history, t0, t0 + period, w, jumps)
+        _, patterns = stretches(motion, t0, t0 + period, history)
         size = flows.energy_norm(patterns[-1], w)
         if not size > 0.0 or not math.isfinite(size):
             raise StructureError("the tangent vector vanished or overflowed over one period")
