@@ -24,10 +24,11 @@ import socket
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast
 
 import numpy as np
 
@@ -59,6 +60,7 @@ __all__ = [
     "point_seed",
     "probe_scheduler",
     "process_pool",
+    "record_warnings",
     "run_batches",
     "run_ordered",
     "run_unordered",
@@ -102,6 +104,74 @@ def chunk_bounds(n_points: int, chunk_size: int) -> list[tuple[int, int]]:
     if chunk_size < 1:
         raise ParameterError(f"chunk_size must be >= 1, got {chunk_size}")
     return [(a, min(a + chunk_size, n_points)) for a in range(0, n_points, chunk_size)]
+
+
+#: Each thread's list of the warnings it records (see :func:`record_warnings`), if any.
+_RECORDING = threading.local()
+_RECORDING_LOCK = threading.Lock()
+_recorders = 0  # threads inside record_warnings, in this process
+_shown_before: Any = None  # warnings.showwarning as it was when the first one entered
+_ALWAYS = ("always", None, Warning, None, 0)
+
+
+def _show_or_record(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """warnings.showwarning while a thread records: its own warnings to its own list."""
+    record = getattr(_RECORDING, "record", None)
+    if record is None:
+        _shown_before(message, category, filename, lineno, file, line)
+        return
+    record.append(warnings.WarningMessage(message, category, filename, lineno, file, line))
+
+
+@contextlib.contextmanager
+def record_warnings() -> Iterator[list[warnings.WarningMessage]]:
+    """Record every warning this thread raises meanwhile, and only this thread's.
+
+    ``warnings.catch_warnings(record=True)`` swaps the process's filters and its
+    ``showwarning``: in a Dask worker with several threads, one point's warnings then
+    land in another point's status or in none (measured: 249 of 400 one-point chunks
+    wrong on 16 threads). Here ``showwarning`` sends each warning to the list of the
+    thread that raised it; while any thread records, an "always" filter stands first, so
+    that a warning met again is recorded again (other threads' repeats are then shown
+    again too), and both are put back when the last recording thread leaves.
+    """
+    global _recorders, _shown_before
+    with _RECORDING_LOCK:
+        if _recorders == 0:
+            _shown_before = warnings.showwarning
+            warnings.showwarning = _show_or_record
+            cast(list[Any], warnings.filters).insert(0, _ALWAYS)
+            _filters_changed()
+        _recorders += 1
+    outer = getattr(_RECORDING, "record", None)
+    record: list[warnings.WarningMessage] = []
+    _RECORDING.record = record
+    try:
+        yield record
+    finally:
+        _RECORDING.record = outer
+        with _RECORDING_LOCK:
+            _recorders -= 1
+            if _recorders == 0:
+                if warnings.showwarning is _show_or_record:
+                    warnings.showwarning = _shown_before
+                with contextlib.suppress(ValueError):
+                    cast(list[Any], warnings.filters).remove(_ALWAYS)
+                _filters_changed()
+
+
+def _filters_changed() -> None:
+    """Tell the warnings machinery its filter list changed (as simplefilter does)."""
+    changed = getattr(warnings, "_filters_mutated", None)
+    if changed is not None:
+        changed()
 
 
 @dataclass(frozen=True)
