@@ -17,11 +17,13 @@ __all__ = [
     "OUTPUT_LIMIT_BYTES",
     "SECONDS_PER",
     "STRUCTURE_PERIOD_S_PER_DOF2",
+    "STRUCTURE_TANGENT_S_PER_DOF3",
     "check_budget",
     "check_output",
     "estimate_s",
     "for_people",
     "structure_period_s",
+    "structure_tangent_s",
 ]
 
 #: Estimated seconds above which a request is refused unless allowed: one hour.
@@ -50,6 +52,20 @@ STRUCTURE_PERIOD_S_PER_DOF2 = 1e-4
 def structure_period_s(n_dof: int) -> float:
     """Estimated seconds of one period of the exact motion of an ``n_dof``-DOF structure."""
     return STRUCTURE_PERIOD_S_PER_DOF2 * float(n_dof) ** 2
+
+
+#: Seconds a recorded period of a stepped sine costs on top of its motion, per DOF cubed:
+#: its largest Lyapunov exponent carries the (2N, 2N) tangent flow along the motion.
+#: CPU seconds of a recorded period less a settling one, near and at twice closed mode 1
+#: (benchmarks/bench_budget.py, one BLAS thread, machine loaded): examples/chain.toml
+#: (5 DOF) 0.0025-0.0028 s, examples/mast.toml (40 DOF) 1.7-2.6 s; the settling periods
+#: there took 0.0006-0.0011 s and 0.13 s, which :data:`STRUCTURE_PERIOD_S_PER_DOF2` covers.
+STRUCTURE_TANGENT_S_PER_DOF3 = 3e-5
+
+
+def structure_tangent_s(n_dof: int) -> float:
+    """Estimated extra seconds of one recorded stepped-sine period of an ``n_dof``-DOF structure."""
+    return STRUCTURE_TANGENT_S_PER_DOF3 * float(n_dof) ** 3
 
 
 def estimate_s(count: float, kind: str) -> float:
@@ -110,12 +126,15 @@ def check_budget(
     allow: str = "--allow-long",
     each: float | None = None,
     given: str | None = None,
+    extra: tuple[float, float, str] | None = None,
 ) -> None:
     """Refuse ``count`` units of ``kind`` (given by ``option``) if they would take too long.
 
     ``each`` is the seconds a unit costs when it is not :data:`SECONDS_PER` [``kind``] (a
     structure's period, :func:`structure_period_s`); ``given`` says how the request was
-    written when not as ``option count`` (a product of several options, a study value).
+    written when not as ``option count`` (a product of several options, a study value);
+    ``extra`` = (count, seconds each, what) is a further cost of some of the units (a
+    stepped sine's recorded periods carry a tangent flow, :func:`structure_tangent_s`).
 
     Raises
     ------
@@ -125,10 +144,14 @@ def check_budget(
     """
     each = SECONDS_PER[kind] if each is None else each
     seconds = float(count) * each
+    more = ""
+    if extra is not None:
+        seconds += float(extra[0]) * extra[1]
+        more = f" plus {extra[2]} of {extra[0]:.0f} periods ({extra[1]:.3g} s each)"
     if seconds > LIMIT_S:
         asked = f"{option} {count}" if given is None else given
         raise ParameterError(
             f"{asked}: about {for_people(seconds)} of computing "
-            f"({each:g} s per {kind}), above the limit of {for_people(LIMIT_S)}; "
+            f"({each:g} s per {kind}){more}, above the limit of {for_people(LIMIT_S)}; "
             f"ask for fewer, or pass {allow} to run it anyway"
         )

@@ -550,7 +550,7 @@ def _amplitude_range(args: argparse.Namespace) -> Any:
 
 def _check_structure_budget(args: argparse.Namespace, study: Any) -> None:
     """Refuse a structure task whose periods of exact motion would take above the limit."""
-    from clearjoint.budget import check_budget, structure_period_s
+    from clearjoint.budget import check_budget, structure_period_s, structure_tangent_s
     from clearjoint.studies import marched_periods
 
     periods = marched_periods(
@@ -571,8 +571,17 @@ def _check_structure_budget(args: argparse.Namespace, study: Any) -> None:
     }.get(args.task)
     if given is not None:
         each = structure_period_s(n_dof)
+        extra = None
+        if args.task == "stepped-sine":  # each recorded period carries the tangent flow
+            recorded = periods * args.record_periods / (args.settle_periods + args.record_periods)
+            extra = (recorded, structure_tangent_s(n_dof), "the tangent flow")
         check_budget(
-            periods, f"period of this {n_dof}-DOF structure", option="", each=each, given=given
+            periods,
+            f"period of this {n_dof}-DOF structure",
+            option="",
+            each=each,
+            given=given,
+            extra=extra,
         )
 
 
