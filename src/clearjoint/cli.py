@@ -279,13 +279,19 @@ def _run_report(args: argparse.Namespace) -> int:
     if not folder.is_dir():
         raise RecordError(f"{folder}: not a folder; give --records a folder of record files")
     refuse_file_as_folder(args.out, "--out")
-    written = report_records(
-        Path(args.records),
-        Path(args.out),
-        force=args.force,
-        progress=_stage_printer(args),
-        warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
-    )
+    if args.jobs is not None and args.jobs < 1:
+        raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    jobs = args.jobs or os.cpu_count() or 1  # every core by default, as identify
+    with cli_progress.shown_progress(args, "identifying the records") as shown:
+        written = report_records(
+            Path(args.records),
+            Path(args.out),
+            force=args.force,
+            progress=_stage_printer(args),
+            warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
+            jobs=jobs,
+            files_done=shown,
+        )
     for path in written:
         print(f"wrote {path}")
     _print_findings(Path(args.out) / "results.json")

@@ -100,6 +100,7 @@ def _stiffness_parser(sub: Any) -> None:
 
 _JSON_TABLE = "print one JSON object instead of a table"
 _JOBS = "processes (default: every core)"
+_JOBS_FILES = "processes over the files (default: every core; the results do not depend on it)"
 _QUIET = "no progress bar or progress lines on stderr"
 _AMPLITUDES = "one (5um), a list (1um,5um,20um) or a range (1um..1mm, see --points)"
 _POINTS = "amplitudes in an --amplitude range, spaced logarithmically (default 40)"
@@ -207,6 +208,7 @@ def _report_parser(sub: Any) -> None:
     )
     p.add_argument("--records", required=True, help="folder of record files")
     p.add_argument("--out", default="clearjoint-report", help="output folder")
+    p.add_argument("--jobs", type=int, default=None, help=_JOBS_FILES)
     _flags(p, force="overwrite existing output files", quiet=_QUIET)
 
 
@@ -271,7 +273,7 @@ def _identify_parser(sub: Any) -> None:
         "--jobs",
         type=int,
         default=None,
-        help="processes over the files (default: every core; the results do not depend on it)",
+        help=_JOBS_FILES,
     )
     _flags(p, resample="interpolate records that are not uniformly sampled")
     p.add_argument(
