@@ -190,3 +190,17 @@ def test_recorded_periods_alone_can_make_a_stepped_sine_too_long(
     assert "plus the tangent flow of 2000 periods (1.92 s each)" in err
     code, err = _run([*args, "--record-periods", "200", "--allow-long"], capsys)
     assert (code, err) == (2, "clearjoint structure: error: reached the test, recording 200\n")
+
+
+def test_a_stepped_sine_of_no_periods_reaches_its_own_refusal(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The estimate's share of recorded periods has no periods to share here: the stepped
+    sine's own one-line refusal, not a division by zero."""
+    args = ["structure", str(MAST), "stepped-sine", "--from", "5Hz", "--to", "60Hz"]
+    args += ["--settle-periods", "0", "--record-periods", "0", "--out", str(tmp_path / "m.nc")]
+    code, err = _run(args, capsys)
+    assert (code, err) == (
+        2,
+        "clearjoint structure: error: settle_periods must be an integer >= 1, got 0\n",
+    )

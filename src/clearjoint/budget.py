@@ -57,9 +57,12 @@ def structure_period_s(n_dof: int) -> float:
 #: Seconds a recorded period of a stepped sine costs on top of its motion, per DOF cubed:
 #: its largest Lyapunov exponent carries the (2N, 2N) tangent flow along the motion.
 #: CPU seconds of a recorded period less a settling one, near and at twice closed mode 1
-#: (benchmarks/bench_budget.py, one BLAS thread, machine loaded): examples/chain.toml
-#: (5 DOF) 0.0025-0.0028 s, examples/mast.toml (40 DOF) 1.7-2.6 s; the settling periods
-#: there took 0.0006-0.0011 s and 0.13 s, which :data:`STRUCTURE_PERIOD_S_PER_DOF2` covers.
+#: (benchmarks/bench_budget.py, one BLAS thread, machine loaded, three runs):
+#: examples/chain.toml (5 DOF) 0.002-0.004 s, examples/mast.toml (40 DOF) 1.3-3.1 s; the
+#: settling periods there took 0.0006-0.0011 s and up to 0.13 s, which
+#: :data:`STRUCTURE_PERIOD_S_PER_DOF2` covers. A period's cost follows the gap-edge events
+#: it meets: the mast with 5 bays (20 DOF) at the same force met few and cost 5-30 times
+#: less than this estimate.
 STRUCTURE_TANGENT_S_PER_DOF3 = 3e-5
 
 

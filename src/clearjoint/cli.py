@@ -576,19 +576,11 @@ def _check_structure_budget(args: argparse.Namespace, study: Any) -> None:
         + (" x 2 directions" if args.direction == "both" else ""),
     }.get(args.task)
     if given is not None:
-        each = structure_period_s(n_dof)
-        extra = None
-        if args.task == "stepped-sine":  # each recorded period carries the tangent flow
-            recorded = periods * args.record_periods / (args.settle_periods + args.record_periods)
-            extra = (recorded, structure_tangent_s(n_dof), "the tangent flow")
-        check_budget(
-            periods,
-            f"period of this {n_dof}-DOF structure",
-            option="",
-            each=each,
-            given=given,
-            extra=extra,
-        )
+        each, kind = structure_period_s(n_dof), f"period of this {n_dof}-DOF structure"
+        recorded = periods * args.record_periods / max(1, args.settle_periods + args.record_periods)
+        stepped = args.task == "stepped-sine"  # each recorded period carries the tangent flow
+        extra = (recorded, structure_tangent_s(n_dof), "the tangent flow") if stepped else None
+        check_budget(periods, kind, option="", each=each, given=given, extra=extra)
 
 
 def _run_structure(args: argparse.Namespace) -> int:
