@@ -93,3 +93,24 @@ def test_simulate_says_how_far_a_transient_is_without_a_terminal(
     assert shares == sorted(shares)
     assert shares[-1] == 100
     assert all(line.endswith(" left") for line in lines[1:])
+
+
+def test_a_campaign_run_here_reports_in_tests_not_in_its_transients_seconds(
+    tmp_path: Path,
+) -> None:
+    """The rig's tests are transients (time_response); in this process (jobs=1) their own
+    reports would reach the campaign's listener in seconds of motion, and the first to
+    finish would end the command's display after one test."""
+    from clearjoint.rig import load_campaign, run_campaign
+
+    path = tmp_path / "campaign.toml"
+    path.write_text(
+        'seed = 7\nperiods = 12\n[grid]\nfrequencies = ["40Hz"]\n'
+        'force_amplitudes = ["1200N", "2500N"]\n[[structures]]\nname = "joint-1"\n'
+        'clearance = "0.106mm"\n',
+        encoding="utf-8",
+    )
+    heard: list[tuple[float, float]] = []
+    with listening(lambda done, total: heard.append((done, total))):
+        run_campaign(load_campaign(path), tmp_path / "out", jobs=1)
+    assert heard == [(1.0, 2.0), (2.0, 2.0)]
