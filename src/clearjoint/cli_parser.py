@@ -127,6 +127,7 @@ def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
         help="penetration(s) beyond the gap edge: " + _AMPLITUDES,
     )
     p.add_argument("--points", type=int, default=40, help=_POINTS)
+    _flags(p, allow_long="run a range whose table is estimated above 4 GiB (refused otherwise)")
 
 
 def _dissipation_parser(sub: Any) -> None:
@@ -536,6 +537,10 @@ def amplitude_values(args: argparse.Namespace) -> Any:
     from clearjoint.units import parse_amplitude_range, parse_quantity_list
 
     if ".." in args.amplitude:
+        if not getattr(args, "allow_long", True):  # stiffness, dissipation: a table in memory
+            from clearjoint.budget import check_table
+
+            check_table(args.points)
         return parse_amplitude_range(args.amplitude, args.points)
     values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
     return np.array(values)
