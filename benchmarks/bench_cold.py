@@ -46,14 +46,22 @@ def _timed(command: list[str], cache: Path, out: Path) -> float:
 
 
 def where(command: list[str]) -> None:
-    """Run ``command`` cold in this process; print each compile started from Python."""
+    """Run ``command`` cold in this process; print where its compile time goes.
+
+    Two tables. First each kernel compiled from Python, with its seconds (the kernels it
+    calls compiled inside it) and the line that called it. Then every function numba
+    compiled, callees included, with its own seconds (its callees' compiles taken out) split
+    into numba's own Python work (bytecode analysis, type inference, lowering to LLVM IR)
+    and LLVM's (optimising and emitting machine code: numba's "numba:llvm_lock" event).
+    """
     import runpy
     import traceback
 
     from numba.core import event
 
-    stack: list[tuple[str, float, str]] = []
+    stack: list[list[Any]] = []  # [name, start, seconds in callees, seconds in LLVM]
     tops: list[tuple[float, str, str]] = []
+    own: dict[str, list[float]] = {}  # name -> [own seconds, of which LLVM, compiles]
 
     class Timer(event.Listener):  # type: ignore[misc]
         def on_start(self, ev: Any) -> None:
@@ -63,14 +71,31 @@ def where(command: list[str]) -> None:
                     if "clearjoint" in frame.filename and "numba" not in frame.filename:
                         caller = f"{frame.filename.split('src/')[-1]}:{frame.lineno}"
                         break
-            stack.append((ev.data["dispatcher"].py_func.__qualname__, time.perf_counter(), caller))
+            name = ev.data["dispatcher"].py_func.__qualname__
+            stack.append([name, time.perf_counter(), 0.0, 0.0, caller])
 
         def on_end(self, ev: Any) -> None:
-            name, start, caller = stack.pop()
-            if not stack:
-                tops.append((time.perf_counter() - start, name, caller))
+            name, start, inner, llvm, caller = stack.pop()
+            seconds = time.perf_counter() - start
+            row = own.setdefault(name, [0.0, 0.0, 0])
+            row[0] += seconds - inner
+            row[1] += llvm
+            row[2] += 1
+            if stack:
+                stack[-1][2] += seconds
+            else:
+                tops.append((seconds, name, caller))
+
+    class Llvm(event.Listener):  # type: ignore[misc]
+        def on_start(self, ev: Any) -> None:
+            self.start = time.perf_counter()
+
+        def on_end(self, ev: Any) -> None:
+            if stack:
+                stack[-1][3] += time.perf_counter() - self.start
 
     event.register("numba:compile", Timer())
+    event.register("numba:llvm_lock", Llvm())
     start = time.perf_counter()
     old = sys.argv
     sys.argv = ["clearjoint", *command, "--quiet"]
@@ -86,6 +111,17 @@ def where(command: list[str]) -> None:
     print(f"cold run in this process: {total:.1f} s, of which compiling {compiled:.1f} s:")
     for seconds, name, caller in sorted(tops, reverse=True):
         print(f"  {seconds:5.1f} s  {name}  (called at {caller})")
+    llvm = sum(row[1] for row in own.values())
+    times = sorted(row[0] for row in own.values())
+    print(
+        f"{sum(int(row[2]) for row in own.values())} compiles of {len(own)} functions; "
+        f"numba's Python work {compiled - llvm:.1f} s, LLVM {llvm:.1f} s; "
+        f"a function's own compile: median {statistics.median(times):.2f} s, "
+        f"smallest {times[0]:.2f} s"
+    )
+    print("  own s  (LLVM s)  compiles  function")
+    for name, (seconds, in_llvm, count) in sorted(own.items(), key=lambda i: -i[1][0]):
+        print(f"  {seconds:5.2f}  ({in_llvm:4.2f})  {int(count):8d}  {name}")
 
 
 def main() -> None:

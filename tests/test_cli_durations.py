@@ -147,3 +147,60 @@ def test_a_steady_state_written_over_ten_million_periods_is_refused(
     ), err
     assert err.endswith("ask for fewer periods, or pass --allow-long to write it anyway\n")
     assert not out.exists()
+
+
+MAST = ROOT / "examples" / "mast.toml"  # 40 DOF
+
+
+def test_the_mast_default_stepped_sine_is_refused_with_its_tangent_flow(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A recorded period also carries the (2N, 2N) tangent flow: 3e-5 s x N^3 more
+    (clearjoint.budget's published cost). The default 100 x (200 + 100) periods of the
+    40-DOF mast: 30,000 x 1e-4 x 40^2 = 4,800 s and 10,000 x 3e-5 x 40^3 = 19,200 s,
+    24,000 s = 6.7 h, where the periods alone gave 80 min."""
+    args = ["structure", str(MAST), "stepped-sine", "--from", "5Hz", "--to", "60Hz"]
+    code, err = _run([*args, "--out", str(tmp_path / "m.nc")], capsys)
+    assert code == 2
+    _refused(
+        err,
+        "clearjoint structure: error: --points 100 x (--settle-periods 200 + "
+        "--record-periods 100) periods: about 6.7 h of computing (0.16 s per period of "
+        "this 40-DOF structure) plus the tangent flow of 10000 periods (1.92 s each)",
+    )
+
+
+def test_recorded_periods_alone_can_make_a_stepped_sine_too_long(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def stepped(*_args: object, **kwargs: object) -> None:
+        raise ParameterError(f"reached the test, recording {kwargs['record_periods']}")
+
+    monkeypatch.setattr(studies, "stepped_sine_of", stepped)
+    args = ["structure", str(MAST), "stepped-sine", "--from", "5Hz", "--to", "60Hz"]
+    args += ["--out", str(tmp_path / "m.nc"), "--points", "10", "--settle-periods", "1"]
+    # 10 x (1 + 150) periods x 0.16 s = 242 s, and 1500 recorded x 1.92 s = 2,880 s: 52 min
+    code, err = _run([*args, "--record-periods", "150"], capsys)
+    assert (code, err) == (2, "clearjoint structure: error: reached the test, recording 150\n")
+    # 10 x (1 + 200) x 0.16 = 322 s (the periods alone would pass) + 2000 x 1.92 = 4,162 s
+    code, err = _run([*args, "--record-periods", "200"], capsys)
+    assert code == 2
+    _refused(err, "clearjoint structure: error: --points 10 x (--settle-periods 1 + ")
+    assert "about 69 min of computing" in err
+    assert "plus the tangent flow of 2000 periods (1.92 s each)" in err
+    code, err = _run([*args, "--record-periods", "200", "--allow-long"], capsys)
+    assert (code, err) == (2, "clearjoint structure: error: reached the test, recording 200\n")
+
+
+def test_a_stepped_sine_of_no_periods_reaches_its_own_refusal(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The estimate's share of recorded periods has no periods to share here: the stepped
+    sine's own one-line refusal, not a division by zero."""
+    args = ["structure", str(MAST), "stepped-sine", "--from", "5Hz", "--to", "60Hz"]
+    args += ["--settle-periods", "0", "--record-periods", "0", "--out", str(tmp_path / "m.nc")]
+    code, err = _run(args, capsys)
+    assert (code, err) == (
+        2,
+        "clearjoint structure: error: settle_periods must be an integer >= 1, got 0\n",
+    )

@@ -230,3 +230,39 @@ def test_an_amplitude_range_reads_the_same_in_stiffness_as_in_modes(
     assert seen[0] == pytest.approx([1e-6, 1e-5, 1e-4], rel=1e-12)
     assert cli.main(["modes", FRF, "--amplitude", "10um,1um", *out]) == 2
     assert "must be above zero and ascending" in capsys.readouterr().err
+
+
+_JOINT = ["--mass", "2kg", "--stiffness", "8e7N/m", "--clearance", "0.1mm"]
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["stiffness", *_JOINT],
+        ["dissipation", "--study", str(ROOT / "examples" / "study.toml")],
+    ],
+)
+def test_a_hundred_million_table_amplitudes_are_refused_up_front(
+    command: list[str], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """stiffness and dissipation take microseconds a point: the limit is memory. 1e8 points
+    at 500 bytes (clearjoint.budget's published cost) are 5e10 bytes, 46.6 GiB, above 4 GiB;
+    the machine this was measured on had 23 GiB. 8e6 points (3.7 GiB) pass."""
+    from clearjoint import units
+
+    args = [*command, "--amplitude", "1um..1mm", "--points"]
+    code, out, err = _run([*args, "100000000"], capsys)
+    assert (code, out) == (2, "")
+    assert err == (
+        f"clearjoint {command[0]}: error: --points 100000000: about 47 GiB of table in memory "
+        "(500 bytes a point), above the limit of 4 GiB; ask for fewer, or pass --allow-long "
+        "to run it anyway\n"
+    )
+
+    def reached(*_args: object) -> None:
+        raise ParameterError("reached the range")
+
+    monkeypatch.setattr(units, "parse_amplitude_range", reached)
+    for points in (["8000000"], ["100000000", "--allow-long"]):
+        code, out, err = _run([*args, *points], capsys)
+        assert (code, err) == (2, f"clearjoint {command[0]}: error: reached the range\n")

@@ -17,11 +17,15 @@ __all__ = [
     "OUTPUT_LIMIT_BYTES",
     "SECONDS_PER",
     "STRUCTURE_PERIOD_S_PER_DOF2",
+    "STRUCTURE_TANGENT_S_PER_DOF3",
+    "TABLE_BYTES_PER_POINT",
     "check_budget",
     "check_output",
+    "check_table",
     "estimate_s",
     "for_people",
     "structure_period_s",
+    "structure_tangent_s",
 ]
 
 #: Estimated seconds above which a request is refused unless allowed: one hour.
@@ -50,6 +54,23 @@ STRUCTURE_PERIOD_S_PER_DOF2 = 1e-4
 def structure_period_s(n_dof: int) -> float:
     """Estimated seconds of one period of the exact motion of an ``n_dof``-DOF structure."""
     return STRUCTURE_PERIOD_S_PER_DOF2 * float(n_dof) ** 2
+
+
+#: Seconds a recorded period of a stepped sine costs on top of its motion, per DOF cubed:
+#: its largest Lyapunov exponent carries the (2N, 2N) tangent flow along the motion.
+#: CPU seconds of a recorded period less a settling one, near and at twice closed mode 1
+#: (benchmarks/bench_budget.py, one BLAS thread, machine loaded, three runs):
+#: examples/chain.toml (5 DOF) 0.002-0.004 s, examples/mast.toml (40 DOF) 1.3-3.1 s; the
+#: settling periods there took 0.0006-0.0011 s and up to 0.13 s, which
+#: :data:`STRUCTURE_PERIOD_S_PER_DOF2` covers. A period's cost follows the gap-edge events
+#: it meets: the mast with 5 bays (20 DOF) at the same force met few and cost 5-30 times
+#: less than this estimate.
+STRUCTURE_TANGENT_S_PER_DOF3 = 3e-5
+
+
+def structure_tangent_s(n_dof: int) -> float:
+    """Estimated extra seconds of one recorded stepped-sine period of an ``n_dof``-DOF structure."""
+    return STRUCTURE_TANGENT_S_PER_DOF3 * float(n_dof) ** 3
 
 
 def estimate_s(count: float, kind: str) -> float:
@@ -102,6 +123,35 @@ def check_output(periods: int, samples_per_period: int, *, allow: str = "--allow
         )
 
 
+#: Bytes a point of a joint's amplitude table costs in memory, its arrays and the printed
+#: table or JSON together: ``clearjoint stiffness`` with --amplitude 1um..1mm --points
+#: 1000000 took 366 MB resident (584 MB with --json) and ``clearjoint dissipation --study
+#: examples/study.toml`` 642 MB, against 164 and 233 MB with 100000 points (rounded up).
+TABLE_BYTES_PER_POINT = 500
+
+
+def check_table(points: int, *, option: str = "--points", allow: str = "--allow-long") -> None:
+    """Refuse an amplitude range of ``points`` whose table would not fit in memory.
+
+    ``clearjoint stiffness`` and ``dissipation`` compute a row a point in microseconds: the
+    limit is the memory (:data:`TABLE_BYTES_PER_POINT`), as for :func:`check_output`.
+
+    Raises
+    ------
+    ParameterError
+        The estimate exceeds :data:`OUTPUT_LIMIT_BYTES`; the message gives the estimate,
+        the limit and ``allow``.
+    """
+    size = float(points) * TABLE_BYTES_PER_POINT
+    if size > OUTPUT_LIMIT_BYTES:
+        raise ParameterError(
+            f"{option} {points}: about {size / 2**30:.0f} GiB of table in memory "
+            f"({TABLE_BYTES_PER_POINT} bytes a point), above the limit of "
+            f"{OUTPUT_LIMIT_BYTES / 2**30:.0f} GiB; ask for fewer, or pass {allow} to run "
+            "it anyway"
+        )
+
+
 def check_budget(
     count: float,
     kind: str,
@@ -110,12 +160,15 @@ def check_budget(
     allow: str = "--allow-long",
     each: float | None = None,
     given: str | None = None,
+    extra: tuple[float, float, str] | None = None,
 ) -> None:
     """Refuse ``count`` units of ``kind`` (given by ``option``) if they would take too long.
 
     ``each`` is the seconds a unit costs when it is not :data:`SECONDS_PER` [``kind``] (a
     structure's period, :func:`structure_period_s`); ``given`` says how the request was
-    written when not as ``option count`` (a product of several options, a study value).
+    written when not as ``option count`` (a product of several options, a study value);
+    ``extra`` = (count, seconds each, what) is a further cost of some of the units (a
+    stepped sine's recorded periods carry a tangent flow, :func:`structure_tangent_s`).
 
     Raises
     ------
@@ -125,10 +178,14 @@ def check_budget(
     """
     each = SECONDS_PER[kind] if each is None else each
     seconds = float(count) * each
+    more = ""
+    if extra is not None:
+        seconds += float(extra[0]) * extra[1]
+        more = f" plus {extra[2]} of {extra[0]:.0f} periods ({extra[1]:.3g} s each)"
     if seconds > LIMIT_S:
         asked = f"{option} {count}" if given is None else given
         raise ParameterError(
             f"{asked}: about {for_people(seconds)} of computing "
-            f"({each:g} s per {kind}), above the limit of {for_people(LIMIT_S)}; "
+            f"({each:g} s per {kind}){more}, above the limit of {for_people(LIMIT_S)}; "
             f"ask for fewer, or pass {allow} to run it anyway"
         )

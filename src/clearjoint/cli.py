@@ -279,13 +279,19 @@ def _run_report(args: argparse.Namespace) -> int:
     if not folder.is_dir():
         raise RecordError(f"{folder}: not a folder; give --records a folder of record files")
     refuse_file_as_folder(args.out, "--out")
-    written = report_records(
-        Path(args.records),
-        Path(args.out),
-        force=args.force,
-        progress=_stage_printer(args),
-        warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
-    )
+    if args.jobs is not None and args.jobs < 1:
+        raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
+    jobs = args.jobs or os.cpu_count() or 1  # every core by default, as identify
+    with cli_progress.shown_progress(args, "identifying the records") as shown:
+        written = report_records(
+            Path(args.records),
+            Path(args.out),
+            force=args.force,
+            progress=_stage_printer(args),
+            warn=lambda m: print(f"clearjoint report: warning: {m}", file=sys.stderr, flush=True),
+            jobs=jobs,
+            files_done=shown,
+        )
     for path in written:
         print(f"wrote {path}")
     _print_findings(Path(args.out) / "results.json")
@@ -550,7 +556,7 @@ def _amplitude_range(args: argparse.Namespace) -> Any:
 
 def _check_structure_budget(args: argparse.Namespace, study: Any) -> None:
     """Refuse a structure task whose periods of exact motion would take above the limit."""
-    from clearjoint.budget import check_budget, structure_period_s
+    from clearjoint.budget import check_budget, structure_period_s, structure_tangent_s
     from clearjoint.studies import marched_periods
 
     periods = marched_periods(
@@ -570,10 +576,11 @@ def _check_structure_budget(args: argparse.Namespace, study: Any) -> None:
         + (" x 2 directions" if args.direction == "both" else ""),
     }.get(args.task)
     if given is not None:
-        each = structure_period_s(n_dof)
-        check_budget(
-            periods, f"period of this {n_dof}-DOF structure", option="", each=each, given=given
-        )
+        each, kind = structure_period_s(n_dof), f"period of this {n_dof}-DOF structure"
+        recorded = periods * args.record_periods / max(1, args.settle_periods + args.record_periods)
+        stepped = args.task == "stepped-sine"  # each recorded period carries the tangent flow
+        extra = (recorded, structure_tangent_s(n_dof), "the tangent flow") if stepped else None
+        check_budget(periods, kind, option="", each=each, given=given, extra=extra)
 
 
 def _run_structure(args: argparse.Namespace) -> int:

@@ -100,6 +100,7 @@ def _stiffness_parser(sub: Any) -> None:
 
 _JSON_TABLE = "print one JSON object instead of a table"
 _JOBS = "processes (default: every core)"
+_JOBS_FILES = "processes over the files (default: every core; the results do not depend on it)"
 _QUIET = "no progress bar or progress lines on stderr"
 _AMPLITUDES = "one (5um), a list (1um,5um,20um) or a range (1um..1mm, see --points)"
 _POINTS = "amplitudes in an --amplitude range, spaced logarithmically (default 40)"
@@ -126,6 +127,7 @@ def _add_joint_options(p: argparse.ArgumentParser, *, required: bool) -> None:
         help="penetration(s) beyond the gap edge: " + _AMPLITUDES,
     )
     p.add_argument("--points", type=int, default=40, help=_POINTS)
+    _flags(p, allow_long="run a range whose table is estimated above 4 GiB (refused otherwise)")
 
 
 def _dissipation_parser(sub: Any) -> None:
@@ -207,6 +209,7 @@ def _report_parser(sub: Any) -> None:
     )
     p.add_argument("--records", required=True, help="folder of record files")
     p.add_argument("--out", default="clearjoint-report", help="output folder")
+    p.add_argument("--jobs", type=int, default=None, help=_JOBS_FILES)
     _flags(p, force="overwrite existing output files", quiet=_QUIET)
 
 
@@ -271,7 +274,7 @@ def _identify_parser(sub: Any) -> None:
         "--jobs",
         type=int,
         default=None,
-        help="processes over the files (default: every core; the results do not depend on it)",
+        help=_JOBS_FILES,
     )
     _flags(p, resample="interpolate records that are not uniformly sampled")
     p.add_argument(
@@ -534,6 +537,10 @@ def amplitude_values(args: argparse.Namespace) -> Any:
     from clearjoint.units import parse_amplitude_range, parse_quantity_list
 
     if ".." in args.amplitude:
+        if not getattr(args, "allow_long", True):  # stiffness, dissipation: a table in memory
+            from clearjoint.budget import check_table
+
+            check_table(args.points)
         return parse_amplitude_range(args.amplitude, args.points)
     values = parse_quantity_list(args.amplitude, "length", name="--amplitude", bare="refuse")
     return np.array(values)

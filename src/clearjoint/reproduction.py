@@ -57,8 +57,13 @@ def report_records(
     force: bool = False,
     progress: Progress | None = None,
     warn: Progress | None = None,
+    jobs: int = 1,
+    files_done: Callable[[int, int], Any] | None = None,
 ) -> list[Path]:
     """Identify every record in ``folder``, fit the laws and write the report to ``out_dir``.
+
+    The records are identified by ``jobs`` processes (:func:`clearjoint.identify.identify_files`,
+    the same results as one), which call ``files_done(done, total)`` after each file.
 
     The identification's warnings (a force-controlled record without a mass, with how to
     add it) go to ``warn`` one line each, and onto the report's page and results.json.
@@ -75,7 +80,7 @@ def report_records(
         raise RecordError(f"{folder}: no record files ({endings}) in it")
     refuse_to_overwrite([Path(out_dir) / n for n in ("report.html", "results.json")], force=force)
     say(f"identifying {len(files)} records")
-    results, failures = identify_files(files)
+    results, failures = identify_files(files, jobs=jobs, progress=files_done)
     if not results:
         from clearjoint.identify import IdentificationError
 

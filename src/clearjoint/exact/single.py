@@ -29,6 +29,7 @@ from clearjoint.contact import contact_friction_power, hertz_contact
 from clearjoint.errors import ParameterError, SimulationError
 from clearjoint.exact import kernel as kn
 from clearjoint.joint import Friction, Joint, Losses, Pin
+from clearjoint.progress import report
 from clearjoint.results.motion import EnergyLedger, Stage, SteadyState
 from clearjoint.stiffness import viscous_coefficient
 from clearjoint.system import as_joint
@@ -36,6 +37,11 @@ from clearjoint.system import as_joint
 FloatArray = NDArray[np.float64]
 
 STAGE_NAMES = {kn.FREE: "free-play", kn.COMPRESSION: "compression", kn.TENSION: "tension"}
+
+#: Pieces of whole forcing periods a recorded transient is run in, each ending in a progress
+#: report (clearjoint.progress): every period is the kernel's same arithmetic from the same
+#: state, so the motion is the one run's to the bit (:func:`run_kernel_in_pieces`).
+PROGRESS_PIECES = 100
 
 
 def parameters(
@@ -168,6 +174,38 @@ def run_kernel(
             )
         state[:] = start
         return Run(segments[:n_seg], impacts[:n_imp], strobe, ledger, events)
+
+
+def run_kernel_in_pieces(p: FloatArray, state: FloatArray, n_periods: int, t_last: float) -> Run:
+    """:func:`run_kernel` with ``record``, in up to :data:`PROGRESS_PIECES` runs of whole periods.
+
+    After each piece the seconds of motion done (of ``(n_periods - 1) T + t_last``) are
+    reported (:func:`clearjoint.progress.report`). A period always starts at forcing phase 0
+    from the state the last one ended in, and its records are numbered from the run's first
+    period, so the records are those of one run to the bit (tests/test_simulate_progress.py).
+    """
+    pieces = max(1, min(PROGRESS_PIECES, n_periods))
+    if pieces == 1:
+        return run_kernel(p, state, n_periods, t_last, record=True)
+    tf = p[kn.P_TF]
+    total = (n_periods - 1) * tf + t_last
+    runs: list[Run] = []
+    first = 0
+    for piece in range(pieces):
+        last = n_periods * (piece + 1) // pieces  # periods [first, last) in this piece
+        run = run_kernel(p, state, last - first, t_last if last == n_periods else tf, True)
+        run.segments[:, kn.SEG_PERIOD] += first
+        run.impacts[:, 0] += first
+        runs.append(run)
+        first = last
+        report(min(last * tf, total), total)
+    return Run(
+        np.concatenate([run.segments for run in runs]),
+        np.concatenate([run.impacts for run in runs]),
+        np.concatenate([run.strobe for run in runs]),
+        np.concatenate([run.ledger for run in runs]),
+        sum(run.events for run in runs),
+    )
 
 
 def _mechanical_energy(joint: Joint, x: float, v: float) -> float:

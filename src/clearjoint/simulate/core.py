@@ -29,6 +29,7 @@ from clearjoint.exact.single import (
     motion_fields,
     orbit_from,
     run_kernel,
+    run_kernel_in_pieces,
     sample_times,
     setup,
 )
@@ -75,7 +76,8 @@ def time_response(
     sampled ``samples_per_period`` times per forcing period, or at
     ``sampling_rate`` (Hz) when that is given. ``losses`` (:class:`~clearjoint.Losses`,
     default none) or the one-DOF system given as ``joint`` carry the damping, friction,
-    restitution and the pin.
+    restitution and the pin. The kernel runs in pieces of whole forcing periods and reports
+    the seconds done after each (:func:`clearjoint.progress.report`); the motion is the same.
     """
     joint, losses, p = setup(joint, force_amplitude, omega, losses)
     duration = _checks.positive("duration", duration, unit="s")
@@ -90,7 +92,7 @@ def time_response(
         n_periods, t_last = n_full, tf
     else:
         n_periods, t_last = n_full + 1, remainder
-    run = run_kernel(p, state, n_periods, t_last, record=True)
+    run = run_kernel_in_pieces(p, state, n_periods, t_last)  # reports its progress
     fields = motion_fields(p, joint, run, start, time, pin, mu_c)
     return Motion(**fields)  # type: ignore[arg-type]
 
