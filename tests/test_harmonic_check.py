@@ -73,3 +73,19 @@ def test_bad_input(three_links: Structure, curve: FrequencyResponse) -> None:
     joint = Joint(mass=1.0, clearance=0.35, compression_stiffness=3.0, gap_stiffness=1.0)
     with pytest.raises(ParameterError, match="shooting"):
         check_orbits(dataclasses.replace(fr, settings={**fr.settings, "system": joint}))
+
+
+def test_the_checks_motion_does_not_report_into_the_curves_progress(
+    three_links: Structure,
+) -> None:
+    # the exact motion reports seconds of motion; the curve reports its parameter range
+    # (0.3 rad/s here): a listener of the curve must hear only the latter
+    from clearjoint.progress import listening
+
+    heard: list[float] = []
+    with listening(lambda done, total: heard.append(total)):
+        frequency_response(
+            three_links, FORCE, 300.0, 300.3, harmonics=3, max_points=2, check_points=2
+        )
+    assert heard
+    assert heard == pytest.approx([0.3] * len(heard))

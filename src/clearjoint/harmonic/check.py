@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint.errors import ClearjointError, ParameterError
+from clearjoint.progress import silenced
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -220,14 +221,15 @@ def check_orbits(
         scale = np.concatenate((np.ones(n), np.full(n, 1.0 / w)))
         crossings[m] = monodromy.crossings(model, basis, coefficients[i]).size
         try:
-            motion = time_response(
-                structure,
-                pattern * float(response.force_amplitude[i]),
-                w,
-                2.0 * math.pi / w,
-                initial=(x[:n], x[n:]),
-                samples_per_period=8,
-            )
+            with silenced():  # its seconds of motion are not the curve's progress
+                motion = time_response(
+                    structure,
+                    pattern * float(response.force_amplitude[i]),
+                    w,
+                    2.0 * math.pi / w,
+                    initial=(x[:n], x[n:]),
+                    samples_per_period=8,
+                )
         except ClearjointError:  # e.g. chattering: the orbit is not the motion
             continue
         end = np.concatenate(motion.final_state)
