@@ -30,8 +30,9 @@ and prints the largest difference of the orbits (relative to the largest coeffic
 and the verdicts that differ. ``--exact`` also checks every point's verdict against the
 exact monodromy's (``monodromy.multipliers``; slow at 40 bays and more). ``--modes B``
 times the first nonlinear mode (EPMC) of the B-bay mast at 50 amplitudes (0.1 to 20 mm x
-(B / 10)^2 at the tip). ``--plot FILE.png`` draws the cost per point against the unknowns
-(log-log) with the fitted exponent. ``--pyharm PYTHON`` runs pyHarm's SDOF comparison
+(B / 10)^2 at the tip; with ``--json`` its time, CPU time, converged count and sparse
+LU calls go to the table's "modes"). ``--plot FILE.png`` draws the cost per point against
+the unknowns (log-log) with the fitted exponent. ``--pyharm PYTHON`` runs pyHarm's SDOF comparison
 (``bench_harmonic.py --pyharm PYTHON``, in its own interpreter) after the sizes.
 
 BLAS runs on one thread (the machine's 2 cores are shared); every timing is on a loaded
@@ -137,6 +138,7 @@ def run_size(bays: int, points: int, exact: bool) -> dict[str, Any]:
     timers.wrap("splu", scipy.sparse.linalg, "splu")
     load = os.getloadavg()[0]
     started = time.perf_counter()
+    cpu = time.process_time()
     try:
         fr = frequency_response(
             structure,
@@ -151,6 +153,7 @@ def run_size(bays: int, points: int, exact: bool) -> dict[str, Any]:
     finally:
         timers.restore()
     took = time.perf_counter() - started
+    cpu = time.process_time() - cpu
     start = timers.spent["start"]
     n = fr.omega.size
     rest = took - start
@@ -161,6 +164,7 @@ def run_size(bays: int, points: int, exact: bool) -> dict[str, Any]:
         "unknowns": unknowns,
         "points": n,
         "total": took,
+        "cpu": cpu,
         "start": start,
         "per_point": per_point,
         "verdict": timers.spent.get("verdict", 0.0),
@@ -206,7 +210,7 @@ def report(row: dict[str, Any]) -> None:
     verdict_share = row["verdict"] / max(row["total"] - row["start"], 1e-12)
     print(
         f"{row['bays']:3d} bays, {row['unknowns']:5d} unknowns: {n} points in "
-        f"{row['total']:7.1f} s; start {row['start']:6.2f} s; per point "
+        f"{row['total']:7.1f} s ({row['cpu']:.1f} s CPU); start {row['start']:6.2f} s; per point "
         f"{row['per_point']:.4f} s, of which the stability verdict {100 * verdict_share:4.1f} % "
         f"({row['verdict'] / n * 1e3:.1f} ms a point), splu {row['splu_calls']} calls "
         f"{row['splu']:.1f} s (start included); {int(np.sum(~row['stable']))} unstable; "
@@ -256,23 +260,46 @@ def compare(rows: list[dict[str, Any]], path: str) -> None:
         )
 
 
-def modes(bays: int) -> None:
-    """Time the first nonlinear mode of the ``bays``-bay mast at 50 amplitudes."""
+def modes(bays: int) -> dict[str, Any]:
+    """Time the first nonlinear mode of the ``bays``-bay mast at 50 amplitudes; its numbers."""
     structure = model(bays)
     amplitudes = np.geomspace(1e-4, 2e-2, 50) * (bays / 10) ** 2
     load = os.getloadavg()[0]
     started = time.perf_counter()
-    nm = nonlinear_modes(structure, 1, amplitudes, harmonics=H)
+    cpu = time.process_time()
+    timers = Timers()
+    timers.wrap("splu", scipy.sparse.linalg, "splu")
+    try:
+        nm = nonlinear_modes(structure, 1, amplitudes, harmonics=H)
+    finally:
+        timers.restore()
     took = time.perf_counter() - started
+    cpu = time.process_time() - cpu
     f = nm.frequency[nm.converged] / (2 * math.pi)
     span = f"{f.min():.3f} to {f.max():.3f} Hz" if f.size else "none"
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     print(
         f"first nonlinear mode (EPMC), {bays} bays, {(2 * H + 1) * structure.n_dof} unknowns: "
-        f"50 amplitudes in {took:.1f} s, {int(nm.converged.sum())}/50 converged, {span}; "
-        f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0:.0f} MiB; "
-        f"load {load:.2f}",
+        f"50 amplitudes in {took:.1f} s ({cpu:.1f} s CPU), {int(nm.converged.sum())}/50 "
+        f"converged, {span}; splu {timers.calls['splu']} calls {timers.spent['splu']:.1f} s; "
+        f"peak RSS {rss:.0f} MiB; load {load:.2f}",
         flush=True,
     )
+    return {
+        "bays": bays,
+        "unknowns": (2 * H + 1) * structure.n_dof,
+        "amplitudes": int(amplitudes.size),
+        "amplitude_range_m": [float(amplitudes[0]), float(amplitudes[-1])],
+        "total": took,
+        "cpu": cpu,
+        "converged": int(nm.converged.sum()),
+        "frequency_hz": [float(f.min()), float(f.max())] if f.size else None,
+        "splu": timers.spent["splu"],
+        "splu_calls": timers.calls["splu"],
+        "rss_mib": rss,
+        "load": load,
+        "note": nm.note,
+    }
 
 
 def plot(rows: list[dict[str, Any]], exponent: float, path: str) -> None:
@@ -305,6 +332,7 @@ TABLE_KEYS = (
     "unknowns",
     "points",
     "total",
+    "cpu",
     "start",
     "per_point",
     "verdict",
@@ -324,9 +352,11 @@ def write_json(
     fitted: list[dict[str, Any]],
     exponent: float,
     started: str,
+    mode: dict[str, Any] | None = None,
 ) -> None:
     """The measured table as JSON: one object per size (``TABLE_KEYS``, plus the verdict's
-    time per point and share, the unstable points), the sizes without a curve, the fit."""
+    time per point and share, the unstable points), the sizes without a curve, the fit,
+    and the nonlinear mode's timing (``--modes``) under "modes"."""
     import json
 
     table = []
@@ -353,6 +383,8 @@ def write_json(
             "of": "per_point ~ unknowns^exponent, least squares in log-log",
         },
     }
+    if mode is not None:
+        out["modes"] = mode
     Path(path).write_text(json.dumps(out, indent=1) + "\n")
     print(f"table written to {path}")
 
@@ -407,8 +439,9 @@ def main() -> None:
         )
         if args.plot:
             plot(fitted, p, args.plot)
+    mode = modes(args.modes) if args.modes else None
     if args.json:
-        write_json(args.json, rows, failed, fitted, p, started)
+        write_json(args.json, rows, failed, fitted, p, started, mode)
     if args.save:
         arrays: dict[str, Any] = {}
         for r in rows:
@@ -420,8 +453,6 @@ def main() -> None:
         print(f"orbits written to {args.save}")
     if args.compare:
         compare(rows, args.compare)
-    if args.modes:
-        modes(args.modes)
     if args.pyharm:
         here = Path(__file__).resolve().parent / "bench_harmonic.py"
         subprocess.run([sys.executable, str(here), "--pyharm", args.pyharm], check=False)

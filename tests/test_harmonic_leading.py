@@ -233,3 +233,62 @@ def test_an_orbit_too_big_for_the_caches_keeps_the_block_route(
         np.abs(found.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
     )
     monodromy.clear_cache()
+
+
+def test_short_patterns_stay_taylor_when_the_orbits_patterns_would_not_all_fit(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A cache that holds the curve's long patterns but not all of an orbit's patterns (as
+    the 80-bay mast's: 137 long ones, 856 MiB of 1 GiB): the short patterns are not
+    decomposed when met again (they would evict the long ones, decomposed again at every
+    pass). Along the curve, warm, only the long patterns are decomposed, each once; the
+    short ones keep Taylor's series; the leading multipliers equal the eigenvalues of the
+    whole monodromy (the plain expm product, the cache being too small for it) to 1e-9."""
+    structure, fr, basis = curve
+    model = build(structure, None, 1.0)
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)
+    bound = monodromy._short_bound(model)
+    long_keys: set[bytes] = set()
+    totals = []
+    for i in range(fr.omega.size):
+        widths, states = monodromy._segments(model, basis, fr.coefficients[i])
+        longest: dict[bytes, float] = {}
+        for state, width in zip(states, widths, strict=True):
+            key = state.tobytes()
+            longest[key] = max(longest.get(key, 0.0), float(width) / float(fr.omega[i]))
+        long_keys |= {k for k, t in longest.items() if bound * t > monodromy.SHORT_LIMIT}
+        totals.append(len(longest))
+    matrix_bytes = (2 * model.n_dof) ** 2 * 8
+    limit = 2 * matrix_bytes * len(long_keys)  # room for every long pattern of the curve
+    assert all(2 * matrix_bytes * total > limit for total in totals)  # not for all of one orbit
+    monodromy.clear_cache()
+    monkeypatch.setattr(monodromy._FLOWS, "limit", limit)
+    decomposed = []
+    taylor = []
+    original, propagate = monodromy._decompose, ShortFlow.propagate
+
+    def counted(a: np.ndarray) -> object:
+        decomposed.append(1)
+        return original(a)
+
+    def stepped(self: ShortFlow, t: float, phi: np.ndarray) -> np.ndarray:
+        taylor.append(t)
+        return propagate(self, t, phi)
+
+    monkeypatch.setattr(ShortFlow, "propagate", stepped)
+    block = None
+    for i in range(fr.omega.size):
+        coef, w = fr.coefficients[i], float(fr.omega[i])
+        monkeypatch.setattr(monodromy, "_decompose", counted)
+        before = len(taylor)
+        found = monodromy.leading_block(model, basis, coef, w, block)
+        assert len(taylor) > before  # the short patterns, met again or not: Taylor
+        monkeypatch.setattr(monodromy, "_decompose", original)
+        exact = monodromy.multipliers(model, basis, coef, w)
+        k = found.block.shape[1]
+        np.testing.assert_allclose(
+            np.abs(found.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
+        )
+        block = found.block
+    assert len(decomposed) == len(long_keys)  # each long pattern once, no short one
+    monodromy.clear_cache()

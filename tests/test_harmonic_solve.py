@@ -125,3 +125,31 @@ def test_epmc_sparse_jacobian_is_the_dense_one() -> None:
     assert np.array_equal(r, r_s)
     assert sparse.shape == dense.shape
     np.testing.assert_allclose(sparse.toarray(), dense, rtol=0.0, atol=1e-13 * np.abs(dense).max())
+
+
+def test_epmc_sparse_jacobian_has_scipys_stacked_pattern() -> None:
+    """The bordered CSR written directly holds exactly scipy's hstack/vstack of the blocks:
+    the same entries, the explicit zeros of dR/dq kept and the zeros of the w and xi
+    columns dropped (so the sparse LU sees the same matrix and ordering as before)."""
+    import scipy.sparse
+
+    from clearjoint.harmonic.modes import _sparse_epmc_jacobian
+
+    rng = np.random.default_rng(3)
+    n = 40
+    jac = scipy.sparse.random(n, n, density=0.1, random_state=4, format="csr")
+    jac.data[::5] = 0.0
+    d_w, d_xi = rng.normal(size=n), rng.normal(size=n)
+    d_w[rng.random(n) < 0.3] = 0.0
+    d_xi[rng.random(n) < 0.3] = 0.0
+    border = scipy.sparse.csr_matrix((np.ones(2), ([0, 1], [3, 17])), shape=(2, n + 2))
+    stacked = scipy.sparse.vstack(
+        (scipy.sparse.hstack((jac, np.column_stack((d_w, d_xi)))), border), format="csc"
+    )
+    direct = scipy.sparse.csc_matrix(_sparse_epmc_jacobian(jac, d_w, d_xi, 3, 17))
+    stacked.sort_indices()
+    direct.sort_indices()
+    assert direct.nnz == stacked.nnz == jac.nnz + np.count_nonzero(d_w) + np.count_nonzero(d_xi) + 2
+    assert np.array_equal(direct.indptr, stacked.indptr)
+    assert np.array_equal(direct.indices, stacked.indices)
+    assert np.array_equal(direct.data, stacked.data)

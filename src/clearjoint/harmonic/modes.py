@@ -577,14 +577,37 @@ def epmc_residual(
 def _sparse_epmc_jacobian(
     jac_u: Any, d_omega: FloatArray, d_xi: FloatArray, a_row: int, b_row: int
 ) -> Any:
-    """[[dR/dq, dR/dw, dR/dxi], [e_a^T, 0, 0], [e_b^T, 0, 0]] as a CSR matrix (as the dense)."""
+    """[[dR/dq, dR/dw, dR/dxi], [e_a^T, 0, 0], [e_b^T, 0, 0]] as a CSR matrix (as the dense).
+
+    Written straight into CSR arrays (each row of dR/dq, then its non-zero entries of the
+    two columns): the same entries as scipy's ``hstack``/``vstack`` of the blocks (which
+    drop the columns' zeros), without their COO round trip, a sixth of EPMC's time on the
+    40-bay mast (issue 25).
+    """
     import scipy.sparse
 
-    n_u = jac_u.shape[0]
-    border = scipy.sparse.csr_matrix((np.ones(2), ([0, 1], [a_row, b_row])), shape=(2, n_u + 2))
-    return scipy.sparse.vstack(
-        (scipy.sparse.hstack((jac_u, np.column_stack((d_omega, d_xi)))), border), format="csr"
-    )
+    jac = scipy.sparse.csr_matrix(jac_u)
+    n_u = jac.shape[0]
+    has_w, has_xi = d_omega != 0.0, d_xi != 0.0
+    own = np.diff(jac.indptr)
+    indptr = np.zeros(n_u + 3, dtype=np.int64)
+    np.cumsum(own + has_w + has_xi, out=indptr[1 : n_u + 1])
+    indptr[n_u + 1] = indptr[n_u] + 1
+    indptr[n_u + 2] = indptr[n_u] + 2
+    nnz = int(indptr[-1])
+    indices = np.empty(nnz, dtype=np.int64)
+    data = np.empty(nnz)
+    rows = np.repeat(np.arange(n_u), own)
+    at = indptr[rows] + (np.arange(jac.indptr[-1]) - jac.indptr[rows])
+    indices[at], data[at] = jac.indices, jac.data
+    ends = indptr[:n_u] + own
+    w_rows = np.flatnonzero(has_w)
+    indices[ends[w_rows]], data[ends[w_rows]] = n_u, d_omega[w_rows]
+    xi_rows = np.flatnonzero(has_xi)
+    xi_at = ends[xi_rows] + has_w[xi_rows]
+    indices[xi_at], data[xi_at] = n_u + 1, d_xi[xi_rows]
+    indices[nnz - 2 :], data[nnz - 2 :] = (a_row, b_row), 1.0
+    return scipy.sparse.csr_matrix((data, indices, indptr), shape=(n_u + 2, n_u + 2))
 
 
 def _march(

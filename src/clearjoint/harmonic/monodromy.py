@@ -300,6 +300,10 @@ def _product(
     # they would evict each other at every segment: on the whole Phi expm is cheaper then,
     # on a block they are held for this orbit alone (``local``)
     fits = 2 * len(decomposed) * a.nbytes <= _FLOWS.limit
+    # the short patterns are decomposed when met again only if all the orbit's patterns fit:
+    # else they would evict the long ones, to be decomposed again at every pass (the 80-bay
+    # mast: 2N = 640, 6.5 MB a decomposition)
+    room = 2 * len(longest) * a.nbytes <= _FLOWS.limit
     eigen = method == "eigen" and (fits or short)
     local: dict[bytes, _Flow | None] | None = None if fits else {}
     system_key = _fingerprint(system) if eigen else b""
@@ -322,7 +326,7 @@ def _product(
                 # when another orbit meets it again: a pattern that recurs along the curve
                 # costs one decomposition, one that does not costs none
                 seen, mark = _SEEN_SHORT.get((system_key, key))
-                if local is not None or not seen or mark is token:
+                if local is not None or not room or not seen or mark is token:
                     _SEEN_SHORT.put((system_key, key), token, 1)
                     if key not in taylor:
                         taylor[key] = ShortFlow.for_structure(
