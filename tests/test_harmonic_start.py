@@ -44,3 +44,19 @@ def test_a_start_past_the_limit_is_one_clear_error(
     assert "max_points after 10 points" in message
     assert f"reached only {error.reached * 40:.3g} N of 40 N" in message
     assert "start at a lower force" in message
+
+
+def test_the_force_continuation_does_not_report_into_the_curves_progress(
+    three_links: Structure,
+) -> None:
+    # the start's force continuation counts the force, not the curve's frequency range; a
+    # display ends at the first series of reports that finishes (cli_progress), so the
+    # start's reports reaching the full force would end the curve's bar before the curve
+    from clearjoint.progress import listening
+
+    heard: list[tuple[float, float]] = []
+    with listening(lambda done, total: heard.append((done, total))):
+        frequency_response(three_links, FORCE, OMEGA, 810.0, max_points=3, check_points=0)
+    assert heard
+    assert [total for _, total in heard] == pytest.approx([10.0] * len(heard)), heard[:3]  # rad/s
+    assert all(done < total for done, total in heard[:-1])

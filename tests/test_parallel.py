@@ -5,6 +5,7 @@ from __future__ import annotations
 import socket
 import subprocess
 import sys
+import threading
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -302,3 +303,50 @@ def test_warnings_outside_a_recording_thread_are_shown_as_before() -> None:
         warnings.warn("shown", UserWarning, stacklevel=1)
     assert [str(w.message) for w in inside] == ["recorded"]
     assert [str(w.message) for w in outside] == ["shown"]
+
+
+def test_a_catch_warnings_in_another_thread_leaves_no_always_filter_and_no_loop() -> None:
+    # another thread (the store's writer, a library) enters catch_warnings while a point
+    # records and leaves it after: its exit puts back the filter list and showwarning it
+    # saved, both with record_warnings' changes in. These must not stay (an "always"
+    # filter for the rest of the process, over the user's "error" or "default"), nor
+    # make the next recording's showwarning call itself (RecursionError on any warning
+    # outside a recording thread)
+    shown_before, filters_before = warnings.showwarning, list(warnings.filters)
+    entered, recorded, left = threading.Event(), threading.Event(), threading.Event()
+
+    def other() -> None:
+        recorded.wait()
+        with warnings.catch_warnings():
+            entered.set()
+            left.wait()
+
+    thread = threading.Thread(target=other)
+    thread.start()
+    with record_warnings():
+        recorded.set()
+        entered.wait()
+    left.set()
+    thread.join()
+    assert warnings.filters == filters_before
+    left_shown = warnings.showwarning  # as that other thread's exit left it
+    with warnings.catch_warnings(record=True) as outside:
+        warnings.showwarning = left_shown
+        with record_warnings() as caught:  # a second run
+            warnings.warn("recorded", UserWarning, stacklevel=1)
+            result: list[BaseException] = []
+            thread = threading.Thread(target=_warn_into, args=(result,))
+            thread.start()
+            thread.join()
+    assert not result, result
+    assert [str(w.message) for w in caught] == ["recorded"]
+    assert [str(w.message) for w in outside] == ["shown"]
+    assert warnings.filters == filters_before
+    warnings.showwarning = shown_before
+
+
+def _warn_into(errors: list[BaseException]) -> None:
+    try:
+        warnings.warn("shown", UserWarning, stacklevel=1)
+    except BaseException as exc:  # RecursionError when showwarning calls itself
+        errors.append(exc)

@@ -111,6 +111,7 @@ _RECORDING = threading.local()
 _RECORDING_LOCK = threading.Lock()
 _recorders = 0  # threads inside record_warnings, in this process
 _shown_before: Any = None  # warnings.showwarning as it was when the first one entered
+_filtered: list[Any] = []  # the filter lists _ALWAYS was put into (removed from each)
 _ALWAYS = ("always", None, Warning, None, 0)
 
 
@@ -145,9 +146,14 @@ def record_warnings() -> Iterator[list[warnings.WarningMessage]]:
     global _recorders, _shown_before
     with _RECORDING_LOCK:
         if _recorders == 0:
-            _shown_before = warnings.showwarning
+            # another thread's catch_warnings, left after the last recording thread,
+            # may have put _show_or_record back: never call it from itself
+            if warnings.showwarning is not _show_or_record:
+                _shown_before = warnings.showwarning
             warnings.showwarning = _show_or_record
-            cast(list[Any], warnings.filters).insert(0, _ALWAYS)
+            filters = cast(list[Any], warnings.filters)
+            filters.insert(0, _ALWAYS)
+            _filtered.append(filters)
             _filters_changed()
         _recorders += 1
     outer = getattr(_RECORDING, "record", None)
@@ -162,8 +168,11 @@ def record_warnings() -> Iterator[list[warnings.WarningMessage]]:
             if _recorders == 0:
                 if warnings.showwarning is _show_or_record:
                     warnings.showwarning = _shown_before
-                with contextlib.suppress(ValueError):
-                    cast(list[Any], warnings.filters).remove(_ALWAYS)
+                # from the list it was put into too: another thread's catch_warnings
+                # entered meanwhile puts that list back when it leaves
+                for filters in (*_filtered, cast(list[Any], warnings.filters)):
+                    filters[:] = [f for f in filters if f is not _ALWAYS]
+                _filtered.clear()
                 _filters_changed()
 
 

@@ -49,6 +49,7 @@ from clearjoint.harmonic.system import (
     scale_length,
 )
 from clearjoint.joint import Losses, takes_losses
+from clearjoint.progress import silenced
 from clearjoint.results import FrequencyResponse, ResponseEvent
 
 FloatArray = NDArray[np.float64]
@@ -487,22 +488,23 @@ def _start_plain(
             return ev.residual / k_ref, jac / k_ref, d_lam / k_ref, None
 
         try:
-            branch = continue_branch(
-                residual if sparse is None else SparseResidual(residual),
-                fraction * open_guess,
-                fraction,
-                1.0,
-                u_scale=np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess))))),
-                lam_scale=1.0,
-                settings=ContinuationSettings(
-                    step=0.01,
-                    min_step=1e-7,
-                    max_step=0.1,
-                    max_points=points,
-                    tolerance=TOLERANCE,
-                    chord_parameter=sparse is not None,  # the sparse corrector and tangent
-                ),
-            )
+            with silenced():  # it counts the force, not the curve's progress
+                branch = continue_branch(
+                    residual if sparse is None else SparseResidual(residual),
+                    fraction * open_guess,
+                    fraction,
+                    1.0,
+                    u_scale=np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess))))),
+                    lam_scale=1.0,
+                    settings=ContinuationSettings(
+                        step=0.01,
+                        min_step=1e-7,
+                        max_step=0.1,
+                        max_points=points,
+                        tolerance=TOLERANCE,
+                        chord_parameter=sparse is not None,  # the sparse corrector and tangent
+                    ),
+                )
         except ClearjointError:
             branch = None
         if branch is not None and branch.reason == "reached":
