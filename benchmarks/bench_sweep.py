@@ -32,7 +32,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -201,6 +201,52 @@ def _timed_store_run(sweep: Sweep, client: object) -> tuple[float, float]:
         return time.perf_counter() - t0, time.process_time() - c0
 
 
+@contextlib.contextmanager
+def _external_cluster(workers: int, threads: int) -> Iterator[str]:
+    """A scheduler and ``workers`` worker processes of ``threads`` threads each, started as
+    processes of their own (``dask scheduler``, ``dask worker``), as on a real cluster
+    whose scheduler does not share the client's process: yield its address."""
+    import json
+
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).resolve().parent), *sys.path])
+    )
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
+    with tempfile.TemporaryDirectory() as folder:
+        file = str(Path(folder) / "scheduler.json")
+        common = ["--scheduler-file", file, "--no-dashboard", "--host", "127.0.0.1"]
+        started = [
+            subprocess.Popen(
+                [sys.executable, "-m", "distributed.cli.dask_scheduler", *common], **quiet
+            )
+        ]
+        try:
+            deadline = time.monotonic() + 60.0
+            while not Path(file).exists() and time.monotonic() < deadline:
+                time.sleep(0.1)
+            time.sleep(0.5)  # written whole
+            started.append(
+                subprocess.Popen(
+                    [
+                        sys.executable,
+                        "-m",
+                        "distributed.cli.dask_worker",
+                        *common,
+                        "--nworkers",
+                        str(workers),
+                        "--nthreads",
+                        str(threads),
+                    ],
+                    **quiet,
+                )
+            )
+            yield str(json.loads(Path(file).read_text())["address"])
+        finally:
+            for process in reversed(started):
+                process.terminate()
+                process.wait()
+
+
 def _median(values: list[float]) -> float:
     return float(np.median(values))
 
@@ -317,21 +363,23 @@ def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
         f"median {_median(control):.2f}x (rounds: {', '.join(f'{r:.2f}' for r in control)}); "
         f"load average after each round: {', '.join(f'{x:.1f}' for x in loads)}"
     )
-    # 3. a simulated cluster of 200 threads on 50 ms sleeps, chunk_size = 1; twice: as Dask
-    # starts it, and with its workers' statistical profiler off. That profiler walks every
-    # thread's stack each 10 ms: here 100 threads share a worker process and its CPU,
-    # where a real cluster of 200 workers profiles one thread each, on cores of their own
+    # 3. a simulated cluster of 200 threads on 50 ms sleeps, chunk_size = 1; three times: a
+    # LocalCluster as Dask starts it; the same with its workers' statistical profiler off
+    # (it walks every thread's stack each 10 ms: here 100 threads share a worker process
+    # and its CPU, where a real cluster of 200 workers profiles one thread each, on cores of
+    # their own); and a scheduler and workers started as processes of their own, since a
+    # LocalCluster's scheduler runs on the client's own IO-loop thread
     import dask
     import distributed  # noqa: F401  (its config defaults in place before it is set)
 
     sleeps = replace(spin_sweep(int(10_000 * scale), 0.050, 1), task=SLEEP)
     m = sleeps.n_points
     group = auto_group(m, 200)
-    for profiled in (True, False):
-        with (
-            dask.config.set({"distributed.worker.profile.enabled": profiled}),
-            dask_client(workers=2, threads=100) as client,
-        ):
+    for profiled, external in ((True, False), (False, False), (True, True)):
+        with contextlib.ExitStack() as stack:
+            stack.enter_context(dask.config.set({"distributed.worker.profile.enabled": profiled}))
+            address = stack.enter_context(_external_cluster(2, 100)) if external else None
+            client = stack.enter_context(dask_client(address, workers=2, threads=100))
             client.wait_for_workers(2)
             _timed_store_run(replace(sleeps, axes=(Axis("task.index", (0.0, 1.0), ""),)), client)
             stored, cpu, plain = [], [], []
@@ -342,9 +390,15 @@ def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
                 t0 = time.perf_counter()
                 run_sweep(sleeps, client=client)
                 plain.append(time.perf_counter() - t0)
+        where = (
+            "a scheduler and 2 worker processes of their own, as on a real cluster"
+            if external
+            else "a LocalCluster: its scheduler in this process, workers' profiler "
+            + ("on, as Dask starts them" if profiled else "off")
+        )
         print(
             f"3. {m} tasks (chunks of 1 point) of a 50 ms sleep on 2 workers x 100 threads "
-            f"(workers' profiler {'on, as Dask starts them' if profiled else 'off'}), as "
+            f"({where}), as "
             f"{-(-m // group)} Dask tasks of {group}: with the store "
             f"{m / _median(stored):.0f} tasks/s (client CPU {_median(cpu) / m * 1e3:.2f} ms "
             f"a task), without it {m / _median(plain):.0f} tasks/s; target >= 2,000/s "
