@@ -141,8 +141,8 @@ def record_warnings() -> Iterator[list[warnings.WarningMessage]]:
     chunks wrong on 16 threads, two runs). Here ``showwarning`` sends each warning to
     the list of the thread that raised it; while any thread records, an "always" filter
     stands first, so that a warning met again is recorded again (other threads' repeats
-    are then shown
-    again too), and both are put back when the last recording thread leaves.
+    are then shown again too), and both are put back when the last recording thread
+    leaves.
     """
     global _recorders, _shown_before
     with _RECORDING_LOCK:
