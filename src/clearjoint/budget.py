@@ -111,15 +111,20 @@ def check_output(periods: int, samples_per_period: int, *, allow: str = "--allow
         The estimate exceeds :data:`OUTPUT_LIMIT_BYTES`; the message gives the estimate,
         the limit and ``allow``.
     """
-    samples = float(periods) * float(samples_per_period)
-    size = samples * OUTPUT_BYTES_PER_SAMPLE
+    _check_bytes(
+        float(periods) * float(samples_per_period) * OUTPUT_BYTES_PER_SAMPLE,
+        f"[output] periods {periods} x samples_per_period {samples_per_period}",
+        f"series in memory and on disk ({OUTPUT_BYTES_PER_SAMPLE} bytes a sample)",
+        f"ask for fewer periods, or pass {allow} to write it anyway",
+    )
+
+
+def _check_bytes(size: float, asked: str, what: str, instead: str) -> None:
+    """Refuse a request whose ``size`` bytes exceed :data:`OUTPUT_LIMIT_BYTES`, in one line."""
     if size > OUTPUT_LIMIT_BYTES:
         raise ParameterError(
-            f"[output] periods {periods} x samples_per_period {samples_per_period}: about "
-            f"{size / 2**30:.0f} GiB of series in memory and on disk "
-            f"({OUTPUT_BYTES_PER_SAMPLE} bytes a sample), above the limit of "
-            f"{OUTPUT_LIMIT_BYTES / 2**30:.0f} GiB; ask for fewer periods, or pass {allow} "
-            "to write it anyway"
+            f"{asked}: about {size / 2**30:.0f} GiB of {what}, above the limit of "
+            f"{OUTPUT_LIMIT_BYTES / 2**30:.0f} GiB; {instead}"
         )
 
 
@@ -142,14 +147,12 @@ def check_table(points: int, *, option: str = "--points", allow: str = "--allow-
         The estimate exceeds :data:`OUTPUT_LIMIT_BYTES`; the message gives the estimate,
         the limit and ``allow``.
     """
-    size = float(points) * TABLE_BYTES_PER_POINT
-    if size > OUTPUT_LIMIT_BYTES:
-        raise ParameterError(
-            f"{option} {points}: about {size / 2**30:.0f} GiB of table in memory "
-            f"({TABLE_BYTES_PER_POINT} bytes a point), above the limit of "
-            f"{OUTPUT_LIMIT_BYTES / 2**30:.0f} GiB; ask for fewer, or pass {allow} to run "
-            "it anyway"
-        )
+    _check_bytes(
+        float(points) * TABLE_BYTES_PER_POINT,
+        f"{option} {points}",
+        f"table in memory ({TABLE_BYTES_PER_POINT} bytes a point)",
+        f"ask for fewer, or pass {allow} to run it anyway",
+    )
 
 
 def check_budget(
