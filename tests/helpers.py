@@ -240,3 +240,16 @@ def with_losses(keywords: Mapping[str, Any]) -> dict[str, Any]:
     rest = {k: v for k, v in keywords.items() if k not in LOSS_KEYWORDS}
     losses = {k: v for k, v in keywords.items() if k in LOSS_KEYWORDS}
     return {**rest, "losses": Losses(**losses)} if losses else rest
+
+
+def check_progress_lines(err: str, first: str) -> None:
+    """A command's stderr without a terminal: ``first``, then a line a report whose share
+    rises to 100 % and which ends with the time left (the compile line of a first run
+    left out)."""
+    lines = [line for line in err.splitlines() if "compiling the solvers" not in line]
+    assert lines[0] == first
+    shares = [int(line.split(": ")[1].split(" %")[0]) for line in lines[1:]]
+    assert len(shares) > 10  # about one a piece (the first starts the clock)
+    assert shares == sorted(shares)
+    assert shares[-1] == 100
+    assert all(line.endswith(" left") for line in lines[1:])

@@ -21,6 +21,7 @@ from clearjoint.exact import single
 from clearjoint.progress import listening
 from clearjoint.simulate import time_response
 from clearjoint.studies import load_study
+from helpers import check_progress_lines
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = ROOT / "examples" / "study.toml"
@@ -82,17 +83,7 @@ def test_simulate_says_how_far_a_transient_is_without_a_terminal(
     monkeypatch.setattr(cli_progress, "PROGRESS_EVERY_S", 0.0)
     monkeypatch.setattr(cli_progress, "PROGRESS_LINES_IN_PROCESS", True)  # as the command
     assert cli.main(["simulate", str(study), "--json"]) == 0
-    lines = [
-        line
-        for line in capsys.readouterr().err.splitlines()
-        if "compiling the solvers" not in line  # a first run says so
-    ]
-    assert lines[0] == f"clearjoint simulate: simulating {study}"
-    shares = [int(line.split(": ")[1].split(" %")[0]) for line in lines[1:]]
-    assert len(shares) > 10
-    assert shares == sorted(shares)
-    assert shares[-1] == 100
-    assert all(line.endswith(" left") for line in lines[1:])
+    check_progress_lines(capsys.readouterr().err, f"clearjoint simulate: simulating {study}")
 
 
 def test_a_campaign_run_here_reports_in_tests_not_in_its_transients_seconds(

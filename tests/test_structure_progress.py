@@ -20,6 +20,7 @@ from clearjoint import cli, cli_progress
 from clearjoint.progress import listening
 from clearjoint.structure import motion as structure_motion
 from clearjoint.structure.study import load_structure_study
+from helpers import check_progress_lines
 
 ROOT = Path(__file__).resolve().parents[1]
 CHAIN = ROOT / "examples" / "chain.toml"
@@ -82,14 +83,4 @@ def test_structure_respond_says_how_far_it_is_without_a_terminal(
     monkeypatch.setattr(cli_progress, "PROGRESS_LINES_IN_PROCESS", True)  # as the command
     args = ["structure", str(CHAIN), "respond", "--out", str(tmp_path / "r.nc")]
     assert cli.main(args) == 0
-    lines = [
-        line
-        for line in capsys.readouterr().err.splitlines()
-        if "compiling the solvers" not in line  # a first run says so
-    ]
-    assert lines[0] == f"clearjoint structure: respond of {CHAIN}"
-    shares = [int(line.split(": ")[1].split(" %")[0]) for line in lines[1:]]
-    assert len(shares) > 10  # about one a piece (the first starts the clock)
-    assert shares == sorted(shares)
-    assert shares[-1] == 100
-    assert all(line.endswith(" left") for line in lines[1:])
+    check_progress_lines(capsys.readouterr().err, f"clearjoint structure: respond of {CHAIN}")
