@@ -48,6 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.errors import ClearjointError, ParameterError
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.progress import report
@@ -276,7 +277,7 @@ def _tangent(a: Any, previous: FloatArray) -> FloatArray:
     if not isinstance(a, np.ndarray):
         return _sparse_tangent(a, previous)
     t = np.empty(a.shape[1])
-    if not tangent_solve(np.ascontiguousarray(a, dtype=np.float64), previous, t):
+    if not _compiled_tangent_solve(np.ascontiguousarray(a, dtype=np.float64), previous, t):
         _, _, vt = np.linalg.svd(a)
         t = vt[-1] / np.linalg.norm(vt[-1])
     unit: FloatArray = np.asarray(t, dtype=np.float64)
@@ -988,3 +989,7 @@ def _cross_kink(
                 break
             jump *= 10.0
     return None
+
+
+# for Python callers: the kernel as compiled at install where that is usable
+_compiled_tangent_solve = prefer(tangent_solve)

@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.errors import ParameterError, ParameterTypeError
 
 _P = ParamSpec("_P")
@@ -127,7 +128,9 @@ class ClearanceJoint:
         from clearjoint.laws import clearance  # here: numba loads on first use only
 
         samples = np.asarray(delta, dtype=np.float64)
-        force, _ = clearance.forces_and_tangents(_column(samples), *clearance.parameters((self,)))
+        force, _ = prefer(clearance.forces_and_tangents)(
+            _column(samples), *clearance.parameters((self,))
+        )
         return force.reshape(samples.shape)
 
     def tangent_stiffness(self, delta: ArrayLike) -> NDArray[np.float64]:
@@ -139,7 +142,7 @@ class ClearanceJoint:
         from clearjoint.laws import clearance  # here: numba loads on first use only
 
         samples = np.asarray(delta, dtype=np.float64)
-        _, stiffness = clearance.forces_and_tangents(
+        _, stiffness = prefer(clearance.forces_and_tangents)(
             _column(samples), *clearance.parameters((self,))
         )
         return stiffness.reshape(samples.shape)
@@ -152,7 +155,7 @@ class ClearanceJoint:
         from clearjoint.laws import clearance  # here: numba loads on first use only
 
         samples = np.asarray(delta, dtype=np.float64)
-        energy = clearance.potentials(_column(samples), *clearance.parameters((self,)))
+        energy = prefer(clearance.potentials)(_column(samples), *clearance.parameters((self,)))
         return energy.reshape(samples.shape)
 
     def contact_force(self, delta: ArrayLike) -> NDArray[np.float64]:

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.continuation import (
     Branch,
     ContinuationSettings,
@@ -73,6 +74,11 @@ from clearjoint.results.orbit import PeriodicOrbit as PeriodicOrbit
 from clearjoint.results.response import FrequencyResponse as FrequencyResponse
 from clearjoint.results.response import ResponseEvent as ResponseEvent
 from clearjoint.system import VibrationSystem
+
+# the kernels as compiled at install where that is usable (clearjoint.compiled)
+_start_state = prefer(start_state)
+_correct_orbit = prefer(correct_orbit)
+_arclength_step = prefer(arclength_step)
 
 __all__ = [
     "frequency_response",
@@ -169,7 +175,7 @@ def _orbit(
     joint: Joint, losses: Losses, p: FloatArray, z: FloatArray, shot: Shot, n: int, iterations: int
 ) -> PeriodicOrbit:
     state = np.zeros(4)
-    start_state(p, float(z[0]), float(z[1]), state)
+    _start_state(p, float(z[0]), float(z[1]), state)
     cycle = orbit_from(p, joint, state, n, 0, losses.pin, losses.contact_friction_coefficient, 256)
     mu = np.linalg.eigvals(shot.monodromy).astype(np.complex128)
     return PeriodicOrbit(
@@ -218,7 +224,7 @@ def orbit_cycle(
     joint, losses, p = setup(joint, force_amplitude, omega, losses)
     z = np.asarray(initial_state, dtype=np.float64)
     state = np.zeros(4)
-    start_state(p, float(z[0]), float(z[1]), state)
+    _start_state(p, float(z[0]), float(z[1]), state)
     return orbit_from(p, joint, state, 1, 0, losses.pin, losses.contact_friction_coefficient, 64)
 
 
@@ -376,7 +382,7 @@ class _MapResidual:
         y = np.empty(3)
         system = np.empty((3, 3))
         out = np.zeros(N_RES)
-        its = correct_orbit(
+        its = _correct_orbit(
             self.p,
             self.code,
             y0,
@@ -410,7 +416,7 @@ class _MapResidual:
         system = np.empty((3, 3))
         out = np.zeros(N_RES)
         t_new = np.empty(3)
-        its = arclength_step(
+        its = _arclength_step(
             self.p,
             self.code,
             points,
@@ -743,7 +749,7 @@ def frequency_response(
             q = p.copy()
             set_parameter(q, code, float(branch.lam[i]))
             state = np.zeros(4)
-            start_state(q, float(branch.u[i, 0]), float(branch.u[i, 1]), state)
+            _start_state(q, float(branch.u[i, 0]), float(branch.u[i, 1]), state)
             stuck.append(orbit_from(q, joint, state, 1, 0, None, 0.0, 8).stick_time > 0.0)
         sticking.append(stuck[0] != stuck[1])
     events = _events(

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from clearjoint.compiled import prefer
 from clearjoint.continuation import extrapolate, tangent_solve
 from clearjoint.exact import kernel as kn
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
@@ -328,9 +329,9 @@ def shoot(p: FloatArray, z0: FloatArray, n_periods: int) -> Shot:
     if len(z0) == 4:
         state[:] = z0
     else:
-        start_state(p, float(z0[0]), float(z0[1]), state)
+        _start_state_compiled(p, float(z0[0]), float(z0[1]), state)
     out = np.zeros(N_OUT)
-    status = shoot_map(p, state, n_periods, out, NO_PARAMETER)
+    status = _shoot_map_compiled(p, state, n_periods, out, NO_PARAMETER)
     if status != kn.STATUS_OK:
         raise MapError(status)
     return Shot(
@@ -647,3 +648,9 @@ def arclength_step(
         for i in range(3):
             t_new[i] = -t_new[i]
     return its
+
+
+# for Python callers: the kernels as compiled at install where that is usable (numba
+# kernels above call the dispatchers themselves)
+_start_state_compiled = prefer(start_state)
+_shoot_map_compiled = prefer(shoot_map)

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.contact import contact_friction_power, hertz_contact
 from clearjoint.errors import ParameterError, SimulationError
 from clearjoint.exact import kernel as kn
@@ -33,6 +34,12 @@ from clearjoint.progress import report
 from clearjoint.results.motion import EnergyLedger, Stage, SteadyState
 from clearjoint.stiffness import viscous_coefficient
 from clearjoint.system import as_joint
+
+# the kernels as compiled at install where that is usable (clearjoint.compiled)
+_region_of = prefer(kn.region_of)
+_decide_slip = prefer(kn.decide_slip)
+_advance = prefer(kn.advance)
+_sample = prefer(kn.sample)
 
 FloatArray = NDArray[np.float64]
 
@@ -116,9 +123,9 @@ def initial_state(p: FloatArray, initial: ArrayLike | None) -> FloatArray:
         state[kn.S_REGION] = values[2]
         state[kn.S_SLIP] = values[3]
         return state
-    region = kn.region_of(p, x0, v0)
+    region = _region_of(p, x0, v0)
     state[kn.S_REGION] = region
-    state[kn.S_SLIP] = (1 if v0 > 0 else -1) if v0 != 0.0 else kn.decide_slip(p, region, x0, 0.0)
+    state[kn.S_SLIP] = (1 if v0 > 0 else -1) if v0 != 0.0 else _decide_slip(p, region, x0, 0.0)
     return state
 
 
@@ -155,7 +162,7 @@ def run_kernel(
         segments = np.zeros((capacity, kn.SEG_WIDTH))
         impacts = np.zeros((capacity, kn.IMP_WIDTH))
         start = state.copy()
-        n_seg, n_imp, events, status = kn.advance(
+        n_seg, n_imp, events, status = _advance(
             p, start, n_periods, t_last, record, segments, impacts, strobe, ledger
         )
         if status == kn.STATUS_SEGMENTS_FULL:
@@ -237,7 +244,7 @@ def _contact_friction(
         start = row[kn.SEG_PERIOD] * tf + row[kn.SEG_T0]
         times = start + 0.5 * row[kn.SEG_DT] * (nodes + 1.0)
         out = np.zeros((times.size, 3))
-        kn.sample(p, row[None, :], 1, times, out)
+        _sample(p, row[None, :], 1, times, out)
         force = joint.element.contact_force(out[:, 0])
         power = contact_friction_power(pin, friction_coefficient, force, out[:, 1])
         total += 0.5 * row[kn.SEG_DT] * float(np.sum(weights * power))
@@ -287,7 +294,7 @@ def motion_fields(
     """Return the fields of a Motion sampled at ``time`` from a recorded run (MODEL.md sec. 2)."""
     tf = p[kn.P_TF]
     out = np.zeros((time.size, 3))
-    kn.sample(p, run.segments, run.segments.shape[0], time, out)
+    _sample(p, run.segments, run.segments.shape[0], time, out)
     x, v, a = out[:, 0], out[:, 1], out[:, 2]
     seg = run.segments
     starts = seg[:, kn.SEG_PERIOD] * tf + seg[:, kn.SEG_T0]

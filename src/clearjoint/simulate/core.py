@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.errors import ParameterError
 from clearjoint.errors import SimulationError as SimulationError
 from clearjoint.exact import kernel as kn
@@ -145,7 +146,7 @@ def _smallest_multiple(
         dist = np.max(np.abs(strobe[:, :2] - z) / scale, axis=1)
         if dist[-1] > 10.0 * tolerance and dist[-1] > 0.9 * float(np.max(dist[:-multiple])):
             continue  # the states circle the d-orbit instead of approaching it
-        start_state(p, float(z[0]), float(z[1]), state)
+        prefer(start_state)(p, float(z[0]), float(z[1]), state)
         return d
     return multiple
 

@@ -1,0 +1,63 @@
+"""Build hook: compile the solvers' kernels ahead of time into the wheel (clearjoint.compiled).
+
+hatchling runs it when it builds a wheel, standard or editable. It compiles the kernels in
+a subprocess, from this source tree (``python -m clearjoint.compiled``), into
+``src/clearjoint/_kernels_<digest>.<suffix>`` (kept there, ignored by git: an up-to-date
+module is not compiled again); a standard wheel also carries that file, an editable
+install imports it from the source tree. Where the compile cannot run (no C compiler,
+say) the wheel is built without it, with a warning, and the kernels compile at first use
+as before. ``CLEARJOINT_COMPILED=0`` in the environment skips the compile.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+from hatchling.builders.hooks.plugin.interface import BuildHookInterface
+
+
+class CompiledKernels(BuildHookInterface):  # type: ignore[misc]
+    """Compile :data:`clearjoint.compiled.EXPORTS` and put the module into the wheel."""
+
+    PLUGIN_NAME = "custom"
+
+    def initialize(self, version: str, build_data: dict[str, Any]) -> None:
+        if self.target_name != "wheel" or os.environ.get("CLEARJOINT_COMPILED", "1") == "0":
+            return
+        root = Path(self.root)
+        env = dict(os.environ, PYTHONPATH=str(root / "src"))
+        self.app.display_info("clearjoint: compiling the solvers' kernels (about 30 s)")
+        try:
+            done = subprocess.run(
+                [sys.executable, "-m", "clearjoint.compiled"],
+                cwd=root,
+                env=env,
+                capture_output=True,
+                text=True,
+                check=False,
+                timeout=3600,
+            )
+        except (OSError, subprocess.SubprocessError) as exc:
+            self._skip(str(exc))
+            return
+        lines = done.stdout.strip().splitlines()
+        if done.returncode != 0 or not lines or not Path(lines[-1]).is_file():
+            reason = (done.stderr.strip().splitlines() or ["no output"])[-1]
+            self._skip(reason)
+            return
+        module = Path(lines[-1])
+        if version == "editable":
+            return  # an editable install imports the package, and the module, from src/
+        build_data["force_include"][str(module)] = f"clearjoint/{module.name}"
+        build_data["pure_python"] = False
+        build_data["infer_tag"] = True
+
+    def _skip(self, reason: str) -> None:
+        self.app.display_warning(
+            f"clearjoint: the kernels were not compiled ahead of time ({reason}); "
+            "they will compile at their first use instead"
+        )

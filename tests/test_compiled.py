@@ -1,0 +1,234 @@
+"""compiled: the kernels compiled at install give the JIT kernels' results to the bit, a
+documented command's cold run compiles nothing with them, and anything they cannot take
+(another dtype, a view, a stale module, ``CLEARJOINT_COMPILED=0``) goes to the JIT kernels.
+
+The module is built by the install (``pip install -e .``, its build hook) or by
+``python -m clearjoint.compiled``; without it these tests skip, unless
+``CLEARJOINT_REQUIRE_COMPILED=1`` (CI) makes its absence a failure.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from clearjoint import Joint, Losses, compiled, continuation, periodic
+from clearjoint.exact import shooting, single
+from clearjoint.laws import clearance
+from clearjoint.periodic import frequency_response
+from clearjoint.simulate import time_response
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "src" / "clearjoint"
+
+#: pyHarm's SDOF clearance case (as tests/test_periodic.py): a curve with folds and grazings.
+PYHARM = Joint(
+    mass=1.0, clearance=0.349, gap_stiffness=1.0, compression_stiffness=3.0, tension_stiffness=3.0
+)
+LOSSES = Losses(damping_ratio=0.05 / (2.0 * math.sqrt(3.0)))
+
+
+def _require_module() -> None:
+    if compiled.load() is None:
+        message = (
+            "the kernels compiled at install are absent: build them with "
+            "`python -m clearjoint.compiled` (or reinstall: pip install -e .)"
+        )
+        if os.environ.get("CLEARJOINT_REQUIRE_COMPILED") == "1":
+            pytest.fail(message)
+        pytest.skip(message)
+
+
+def _jit_only(monkeypatch: pytest.MonkeyPatch) -> int:
+    """Point every Python caller back at the JIT kernels; return how many were switched."""
+    switched = 0
+    for module in (single, shooting, periodic, continuation):
+        for name, value in list(vars(module).items()):
+            if callable(value) and hasattr(value, "jit"):
+                monkeypatch.setattr(module, name, value.jit)
+                switched += 1
+    monkeypatch.setattr(compiled, "_loaded", None)  # prefer() at call time: joint.py
+    monkeypatch.setattr(compiled, "_preferred", {})
+    return switched
+
+
+def _same_bits(a: xr.Dataset, b: xr.Dataset) -> list[str]:
+    """The variables and coordinates of two datasets whose bytes differ."""
+    names = [*a.data_vars, *a.coords]
+    return [
+        str(n)
+        for n in names
+        if a[n].dtype.kind in "fiub" and a[n].values.tobytes() != b[n].values.tobytes()
+    ]
+
+
+def test_the_compiled_kernels_give_the_jit_kernels_results_to_the_bit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    _require_module()
+    assert periodic._correct_orbit is not shooting.correct_orbit  # the compiled one in use
+
+    def run() -> tuple[xr.Dataset, xr.Dataset]:
+        curve = frequency_response(PYHARM, 0.03, 0.05, 1.8, losses=LOSSES)
+        motion = time_response(PYHARM, 0.03, 1.1, 60.0, initial=(0.3, 0.0), losses=LOSSES)
+        return curve.to_xarray(), motion.to_xarray()
+
+    compiled_curve, compiled_motion = run()
+    assert _jit_only(monkeypatch) == 10  # 4 in single, 2 in shooting, 3 in periodic, 1 more
+    jit_curve, jit_motion = run()
+    assert compiled_curve.sizes == jit_curve.sizes and compiled_curve.sizes["point"] > 50
+    assert _same_bits(compiled_curve, jit_curve) == []
+    assert _same_bits(compiled_motion, jit_motion) == []
+    monkeypatch.undo()
+    samples = np.linspace(-0.5, 0.5, 101)[:, None].copy()  # across both gap edges
+    parameters = clearance.parameters((PYHARM,))
+    for kernel in (clearance.forces_and_tangents, clearance.potentials):
+        ours = compiled.prefer(kernel)
+        assert ours is not kernel
+        got, expected = ours(samples, *parameters), kernel(samples, *parameters)
+        for a, b in zip(np.atleast_1d(got), np.atleast_1d(expected), strict=True):
+            assert np.asarray(a).tobytes() == np.asarray(b).tobytes()
+
+
+@pytest.mark.parametrize(
+    "samples",
+    [
+        np.linspace(-0.5, 0.5, 8, dtype=np.float32)[:, None],  # another dtype
+        np.asfortranarray(np.linspace(-0.5, 0.5, 16).reshape(8, 2))[:, :1],  # a strided view
+    ],
+    ids=["float32", "view"],
+)
+def test_arguments_the_export_cannot_take_go_to_the_jit_kernel(samples: np.ndarray) -> None:
+    """The extension converts its arguments unchecked (a float32 array would crash the
+    process): the wrapper checks them and hands anything else to numba."""
+    _require_module()
+    law = compiled.prefer(clearance.forces_and_tangents)
+    assert law is not clearance.forces_and_tangents
+    parameters = clearance.parameters((PYHARM,))
+    force, tangent = law(samples, *parameters)
+    expected = clearance.forces_and_tangents(
+        np.ascontiguousarray(samples, dtype=np.float64), *parameters
+    )
+    np.testing.assert_allclose(force, expected[0], rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(tangent, expected[1], rtol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("kind", "value", "taken"),
+    [
+        ("a1", np.zeros(3), True),
+        ("a1", np.zeros(3, dtype=np.float32), False),
+        ("a1", np.zeros((3, 1)), False),
+        ("a1", np.zeros(6)[::2], False),
+        ("a1", [0.0, 0.0], False),
+        ("a2", np.zeros((2, 3)), True),
+        ("a2", np.zeros((2, 3), order="F"), False),
+        ("i", 3, True),
+        ("i", np.int32(3), True),
+        ("i", 2**63, False),
+        ("i", 3.0, False),
+        ("f", 0.5, True),
+        ("f", 2, True),
+        ("f", "0.5", False),
+        ("f", 1j, False),
+        ("b", True, True),
+        ("b", np.bool_(False), True),
+        ("b", 1, False),
+    ],
+)
+def test_each_argument_kind_is_checked(kind: str, value: Any, taken: bool) -> None:
+    assert compiled._ACCEPTS[kind](value) is taken
+
+
+def test_a_read_only_array_is_not_handed_to_the_export() -> None:
+    frozen = np.zeros(3)
+    frozen.flags.writeable = False
+    assert not compiled._ACCEPTS["a1"](frozen)
+
+
+def test_every_export_signature_is_read_as_its_kernel_takes_it() -> None:
+    """Each signature's argument count is its Python function's (no kernel's arguments
+    were dropped or added without the table following)."""
+    import importlib
+    import inspect
+
+    for module, name, signature in compiled.EXPORTS:
+        function = getattr(importlib.import_module(module), name).py_func
+        assert len(compiled.argument_kinds(signature)) == len(
+            inspect.signature(function).parameters
+        ), name
+
+
+def _copy_package(tmp_path: Path) -> Path:
+    copy = tmp_path / "clearjoint"
+    shutil.copytree(PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__", "_kernels_*"))
+    return copy
+
+
+def test_the_module_name_follows_the_kernels_source_only(tmp_path: Path) -> None:
+    copy = _copy_package(tmp_path)
+    name = compiled.module_name(copy)
+    assert name == compiled.module_name() and name.startswith("_kernels_")
+    (copy / "cli.py").write_text((copy / "cli.py").read_text() + "\n# no kernel here\n")
+    assert compiled.module_name(copy) == name
+    law = copy / "laws" / "clearance.py"
+    law.write_text(law.read_text() + "\n# a changed kernel file\n")
+    assert compiled.module_name(copy) != name
+
+
+def _python(code: str, **env: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        env=dict(os.environ, **env),
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=600,
+    )
+
+
+def test_the_switch_turns_the_compiled_kernels_off() -> None:
+    code = "from clearjoint import compiled; print(compiled.load() is None)"
+    assert _python(code, CLEARJOINT_COMPILED="0").stdout.split() == ["True"]
+
+
+def test_a_documented_commands_cold_run_compiles_nothing(tmp_path: Path) -> None:
+    """`clearjoint frf examples/frf.toml --from 10Hz --to 360Hz` with an empty numba cache:
+    every kernel it calls from Python is exported, so numba never compiles (it would say
+    "compiling the solvers, first run only")."""
+    _require_module()
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "clearjoint",
+            "frf",
+            "examples/frf.toml",
+            "--from",
+            "10Hz",
+            "--to",
+            "360Hz",
+            "--out",
+            str(tmp_path / "frf.nc"),
+        ],
+        cwd=ROOT,
+        env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "empty-cache")),
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "compiling the solvers" not in done.stderr
+    assert (tmp_path / "frf.nc").is_file()
+    cached = list((tmp_path / "empty-cache").rglob("*.nbc"))
+    assert cached == []
