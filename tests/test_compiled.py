@@ -85,7 +85,8 @@ def test_the_compiled_kernels_give_the_jit_kernels_results_to_the_bit(
     compiled_curve, compiled_motion = run()
     assert _jit_only(monkeypatch) == 10  # 4 in single, 2 in shooting, 3 in periodic, 1 more
     jit_curve, jit_motion = run()
-    assert compiled_curve.sizes == jit_curve.sizes and compiled_curve.sizes["point"] > 50
+    assert compiled_curve.sizes == jit_curve.sizes
+    assert compiled_curve.sizes["point"] > 50
     assert _same_bits(compiled_curve, jit_curve) == []
     assert _same_bits(compiled_motion, jit_motion) == []
     monkeypatch.undo()
@@ -177,7 +178,8 @@ def _copy_package(tmp_path: Path) -> Path:
 def test_the_module_name_follows_the_kernels_source_only(tmp_path: Path) -> None:
     copy = _copy_package(tmp_path)
     name = compiled.module_name(copy)
-    assert name == compiled.module_name() and name.startswith("_kernels_")
+    assert name == compiled.module_name()
+    assert name.startswith("_kernels_")
     (copy / "cli.py").write_text((copy / "cli.py").read_text() + "\n# no kernel here\n")
     assert compiled.module_name(copy) == name
     law = copy / "laws" / "clearance.py"
