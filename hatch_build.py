@@ -29,7 +29,10 @@ class CompiledKernels(BuildHookInterface):  # type: ignore[misc]
         if self.target_name != "wheel" or os.environ.get("CLEARJOINT_COMPILED", "1") == "0":
             return
         root = Path(self.root)
-        env = dict(os.environ, PYTHONPATH=str(root / "src"))
+        # this source first, then whatever the build environment has on the path (pip's
+        # isolated build puts its own site folder there)
+        path = [str(root / "src"), *filter(None, [os.environ.get("PYTHONPATH")])]
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(path))
         self.app.display_info("clearjoint: compiling the solvers' kernels (about 30 s)")
         try:
             done = subprocess.run(

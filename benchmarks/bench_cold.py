@@ -1,10 +1,12 @@
 """A documented command's first run (empty compiled-code cache) against its later runs.
 
-Run on demand: ``python benchmarks/bench_cold.py [--rounds N] [-- COMMAND...]``; by default
+Run on demand: ``python benchmarks/bench_cold.py [--rounds N] [--jit] [-- COMMAND...]``; by default
 the command is ``clearjoint frf examples/frf.toml --from 10Hz --to 360Hz`` (issue 28: at most
 3x its warm run). Each round runs the command twice as a user does, side by side in this
 one run: cold, with NUMBA_CACHE_DIR a fresh empty folder (numba compiles every kernel and
-stores it there), then warm, with the same folder (every kernel loads). Wall times, and
+stores it there), then warm, with the same folder (every kernel loads). The kernels
+compiled at install (``clearjoint.compiled``) are used when present, unless ``--jit``
+(then numba compiles them on the cold run, as before they existed). Wall times, and
 their ratio cold / warm, are printed per round and as medians. Other sessions may load the
 machine: compare the ratio, measured in one run, not the seconds.
 
@@ -32,8 +34,10 @@ ROOT = Path(__file__).resolve().parents[1]
 DEFAULT = ["frf", "examples/frf.toml", "--from", "10Hz", "--to", "360Hz"]
 
 
-def _timed(command: list[str], cache: Path, out: Path) -> float:
+def _timed(command: list[str], cache: Path, out: Path, jit: bool) -> float:
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    if jit:
+        env["CLEARJOINT_COMPILED"] = "0"
     start = time.perf_counter()
     subprocess.run(
         [sys.executable, "-m", "clearjoint", *command, "--out", str(out), "--force", "--quiet"],
@@ -130,17 +134,33 @@ def main() -> None:
     parser.add_argument(
         "--where", action="store_true", help="then show where a cold run's compile time goes"
     )
+    parser.add_argument(
+        "--jit",
+        action="store_true",
+        help="leave the kernels compiled at install unused (CLEARJOINT_COMPILED=0): numba "
+        "compiles them on the cold run, as before they existed",
+    )
     parser.add_argument("command", nargs="*", help="clearjoint arguments (default: the frf)")
     args = parser.parse_args()
     command = args.command or DEFAULT
+    from clearjoint import compiled
+
+    module = compiled.load()
+    if args.jit:
+        print("kernels compiled at install: not used (--jit)")
+    else:
+        print(
+            "kernels compiled at install: "
+            + (f"used ({module.__name__})" if module else "absent (python -m clearjoint.compiled)")
+        )
     ratios, colds, warms = [], [], []
     with tempfile.TemporaryDirectory(prefix="bench-cold-") as folder:
         for round_ in range(args.rounds):
             cache = Path(folder) / f"cache-{round_}"
             cache.mkdir()
             out = Path(folder) / "out.nc"
-            cold = _timed(command, cache, out)
-            warm = _timed(command, cache, out)
+            cold = _timed(command, cache, out, args.jit)
+            warm = _timed(command, cache, out, args.jit)
             colds.append(cold)
             warms.append(warm)
             ratios.append(cold / warm)

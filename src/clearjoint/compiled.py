@@ -40,6 +40,19 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 _A1 = "f8[::1]"
 _A2 = "f8[:, ::1]"
+_I1 = "i8[::1]"  # int64
+_B1 = "i1[::1]"  # int8 (contact states)
+_B2 = "i1[:, ::1]"
+
+
+def _arguments(*kinds: str) -> str:
+    return ", ".join(kinds)
+
+
+_MARCH = _arguments(
+    _A1, _B1, "f8", _A1, "f8", "i8", "f8", "f8", "f8", _A1, _A1, _I1, _I1, _A1, _A1, _I1, _I1,
+    _A1, _I1, _I1, _A1, _A2, _A2, _A1, _A1, _A1, _A1, "f8", "i8", _A2, _B2, _A1, _A1, "f8",
+)  # fmt: skip
 
 #: The kernels called from Python on the way of the documented commands, with the one
 #: signature each is called with: (module, name, numba signature).
@@ -71,6 +84,19 @@ EXPORTS: tuple[tuple[str, str, str], ...] = (
         f"UniTuple({_A2}, 2)({_A2}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1})",
     ),
     ("clearjoint.laws.clearance", "potentials", f"{_A2}({_A2}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1})"),
+    ("clearjoint.laws.clearance", "state_law", "UniTuple(f8, 2)(i8, f8, f8, f8, f8, f8)"),
+    ("clearjoint.laws.clearance", "contact_states", f"{_B1}({_A1}, {_A1}, {_A1}, {_A1})"),
+    (
+        "clearjoint.laws.clearance",
+        "state_tables",
+        f"UniTuple({_A2}, 2)({_A1}, {_A1}, {_A1}, {_A1}, {_A1})",
+    ),
+    (
+        "clearjoint.exact.march",
+        "march",
+        f"Tuple(({_A1}, {_B1}, f8, {_A1}, {_I1}, {_B1}, i8, i8))({_MARCH})",
+    ),
+    ("clearjoint.exact.march", "pattern_history", f"{_B2}({_B1}, {_I1}, {_B1})"),
 )
 
 #: Set to ``0`` to use the JIT kernels even where the compiled module is present.
@@ -154,21 +180,18 @@ def prefer(kernel: F) -> F:
 
 
 def argument_kinds(signature: str) -> tuple[str, ...]:
-    """The kinds of a signature's arguments in :data:`EXPORTS`: a1, a2 (float64 arrays), i, f, b."""
+    """The kinds of a signature's arguments in :data:`EXPORTS`, as written there."""
     # the arguments are the last parenthesised group: "UniTuple(i8, 4)(f8[::1], i8)"
     start = signature.rindex(")(") + 2 if ")(" in signature else signature.index("(") + 1
     parts = re.split(r",\s*(?![^\[]*\])", signature[start:-1])
-    return tuple(_KINDS[part.strip()] for part in parts)
+    return tuple(part.strip() for part in parts)
 
 
-_KINDS = {_A1: "a1", _A2: "a2", "i8": "i", "f8": "f", "b1": "b"}
-
-
-def _array(rank: int) -> Callable[[Any], bool]:
+def _array(dtype: type, rank: int) -> Callable[[Any], bool]:
     def accepts(value: Any) -> bool:
         return (
             type(value) is np.ndarray
-            and value.dtype == np.float64
+            and value.dtype == dtype
             and value.ndim == rank
             and value.flags.c_contiguous
             and value.flags.writeable
@@ -192,12 +215,16 @@ def _boolean(value: Any) -> bool:
     return isinstance(value, bool | np.bool_)
 
 
+#: What each argument kind of a signature in EXPORTS takes.
 _ACCEPTS: dict[str, Callable[[Any], bool]] = {
-    "a1": _array(1),
-    "a2": _array(2),
-    "i": _integer,
-    "f": _real,
-    "b": _boolean,
+    _A1: _array(np.float64, 1),
+    _A2: _array(np.float64, 2),
+    _I1: _array(np.int64, 1),
+    _B1: _array(np.int8, 1),
+    _B2: _array(np.int8, 2),
+    "i8": _integer,
+    "f8": _real,
+    "b1": _boolean,
 }
 _SIGNATURES = {kernel: signature for _, kernel, signature in EXPORTS}
 

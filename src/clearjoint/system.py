@@ -36,6 +36,7 @@ import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
 from clearjoint.joint import ClearanceJoint, Joint, Losses, checked_losses
 from clearjoint.laws.clearance import COMPRESSION, OPEN, TENSION, state_tables
@@ -360,7 +361,7 @@ class VibrationSystem:
             raise VibrationSystemError(
                 f"a pattern needs one state per joint ({self.n_joints}), got shape {s.shape}"
             )
-        k_table, r_table = state_tables(*self.law_arrays())
+        k_table, r_table = prefer(state_tables)(*self.law_arrays())
         rows = np.arange(self.n_joints)
         k_j, r_j = k_table[rows, s + 1], r_table[rows, s + 1]
         b = self.directions

@@ -26,6 +26,7 @@ import scipy.sparse.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.errors import ClearjointError, ParameterError, ParameterTypeError
 from clearjoint.joint import ClearanceJoint, positive_or_inf
 from clearjoint.laws import clearance
@@ -602,7 +603,7 @@ def _law_state(law: ClearanceJoint, state: int) -> tuple[float, float]:
     """
     if state not in (OPEN, COMPRESSION, TENSION):
         raise StructureError(f"a joint state must be 0 (open), 1 or -1, got {state!r}")
-    k_s, offset = clearance.state_law(
+    k_s, offset = prefer(clearance.state_law)(
         state,
         law.gap_stiffness,
         law.compression_stiffness,

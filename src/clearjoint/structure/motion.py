@@ -42,6 +42,7 @@ import scipy.sparse
 from numpy.typing import ArrayLike, NDArray
 
 from clearjoint import checks as _checks
+from clearjoint.compiled import prefer
 from clearjoint.errors import ParameterError
 from clearjoint.exact import march, single
 from clearjoint.laws import clearance
@@ -99,7 +100,7 @@ class _Flow:
         self.system = s
         n_j = len(self.laws)
         # each joint's (stiffness, offset) in state -1, 0, 1 (column state + 1)
-        self.k_table, self.r_table = clearance.state_tables(*law_parameters)
+        self.k_table, self.r_table = prefer(clearance.state_tables)(*law_parameters)
         k_stiff = self.k_linear + (self.b.T * np.max(self.k_table, axis=1)) @ self.b
         w2 = scipy.linalg.eigh(k_stiff, np.diag(self.m), eigvals_only=True)
         self.omega_ref = math.sqrt(max(float(w2[-1]), 1e-300))
@@ -149,7 +150,7 @@ class _Flow:
 
     def states_at(self, delta: FloatArray, rate: FloatArray) -> NDArray[np.int8]:
         """Each joint's contact state at shortenings ``delta`` moving at ``rate`` (n_j,)."""
-        return clearance.contact_states(
+        return prefer(clearance.contact_states)(
             np.ascontiguousarray(delta, dtype=np.float64),
             np.ascontiguousarray(rate, dtype=np.float64),
             self.g_c,
@@ -364,7 +365,7 @@ def _patterns_visited(
     """How many distinct contact patterns the event sequence passes through."""
     if start.size == 0:
         return 1
-    history = np.ascontiguousarray(march.pattern_history(start, joints, new_states))
+    history = np.ascontiguousarray(prefer(march.pattern_history)(start, joints, new_states))
     rows = history.view(np.dtype((np.void, history.shape[1])))
     return int(np.unique(rows).size)
 
@@ -421,7 +422,7 @@ def _run(
     while status == march.PAUSED:
         piece += 1
         t_pause = math.inf if piece >= pieces else duration * piece / pieces
-        y, states, impact, ev_t, ev_j, ev_s, steps, status = march.march(
+        y, states, impact, ev_t, ev_j, ev_s, steps, status = prefer(march.march)(
             y,
             states,
             float(duration),

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from clearjoint.compiled import prefer
 from clearjoint.errors import SimulationError
 from clearjoint.exact import march
 from clearjoint.exact.patterns import PatternFlow as _Flow
@@ -372,7 +373,7 @@ def stretches(
 def pattern_history(motion: Any) -> NDArray[np.int8]:
     """(E + 1, n_j): the motion's contact pattern at the start and after each event."""
     return np.asarray(
-        march.pattern_history(
+        prefer(march.pattern_history)(
             np.ascontiguousarray(motion.start_pattern, dtype=np.int8),
             np.ascontiguousarray(motion.event_joints, dtype=np.int64),
             np.ascontiguousarray(motion.event_states, dtype=np.int8),
