@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from clearjoint import cli, cli_progress
+from clearjoint import Joint, Losses, cli, cli_progress
 from clearjoint.exact import single
 from clearjoint.progress import listening
 from clearjoint.simulate import time_response
@@ -105,3 +105,101 @@ def test_a_campaign_run_here_reports_in_tests_not_in_its_transients_seconds(
     with listening(lambda done, total: heard.append((done, total))):
         run_campaign(load_campaign(path), tmp_path / "out", jobs=1)
     assert heard == [(1.0, 2.0), (2.0, 2.0)]
+
+
+def _linear_strobe(zeta: float, omega_n: float, omega: float, periods: int) -> np.ndarray:
+    """The state at each forcing period's start of m x'' + 2 zeta omega_n x' + omega_n^2 x
+    = F sin(omega t) from rest (m = 1, F = 1), in closed form: the steady sine plus the
+    free decay that meets the start (an independent route: no clearjoint solver)."""
+    wd = omega_n * np.sqrt(1.0 - zeta**2)
+    # steady part X sin(omega t - phi)
+    denominator = (omega_n**2 - omega**2) ** 2 + (2 * zeta * omega_n * omega) ** 2
+    a = (omega_n**2 - omega**2) / denominator  # coefficient of sin
+    b = -2 * zeta * omega_n * omega / denominator  # coefficient of cos
+    x0, v0 = -b, -a * omega  # the free part cancels the steady part at t = 0
+    t = np.arange(periods) * 2 * np.pi / omega
+    decay = np.exp(-zeta * omega_n * t)
+    c1, c2 = x0, (v0 + zeta * omega_n * x0) / wd
+    x_free = decay * (c1 * np.cos(wd * t) + c2 * np.sin(wd * t))
+    v_free = decay * (
+        -zeta * omega_n * (c1 * np.cos(wd * t) + c2 * np.sin(wd * t))
+        + wd * (-c1 * np.sin(wd * t) + c2 * np.cos(wd * t))
+    )
+    strobe = np.zeros((periods, 4))
+    strobe[:, 0] = b + x_free  # sin(0) = 0, cos(0) = 1 at each period's start
+    strobe[:, 1] = a * omega + v_free
+    return strobe
+
+
+@pytest.mark.parametrize(("zeta", "omega"), [(0.01, 0.7), (0.002, 0.9), (0.02, 1.3)])
+def test_the_periods_left_to_settle_match_a_linear_oscillators_closed_form(
+    zeta: float, omega: float
+) -> None:
+    """From its first 64 periods, the estimate of a linear oscillator's settling is within
+    10 % (and two periods) of the period from which its closed-form transient repeats to
+    the tolerance with some period of 1 to 8 forcing periods (steady_state's test)."""
+    from clearjoint.simulate.core import periods_left
+
+    tolerance = 1e-11
+    strobe = _linear_strobe(zeta, 1.0, omega, 20_000)
+    x_scale = float(np.max(np.abs(strobe[:, 0])))
+    v_scale = float(np.max(np.abs(strobe[:, 1])))
+    settled = strobe.shape[0]
+    for lag in range(1, 9):
+        step = np.maximum(
+            np.abs(strobe[lag:, 0] - strobe[:-lag, 0]) / x_scale,
+            np.abs(strobe[lag:, 1] - strobe[:-lag, 1]) / v_scale,
+        )
+        below = step.size - int(np.argmax(step[::-1] >= tolerance))  # below it from here on
+        settled = min(settled, below + lag)
+    assert settled > 200
+    left = periods_left(strobe[:64], 8, tolerance, x_scale, v_scale)
+    assert left is not None
+    assert abs(64 + left - settled) <= 0.1 * settled + 2
+
+
+def test_no_estimate_where_the_motion_does_not_settle() -> None:
+    from clearjoint.simulate.core import periods_left
+
+    t = np.arange(200.0)
+    strobe = np.zeros((200, 4))
+    strobe[:, 0] = np.sin(0.37 * t)  # undamped, incommensurate: never closes
+    strobe[:, 1] = np.cos(0.37 * t)
+    left = periods_left(strobe, 8, 1e-11, 1.0, 1.0)
+    assert left is None or left > 1e4  # none, or beyond any sensible max_periods
+    assert periods_left(strobe[:5], 8, 1e-11, 1.0, 1.0) is None  # too few periods
+
+
+def test_a_steady_state_reports_its_periods_and_an_estimate_then_ends_done() -> None:
+    """A lightly damped joint inside its gap (linear: k0, zeta = 0.002) settles over some
+    2,000 periods, run in chunks that double: each chunk reports the periods done and an
+    estimate of the total, within a factor 2 of the periods the run took (its last chunk
+    may overshoot the settling by up to its own length)."""
+    from clearjoint.simulate import steady_state
+
+    joint = Joint(mass=1.0, clearance=2.0, gap_stiffness=1.0, compression_stiffness=3.0)
+    heard: list[tuple[float, float]] = []
+    with listening(lambda done, total: heard.append((done, total))):
+        cycle = steady_state(joint, 0.01, 0.9, losses=Losses(damping_ratio=0.002))
+    assert cycle.amplitude < 1.0  # never left the gap: a linear oscillator
+    done = [d for d, _ in heard]
+    assert len(heard) >= 5
+    assert done == sorted(done)
+    assert all(d <= t for d, t in heard)
+    assert heard[-1][0] == heard[-1][1]  # the last report closes the bar
+    took = heard[-1][0]
+    for d, total in heard[2:-1]:  # from 112 periods known
+        assert took / 2 <= total <= 2 * took, (d, total, took)
+
+
+def test_a_stepped_sine_reports_its_steps_not_each_steps_periods() -> None:
+    from clearjoint.simulate import frequency_sweep
+
+    study = load_study(str(STUDY))
+    heard: list[tuple[float, float]] = []
+    omegas = study.omega * np.array([0.9, 1.0, 1.1])
+    with listening(lambda done, total: heard.append((done, total))):
+        frequency_sweep(
+            study.joint, study.force_amplitude, omegas, losses=study.losses, direction="both"
+        )
+    assert heard == [(float(i), 6.0) for i in range(1, 7)]

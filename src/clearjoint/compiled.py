@@ -13,7 +13,8 @@ The module is used only when it was built from the kernels' source as it is now:
 name carries a digest of every package file that holds a kernel (:func:`source_digest`),
 so a changed kernel, an upgrade, or an editable checkout on another commit finds no
 module of that name and falls back to the JIT kernels, as does a machine where it could
-not be built (no C compiler), or ``CLEARJOINT_COMPILED=0`` in the environment. A call
+not be built (no C compiler), or ``CLEARJOINT_COMPILED=0`` in the environment (or
+``NUMBA_DISABLE_JIT=1``, which asks for the kernels as plain Python). A call
 with argument types the export does not take (its signatures are in :data:`EXPORTS`)
 goes to the JIT kernel too. The exported code is numba's own lowering of the same
 Python functions, for a generic CPU of the machine's family; the suite checks that the
@@ -139,7 +140,10 @@ def load() -> ModuleType | None:
     global _loaded
     if _loaded is _NOT_LOADED:
         _loaded = None
-        if os.environ.get(SWITCH, "1").strip() != "0":
+        from numba.core import config
+
+        # NUMBA_DISABLE_JIT=1 asks for the kernels as plain Python: the module is not that
+        if os.environ.get(SWITCH, "1").strip() != "0" and not config.DISABLE_JIT:
             try:
                 _loaded = importlib.import_module(f"clearjoint.{module_name()}")
             except ImportError:

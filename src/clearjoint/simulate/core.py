@@ -13,6 +13,7 @@ it is reported in the ledger but is not among the losses that balance the input.
 
 from __future__ import annotations
 
+import math
 from typing import Literal
 
 import numpy as np
@@ -35,6 +36,7 @@ from clearjoint.exact.single import (
     setup,
 )
 from clearjoint.joint import Joint, Losses, takes_losses
+from clearjoint.progress import report, silenced
 
 # the results moved to clearjoint.results; imported "as" themselves so that the old path
 # clearjoint.simulate.core re-exports them (and the API reference documents them once)
@@ -114,6 +116,47 @@ def _periodic_multiple(
         if dx <= tolerance and dv <= tolerance and same_discrete:
             return mult
     return 0
+
+
+def periods_left(
+    strobe: FloatArray, max_multiple: int, tolerance: float, x_scale: float, v_scale: float
+) -> float | None:
+    """How many more forcing periods the transient needs to settle, from its own decay.
+
+    The distance between stroboscopic states ``m`` periods apart (``m`` <= ``max_multiple``,
+    scaled as :func:`_periodic_multiple` scales it) shrinks about geometrically while the
+    transient dies away, by the largest Floquet multiplier's modulus a period, and swings
+    as the transient's oscillation turns. A straight line fitted to its logarithm over the
+    latter half of ``strobe`` gives the rate; the line's end, raised by the largest swing
+    above it, the level now; the periods left are those that bring that level down to
+    ``tolerance``, for the lag whose level is least. None where the distance does not
+    shrink (a chaotic, lossless or growing motion) or fewer than sixteen periods are known.
+    """
+    best: tuple[float, float] | None = None
+    for lag in range(1, max_multiple + 1):
+        if strobe.shape[0] < lag + 16:
+            break
+        dx = np.abs(strobe[lag:, kn.S_X] - strobe[:-lag, kn.S_X]) / x_scale
+        dv = np.abs(strobe[lag:, kn.S_V] - strobe[:-lag, kn.S_V]) / v_scale
+        distance = np.maximum(dx, dv)[distance_start(strobe.shape[0] - lag) :]
+        if not np.all(distance > 0.0) or not np.all(np.isfinite(distance)):
+            continue
+        periods = np.arange(distance.size, dtype=np.float64)
+        slope, intercept = np.polyfit(periods, np.log(distance), 1)
+        if not slope < 0.0:
+            continue
+        # the envelope's level now: the fitted line at the end, raised by its largest swing
+        swing = float(np.max(np.log(distance) - (slope * periods + intercept)))
+        level = slope * periods[-1] + intercept + swing
+        left = max((math.log(tolerance) - level) / slope, 0.0) + 2 * lag
+        if best is None or level < best[0]:
+            best = (level, left)
+    return None if best is None else best[1]
+
+
+def distance_start(size: int) -> int:
+    """Where the fit of :func:`periods_left` starts: the latter half of what is known."""
+    return size // 2
 
 
 def _smallest_multiple(
@@ -217,7 +260,11 @@ def steady_state(
         v_scale = max(float(np.max(np.abs(strobe[:, 1]))), x_scale * p[kn.P_W])
         multiple = _periodic_multiple(strobe, max_multiple, tol, x_scale, v_scale)
         if multiple:
+            report(done, done)
             break
+        left = periods_left(strobe, max_multiple, tol, x_scale, v_scale)
+        if left is not None:  # a listening bar shows the periods done and an estimate left
+            report(done, min(done + left, max_periods))
         chunk = min(2 * chunk, 1024)
     if not multiple:
         hint = (
@@ -265,18 +312,22 @@ def frequency_sweep(
         initial: tuple[float, float, int, int] | None = None
         for i, omega in enumerate(order):
             try:
-                ss = steady_state(
-                    joint,
-                    force_amplitude,
-                    float(omega),
-                    losses=losses,
-                    initial=initial,
-                    max_periods=max_periods,
-                    samples_per_period=16,
-                )
+                with silenced():  # the sweep reports its steps, not each step's periods
+                    ss = steady_state(
+                        joint,
+                        force_amplitude,
+                        float(omega),
+                        losses=losses,
+                        initial=initial,
+                        max_periods=max_periods,
+                        samples_per_period=16,
+                    )
             except SimulationError:
                 cycles.append(None)
                 continue
+            finally:
+                steps[0] += 1
+                report(steps[0], steps[1])
             amps[i] = ss.amplitude
             mults[i] = ss.period_multiple
             initial = ss.initial_state
@@ -285,6 +336,7 @@ def frequency_sweep(
 
     nan = np.full(w.size, np.nan)
     zeros = np.zeros(w.size, dtype=np.int64)
+    steps = [0, w.size * (2 if direction == "both" else 1)]  # done, to do
     up, m_up, c_up = sweep(w) if direction in ("up", "both") else (nan, zeros, [])
     if direction in ("down", "both"):
         down_r, m_down_r, c_down_r = sweep(w[::-1])
