@@ -143,7 +143,7 @@ def load() -> ModuleType | None:
         from numba.core import config
 
         # NUMBA_DISABLE_JIT=1 asks for the kernels as plain Python: the module is not that
-        if os.environ.get(SWITCH, "1").strip() != "0" and not config.DISABLE_JIT:
+        if os.environ.get(SWITCH, "1").strip() != "0" and not config.DISABLE_JIT:  # type: ignore[attr-defined]
             try:
                 _loaded = importlib.import_module(f"clearjoint.{module_name()}")
             except ImportError:
