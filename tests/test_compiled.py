@@ -92,10 +92,14 @@ def test_the_compiled_kernels_give_the_jit_kernels_results_to_the_bit(
     monkeypatch.undo()
     samples = np.linspace(-0.5, 0.5, 101)[:, None].copy()  # across both gap edges
     parameters = clearance.parameters((PYHARM,))
-    for kernel in (clearance.forces_and_tangents, clearance.potentials):
+    for kernel, arguments in (
+        (clearance.forces_and_tangents, parameters),
+        (clearance.potentials, parameters),
+        (clearance.contact_forces, parameters[1:]),
+    ):
         ours = compiled.prefer(kernel)
         assert ours is not kernel
-        got, expected = ours(samples, *parameters), kernel(samples, *parameters)
+        got, expected = ours(samples, *arguments), kernel(samples, *arguments)
         for a, b in zip(np.atleast_1d(got), np.atleast_1d(expected), strict=True):
             assert np.asarray(a).tobytes() == np.asarray(b).tobytes()
 

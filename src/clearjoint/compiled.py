@@ -85,6 +85,7 @@ EXPORTS: tuple[tuple[str, str, str], ...] = (
         f"UniTuple({_A2}, 2)({_A2}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1})",
     ),
     ("clearjoint.laws.clearance", "potentials", f"{_A2}({_A2}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1})"),
+    ("clearjoint.laws.clearance", "contact_forces", f"{_A2}({_A2}, {_A1}, {_A1}, {_A1}, {_A1})"),
     ("clearjoint.laws.clearance", "state_law", "UniTuple(f8, 2)(i8, f8, f8, f8, f8, f8)"),
     ("clearjoint.laws.clearance", "contact_states", f"{_B1}({_A1}, {_A1}, {_A1}, {_A1})"),
     (

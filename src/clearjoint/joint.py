@@ -168,7 +168,8 @@ class ClearanceJoint:
 
         samples = np.asarray(delta, dtype=np.float64)
         _, k_c, k_t, g_c, g_t = clearance.parameters((self,))
-        return clearance.contact_forces(_column(samples), k_c, k_t, g_c, g_t).reshape(samples.shape)
+        forces = prefer(clearance.contact_forces)(_column(samples), k_c, k_t, g_c, g_t)
+        return forces.reshape(samples.shape)
 
     def in_series(self, stiffness: float) -> ClearanceJoint:
         """Return the one massless law of this joint in series with a spring (MODEL.md 5.2).
