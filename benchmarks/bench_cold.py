@@ -115,6 +115,9 @@ def where(command: list[str]) -> None:
     print(f"cold run in this process: {total:.1f} s, of which compiling {compiled:.1f} s:")
     for seconds, name, caller in sorted(tops, reverse=True):
         print(f"  {seconds:5.1f} s  {name}  (called at {caller})")
+    if not own:
+        print("nothing compiled")
+        return
     llvm = sum(row[1] for row in own.values())
     times = sorted(row[0] for row in own.values())
     print(
@@ -143,15 +146,15 @@ def main() -> None:
     parser.add_argument("command", nargs="*", help="clearjoint arguments (default: the frf)")
     args = parser.parse_args()
     command = args.command or DEFAULT
-    from clearjoint import compiled
+    from clearjoint import compiled  # imports no numba: --where sets its cache folder later
 
-    module = compiled.load()
+    built = sorted(Path(compiled.__file__).parent.glob(compiled.module_name() + ".*"))
     if args.jit:
         print("kernels compiled at install: not used (--jit)")
     else:
         print(
             "kernels compiled at install: "
-            + (f"used ({module.__name__})" if module else "absent (python -m clearjoint.compiled)")
+            + (f"used ({built[0].name})" if built else "absent (python -m clearjoint.compiled)")
         )
     ratios, colds, warms = [], [], []
     with tempfile.TemporaryDirectory(prefix="bench-cold-") as folder:

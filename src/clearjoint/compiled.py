@@ -44,6 +44,7 @@ _A2 = "f8[:, ::1]"
 _I1 = "i8[::1]"  # int64
 _B1 = "i1[::1]"  # int8 (contact states)
 _B2 = "i1[:, ::1]"
+_F2 = "f8[::1, :]"  # Fortran order
 
 
 def _arguments(*kinds: str) -> str:
@@ -53,6 +54,10 @@ def _arguments(*kinds: str) -> str:
 _MARCH = _arguments(
     _A1, _B1, "f8", _A1, "f8", "i8", "f8", "f8", "f8", _A1, _A1, _I1, _I1, _A1, _A1, _I1, _I1,
     _A1, _I1, _I1, _A1, _A2, _A2, _A1, _A1, _A1, _A1, "f8", "i8", _A2, _B2, _A1, _A1, "f8",
+)  # fmt: skip
+
+_ONE_DOF = _arguments(
+    _A1, _A1, _A1, _A1, _A1, _A1, _A2, _F2, _A2, _A1, _A2, _A2
 )  # fmt: skip
 
 #: The kernels called from Python on the way of the documented commands, with the one
@@ -99,6 +104,18 @@ EXPORTS: tuple[tuple[str, str, str], ...] = (
         f"Tuple(({_A1}, {_B1}, f8, {_A1}, {_I1}, {_B1}, i8, i8))({_MARCH})",
     ),
     ("clearjoint.exact.march", "pattern_history", f"{_B2}({_B1}, {_I1}, {_B1})"),
+    ("clearjoint.continuation", "extrapolate", f"{_A1}({_A2}, f8)"),
+    (
+        "clearjoint.harmonic.aft",
+        "_evaluate_one_dof",
+        f"Tuple(({_A1}, {_A2}, {_A1}, {_A2}))({_A1}, f8, f8, f8, f8, f8, {_ONE_DOF})",
+    ),
+    (
+        "clearjoint.harmonic.aft",
+        "_correct_one_dof",
+        f"Tuple((i8, {_A1}, {_A2}, i8, {_A1}, {_A2}, {_A1}, {_A2}))"
+        f"({_A1}, {_A1}, {_A1}, f8, i8, b1, f8, f8, f8, f8, f8, {_ONE_DOF})",
+    ),
 )
 
 #: Set to ``0`` to use the JIT kernels even where the compiled module is present.
@@ -206,6 +223,17 @@ def _array(dtype: type, rank: int) -> Callable[[Any], bool]:
     return accepts
 
 
+def _fortran(value: Any) -> bool:
+    return (
+        type(value) is np.ndarray
+        and value.dtype == np.float64
+        and value.ndim == 2
+        and value.flags.f_contiguous
+        and value.flags.writeable
+        and value.flags.aligned
+    )
+
+
 def _integer(value: Any) -> bool:
     return isinstance(value, int | np.integer) and -(2**63) <= int(value) < 2**63
 
@@ -227,6 +255,7 @@ _ACCEPTS: dict[str, Callable[[Any], bool]] = {
     _I1: _array(np.int64, 1),
     _B1: _array(np.int8, 1),
     _B2: _array(np.int8, 2),
+    _F2: _fortran,
     "i8": _integer,
     "f8": _real,
     "b1": _boolean,

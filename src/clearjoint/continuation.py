@@ -508,7 +508,9 @@ def continue_branch(
             attempt, fast_tangent = (None, None) if stepped is None else stepped
         else:
             if poly:
-                predicted = extrapolate(trail[len(ys) - settings.predictor_degree - 1 : len(ys)], h)
+                predicted = _compiled_extrapolate(
+                    trail[len(ys) - settings.predictor_degree - 1 : len(ys)], h
+                )
             else:
                 predicted = y + h * t + 0.5 * h * h * curvature
             attempt = _correct(residual, predicted, t, scale, settings, fixed_lambda=False)
@@ -993,3 +995,4 @@ def _cross_kink(
 
 # for Python callers: the kernel as compiled at install where that is usable
 _compiled_tangent_solve = prefer(tangent_solve)
+_compiled_extrapolate = prefer(extrapolate)

@@ -35,6 +35,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
+from clearjoint.compiled import prefer
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
 from clearjoint.jit import njit  # numba.njit that survives a read-only install
 from clearjoint.laws import clearance
@@ -291,7 +292,7 @@ def evaluate(
     """
     n = system.n_dof
     if n == 1 and system.friction_force is None and basis.assemble is not None:
-        out = _evaluate_one_dof(
+        out = prefer(_evaluate_one_dof)(
             q,
             omega,
             float(force[0]),
@@ -741,7 +742,7 @@ class OneDofResidual:
         """
         s, basis = self.system, self.basis
         assert basis.assemble is not None
-        status, y, a, its, r, jac, d_omega, kt = _correct_one_dof(
+        status, y, a, its, r, jac, d_omega, kt = prefer(_correct_one_dof)(
             np.ascontiguousarray(y0, dtype=np.float64),
             np.ascontiguousarray(tangent, dtype=np.float64),
             np.ascontiguousarray(scale, dtype=np.float64),
