@@ -237,3 +237,22 @@ def test_the_estimate_for_a_motion_that_never_settles_is_beyond_any_run() -> Non
         strobe[:, 1] = np.cos(ratio * t)
         left = periods_left(strobe, 8, 1e-11, 1.0, 1.0)
         assert left is None or left > 1e5, ratio
+
+
+def test_no_time_left_is_told_from_the_milliseconds_after_a_compile(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without a terminal: a first report 40 s in (a compile came before) and a second
+    10 ms later gave "2 % done, about 0 s left"; the rate now spans 10 s at least, and the
+    time left is the one that rate gives (88 % at 1 % a second: 88 s)."""
+    import argparse
+
+    now = [0.0]
+    monkeypatch.setattr(cli_progress.time, "perf_counter", lambda: now[0])
+    args = argparse.Namespace(command="frf", quiet=False, progress_lines=True)
+    with cli_progress.shown_progress(args, "following the curve") as listener:
+        for at, done in ((40.0, 1.0), (40.01, 2.0), (51.0, 12.0)):
+            now[0] = at
+            listener(done, 100.0)
+    lines = [line for line in capsys.readouterr().err.splitlines() if "% done" in line]
+    assert lines == ["clearjoint frf: 12 % done, about 88 s left"]
