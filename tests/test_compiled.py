@@ -339,3 +339,42 @@ def test_a_big_endian_array_is_refused_not_read_as_other_numbers() -> None:
     law = compiled.prefer(clearance.forces_and_tangents)
     with pytest.raises(TypingError, match="dtype"):
         law(samples, *clearance.parameters((PYHARM,)))
+
+
+class _Counting:
+    """The compiled module, counting the calls that reach each of its functions."""
+
+    def __init__(self, module: Any) -> None:
+        self.module = module
+        self.calls: dict[str, int] = {}
+
+    def __getattr__(self, name: str) -> Any:
+        exported = getattr(self.module, name)
+
+        def counted(*args: Any) -> Any:
+            self.calls[name] = self.calls.get(name, 0) + 1
+            return exported(*args)
+
+        return counted
+
+
+def test_a_structures_motion_reaches_the_compiled_kernels(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The comparison to the bit above would pass too if every call fell back to the JIT
+    kernels (an argument the checks refuse): the structure's march, state tables, contact
+    states and pattern history must each reach the module."""
+    _require_module()
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast, time_response
+
+    counting = _Counting(compiled.load())
+    monkeypatch.setattr(compiled, "_loaded", counting)
+    monkeypatch.setattr(compiled, "_preferred", {})
+    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
+    s = mast(3, joints=hinge, rayleigh=(0.5, 2e-6))
+    force = np.zeros(s.n_dof)
+    force[-2] = 20.0
+    omega = 0.9 * float(s.modes("closed").omega[0])
+    motion = time_response(s, force, omega, 4.0 * math.pi / omega, samples_per_period=32)
+    assert motion.events > 40
+    for name in ("march", "state_tables", "contact_states", "pattern_history"):
+        assert counting.calls.get(name, 0) >= 1, (name, counting.calls)
