@@ -12,12 +12,26 @@ as before. ``CLEARJOINT_COMPILED=0`` in the environment skips the compile.
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
 from typing import Any
 
 from hatchling.builders.hooks.plugin.interface import BuildHookInterface
+
+_EXCEPTION = re.compile(r"^[A-Za-z_][\w.]*(Error|Exception|Exit)\b.*")
+
+
+def failure_reason(stderr: str) -> str:
+    """The line of a failed compile's output that says why: its last exception's line.
+
+    numba's message for a missing C compiler ends on a conda hint (``#> conda install
+    gcc_linux-64 gxx_linux-64``), which alone does not say what failed.
+    """
+    lines = [line.strip() for line in stderr.strip().splitlines() if line.strip()]
+    said = [line for line in lines if _EXCEPTION.match(line)]
+    return (said or lines or ["no output"])[-1]
 
 
 class CompiledKernels(BuildHookInterface):  # type: ignore[misc]
@@ -49,8 +63,7 @@ class CompiledKernels(BuildHookInterface):  # type: ignore[misc]
             return
         lines = done.stdout.strip().splitlines()
         if done.returncode != 0 or not lines or not Path(lines[-1]).is_file():
-            reason = (done.stderr.strip().splitlines() or ["no output"])[-1]
-            self._skip(reason)
+            self._skip(failure_reason(done.stderr))
             return
         module = Path(lines[-1])
         if version == "editable":

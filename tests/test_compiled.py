@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import pytest
 import xarray as xr
+from numba.core.errors import TypingError
 
 from clearjoint import Joint, Losses, compiled, continuation, harmonic, periodic
 from clearjoint.exact import shooting, single
@@ -275,3 +276,110 @@ def test_a_documented_commands_cold_run_compiles_nothing(tmp_path: Path) -> None
     assert (tmp_path / "frf.nc").is_file()
     cached = list((tmp_path / "empty-cache").rglob("*.nbc"))
     assert cached == []
+
+
+def test_a_kernel_of_an_exported_name_from_another_module_stays_itself() -> None:
+    """The export is looked up by name: a function of that name from another module (here
+    a plain Python ``state_law``) must not be sent to the compiled one."""
+    _require_module()
+
+    def state_law(state: int, k0: float, k_c: float, k_t: float, g_c: float, g_t: float) -> Any:
+        return ("not the clearance law", state)
+
+    ours = compiled.prefer(state_law)
+    assert ours(1, 1.0, 3.0, 3.0, 0.1, 0.1) == ("not the clearance law", 1)
+
+
+def test_keyword_arguments_go_to_the_jit_kernel() -> None:
+    """The extension takes its arguments by position only: a call by keyword gives the
+    same result as by position (it failed with a TypeError of the wrapper)."""
+    _require_module()
+    law = compiled.prefer(clearance.contact_forces)
+    assert law is not clearance.contact_forces
+    samples = np.linspace(-0.5, 0.5, 11)[:, None].copy()
+    _, k_c, k_t, g_c, g_t = clearance.parameters((PYHARM,))
+    by_position = law(samples, k_c, k_t, g_c, g_t)
+    by_keyword = law(samples, k_c=k_c, k_t=k_t, g_c=g_c, g_t=g_t)
+    assert by_keyword.tobytes() == by_position.tobytes()
+    # an independent value: the contact force is zero inside the gap, positive beyond it
+    assert by_position[5, 0] == 0.0
+    assert by_position[0, 0] > 0.0
+    assert by_position[-1, 0] > 0.0
+
+
+@pytest.mark.parametrize(
+    ("samples", "taken"),
+    [
+        (np.zeros((8, 2))[:, :1], False),  # every other element: strided
+        (np.zeros(8)[::-1][:, None], False),  # negative stride
+        # numpy counts these as C-contiguous (a size-1 axis's stride is ignored), and so
+        # does the compiled code, which addresses a C array by its shape
+        (np.asfortranarray(np.zeros((8, 2)))[:, :1], True),
+        (np.lib.stride_tricks.as_strided(np.zeros(3), (1, 3), (0, 8), writeable=True), True),
+    ],
+    ids=["strided", "reversed", "size-1-axis", "zero-stride-size-1-axis"],
+)
+def test_which_views_the_export_takes_and_that_they_give_the_same_forces(
+    samples: np.ndarray, taken: bool
+) -> None:
+    """Checked by value against the law on a fresh C array of the same numbers."""
+    _require_module()
+    assert compiled._ACCEPTS["f8[:, ::1]"](samples) is taken
+    samples[...] = np.linspace(-0.5, 0.5, samples.size).reshape(samples.shape)
+    law = compiled.prefer(clearance.forces_and_tangents)
+    parameters = clearance.parameters((PYHARM,))
+    force, _ = law(samples, *parameters)
+    expected, _ = clearance.forces_and_tangents(
+        np.array(samples, dtype=np.float64, order="C"), *parameters
+    )
+    assert force.tobytes() == expected.tobytes()
+
+
+def test_a_big_endian_array_is_refused_not_read_as_other_numbers() -> None:
+    """float64 but big-endian: the extension would read its bytes as little-endian
+    numbers, unchecked; the check sends it to numba, which refuses it by name."""
+    _require_module()
+    samples = np.linspace(-0.5, 0.5, 8)[:, None].astype(">f8")
+    assert not compiled._ACCEPTS["f8[:, ::1]"](samples)
+    law = compiled.prefer(clearance.forces_and_tangents)
+    with pytest.raises(TypingError, match="dtype"):
+        law(samples, *clearance.parameters((PYHARM,)))
+
+
+class _Counting:
+    """The compiled module, counting the calls that reach each of its functions."""
+
+    def __init__(self, module: Any) -> None:
+        self.module = module
+        self.calls: dict[str, int] = {}
+
+    def __getattr__(self, name: str) -> Any:
+        exported = getattr(self.module, name)
+
+        def counted(*args: Any) -> Any:
+            self.calls[name] = self.calls.get(name, 0) + 1
+            return exported(*args)
+
+        return counted
+
+
+def test_a_structures_motion_reaches_the_compiled_kernels(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The comparison to the bit above would pass too if every call fell back to the JIT
+    kernels (an argument the checks refuse): the structure's march, state tables, contact
+    states and pattern history must each reach the module."""
+    _require_module()
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast, time_response
+
+    counting = _Counting(compiled.load())
+    monkeypatch.setattr(compiled, "_loaded", counting)
+    monkeypatch.setattr(compiled, "_preferred", {})
+    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
+    s = mast(3, joints=hinge, rayleigh=(0.5, 2e-6))
+    force = np.zeros(s.n_dof)
+    force[-2] = 20.0
+    omega = 0.9 * float(s.modes("closed").omega[0])
+    motion = time_response(s, force, omega, 4.0 * math.pi / omega, samples_per_period=32)
+    assert motion.events > 40
+    for name in ("march", "state_tables", "contact_states", "pattern_history"):
+        assert counting.calls.get(name, 0) >= 1, (name, counting.calls)

@@ -203,3 +203,56 @@ def test_a_stepped_sine_reports_its_steps_not_each_steps_periods() -> None:
             study.joint, study.force_amplitude, omegas, losses=study.losses, direction="both"
         )
     assert heard == [(float(i), 6.0) for i in range(1, 7)]
+
+
+def test_a_steady_state_without_an_estimate_counts_its_periods_against_its_limit() -> None:
+    """A lossless joint never settles: every chunk of periods is still reported (16, 48,
+    ... doubling), against max_periods, the most the run will do, and the run then fails
+    (it reported nothing where the fit gave no estimate: the first chunk, too short)."""
+    from clearjoint.simulate import SimulationError, steady_state
+
+    lossless = Joint(
+        mass=1.0, clearance=0.349, gap_stiffness=1.0, compression_stiffness=3.0,
+        tension_stiffness=3.0,
+    )  # fmt: skip
+    heard: list[tuple[float, float]] = []
+    with (
+        listening(lambda done, total: heard.append((done, total))),
+        pytest.raises(SimulationError, match="never settles"),
+    ):
+        steady_state(lossless, 0.03, 1.1, max_periods=2000)
+    assert [done for done, _ in heard] == [16.0, 48.0, 112.0, 240.0, 496.0, 1008.0, 2000.0]
+    assert all(total == 2000.0 for _, total in heard)
+
+
+def test_the_estimate_for_a_motion_that_never_settles_is_beyond_any_run() -> None:
+    """Lossless, incommensurate: the stroboscopic distance does not shrink, so the fit's
+    slope is noise; what it gives, if anything, is beyond a million periods."""
+    from clearjoint.simulate.core import periods_left
+
+    t = np.arange(200.0)
+    for ratio in (0.37, 0.5, 1.1, 2.3):
+        strobe = np.zeros((200, 4))
+        strobe[:, 0] = np.sin(ratio * t)
+        strobe[:, 1] = np.cos(ratio * t)
+        left = periods_left(strobe, 8, 1e-11, 1.0, 1.0)
+        assert left is None or left > 1e5, ratio
+
+
+def test_no_time_left_is_told_from_the_milliseconds_after_a_compile(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without a terminal: a first report 40 s in (a compile came before) and a second
+    10 ms later gave "2 % done, about 0 s left"; the rate now spans 10 s at least, and the
+    time left is the one that rate gives (88 % at 1 % a second: 88 s)."""
+    import argparse
+
+    now = [0.0]
+    monkeypatch.setattr(cli_progress.time, "perf_counter", lambda: now[0])
+    args = argparse.Namespace(command="frf", quiet=False, progress_lines=True)
+    with cli_progress.shown_progress(args, "following the curve") as listener:
+        for at, done in ((40.0, 1.0), (40.01, 2.0), (51.0, 12.0)):
+            now[0] = at
+            listener(done, 100.0)
+    lines = [line for line in capsys.readouterr().err.splitlines() if "% done" in line]
+    assert lines == ["clearjoint frf: 12 % done, about 88 s left"]

@@ -67,7 +67,6 @@ def shown_progress(
         "announced": announce or quiet,
         "at": 0.0,
     }
-    start = time.perf_counter()
 
     def say(text: str) -> None:
         print(f"clearjoint {args.command}: {text}", file=sys.stderr, flush=True)
@@ -94,7 +93,9 @@ def shown_progress(
             if "first" not in seen:  # the rate is taken from here: a compile came before
                 seen["first"], seen["from"] = now, done
             ran, went = now - float(seen["first"]), done - float(seen["from"])
-            if now - max(start, float(seen["at"])) < PROGRESS_EVERY_S or went <= 0.0:
+            # the time left is told from a rate measured over PROGRESS_EVERY_S at least: just
+            # after a compile the first two reports are milliseconds apart ("0 s left")
+            if now - max(float(seen["first"]), float(seen["at"])) < PROGRESS_EVERY_S or went <= 0.0:
                 return
             seen["at"] = now
             left = ran * (total - done) / went

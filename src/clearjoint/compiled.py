@@ -176,25 +176,33 @@ def prefer(kernel: F) -> F:
     returned function takes the same arguments. The extension's functions convert their
     arguments without a check (a float32 array would crash the process), so each call's
     arguments are checked against the export's signature first (float64 arrays of the
-    right rank, C-contiguous and writable; ints; floats; bools), and any other call runs
-    the JIT kernel.
+    right rank, C-contiguous and writable; ints; floats; bools), and any other call
+    (keyword arguments included) runs the JIT kernel, as does a kernel of an exported
+    name from another module than the export's.
     """
     name = getattr(kernel, "__name__", "")
     if _preferred.get(name, (None,))[0] is kernel:
         return _preferred[name][1]  # type: ignore[no-any-return]
+    # the export of that name is this kernel only if it comes from the module it was
+    # exported from: another module's kernel of the same name is not the compiled one
+    if _MODULES.get(name) != getattr(kernel, "__module__", None):
+        return kernel
     module = load()
     exported = getattr(module, name, None) if module is not None else None
-    if exported is None or name not in _SIGNATURES:
+    if exported is None:
         return kernel
     kinds = argument_kinds(_SIGNATURES[name])
 
     @functools.wraps(kernel)
-    def call(*args: Any) -> Any:
-        if len(args) == len(kinds) and all(
-            _ACCEPTS[kind](value) for kind, value in zip(kinds, args, strict=True)
+    def call(*args: Any, **keywords: Any) -> Any:
+        # the extension takes its arguments by position only, in the signature's types
+        if (
+            not keywords
+            and len(args) == len(kinds)
+            and all(_ACCEPTS[kind](value) for kind, value in zip(kinds, args, strict=True))
         ):
             return exported(*args)
-        return kernel(*args)
+        return kernel(*args, **keywords)
 
     call.jit = kernel  # type: ignore[attr-defined]
     _preferred[name] = (kernel, call)
@@ -261,6 +269,7 @@ _ACCEPTS: dict[str, Callable[[Any], bool]] = {
     "b1": _boolean,
 }
 _SIGNATURES = {kernel: signature for _, kernel, signature in EXPORTS}
+_MODULES = {kernel: module for module, kernel, _ in EXPORTS}
 
 
 def build(folder: Path | None = None, *, quiet: bool = True) -> Path:

@@ -129,8 +129,11 @@ def periods_left(
     as the transient's oscillation turns. A straight line fitted to its logarithm over the
     latter half of ``strobe`` gives the rate; the line's end, raised by the largest swing
     above it, the level now; the periods left are those that bring that level down to
-    ``tolerance``, for the lag whose level is least. None where the distance does not
-    shrink (a chaotic, lossless or growing motion) or fewer than sixteen periods are known.
+    ``tolerance``, for the lag whose level is least. None where the fitted distance does
+    not shrink or fewer than sixteen periods are known. An estimate, not a verdict: a motion
+    that never settles (lossless, chaotic) may still give a number, by the fit's noise,
+    though one of a million periods and more (``tests/test_simulate_progress.py``); the
+    caller caps it at the most it will run.
     """
     best: tuple[float, float] | None = None
     for lag in range(1, max_multiple + 1):
@@ -262,9 +265,10 @@ def steady_state(
         if multiple:
             report(done, done)
             break
+        # a listening bar shows the periods done and an estimate of the total; without an
+        # estimate it counts them against the most it will run (max_periods), never less
         left = periods_left(strobe, max_multiple, tol, x_scale, v_scale)
-        if left is not None:  # a listening bar shows the periods done and an estimate left
-            report(done, min(done + left, max_periods))
+        report(done, max_periods if left is None else min(done + left, max_periods))
         chunk = min(2 * chunk, 1024)
     if not multiple:
         hint = (
