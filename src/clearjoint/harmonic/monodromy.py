@@ -61,6 +61,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+import scipy.linalg
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
@@ -189,16 +190,24 @@ class _Cache:
 
 _FLOWS = _Cache(_FLOW_BYTES)
 _TRANSITIONS = _Cache(_TRANSITION_BYTES)
+#: The short patterns' Taylor flows (:class:`ShortFlow`: a sparse A, about 100 kB at 2N =
+#: 640), kept across orbits: building one costs a dense (N, N) pattern stiffness and its
+#: conversion, 0.7 s a point on the 80-bay mast's 134 short patterns before issue 25's
+#: fourth round, when each orbit built its own.
+_SHORT_FLOW_BYTES = 64 * 2**20
+_SHORT_FLOWS = _Cache(_SHORT_FLOW_BYTES)
 #: The short patterns met so far (each counted as 1 "byte": up to 65536 of them), marked
 #: by the orbit that met them first.
 _SEEN_SHORT = _Cache(2**16)
 
 
 def clear_cache() -> None:
-    """Free the cached decompositions and transitions (up to 1.25 GiB; module docstring)."""
+    """Free the cached decompositions, transitions and short flows (up to 1.3 GiB; module
+    docstring)."""
     _FLOWS.clear()
     _TRANSITIONS.clear()
     _SEEN_SHORT.clear()
+    _SHORT_FLOWS.clear()
 
 
 def _fingerprint(system: LinearSystem) -> bytes:
@@ -329,9 +338,7 @@ def _product(
                 if local is not None or not room or not seen or mark is token:
                     _SEEN_SHORT.put((system_key, key), token, 1)
                     if key not in taylor:
-                        taylor[key] = ShortFlow.for_structure(
-                            inv_m, _pattern_stiffness(system, states[i]), system.damping
-                        )
+                        taylor[key] = _short_flow(system_key, key, system, inv_m, states[i])
                     return taylor[key]
             if not found:
                 a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
@@ -365,6 +372,23 @@ def _product(
 #: half the patterns of an orbit last below 4 units (two joints crossing their edges
 #: within 0.2 ms), the others above 64.
 SHORT_LIMIT = 16.0
+
+
+def _short_flow(
+    system_key: bytes,
+    key: bytes,
+    system: LinearSystem,
+    inv_m: FloatArray,
+    state: NDArray[np.int64],
+) -> ShortFlow:
+    """The pattern's :class:`ShortFlow`, built once per system and pattern (cached)."""
+    found, cached = _SHORT_FLOWS.get((system_key, key))
+    if found and isinstance(cached, ShortFlow):
+        return cached
+    flow = ShortFlow.for_structure(inv_m, _pattern_stiffness(system, state), system.damping)
+    g = flow.generator
+    _SHORT_FLOWS.put((system_key, key), flow, g.data.nbytes + g.indices.nbytes + g.indptr.nbytes)
+    return flow
 
 
 def _short_bound(system: LinearSystem) -> float:
@@ -510,6 +534,12 @@ def leading_block(
                 mu = np.zeros(size, dtype=np.complex128)
                 ritz = np.linalg.eigvals(b)
                 mu[: ritz.size] = ritz[np.argsort(-np.abs(ritz), kind="stable")]
+                found[0] = _narrowed(q, b, mu[: ritz.size])
+                return mu
+            part = _invariant_part(q, z, b)
+            if part is not None:  # the block's leading part is invariant already
+                mu = np.zeros(size, dtype=np.complex128)
+                mu[: part.size] = part
                 found[0] = q
                 return mu
             q = np.linalg.qr(z)[0]  # not invariant yet: one more pass
@@ -530,6 +560,71 @@ def leading_block(
             return LeadingBlock(mu, found[0], False, passes[0])
         k *= 2
     return LeadingBlock(multipliers(system, basis, coefficients, omega), None, True, passes[0])
+
+
+#: The next point's start keeps the leading j >= ``_LEADING`` directions of an invariant
+#: block where the (j + 1)-th Ritz value's modulus is at most ``_TAIL`` times the largest
+#: and at most ``_GAP`` times the j-th (a gap, so never inside a complex pair).
+_TAIL = 1e-7
+_GAP = 0.5
+
+
+def _narrowed(q: FloatArray, b: FloatArray, ritz: NDArray[np.complex128]) -> FloatArray:
+    """The next point's start from an invariant block q (2N, k), B = Q^T Phi Q and its
+    Ritz values ``ritz`` (largest modulus first): the Schur vectors of the leading j of
+    them, j the least from ``_LEADING`` on with abs(ritz[j]) <= ``_TAIL`` abs(ritz[0])
+    and <= ``_GAP`` abs(ritz[j - 1]), or q itself where there is no such j < k.
+
+    Why: a block doubled where the leading 16 directions split a complex pair (the 80-bay
+    mast's 11th point: 32 columns) would otherwise stay doubled for the rest of the curve,
+    each pass costing twice. The directions dropped have multipliers below 1e-7 of the
+    largest, so their part of the next point's invariance residual (at most that times
+    the start's own error) is far below ``_INVARIANT`` after one pass. Only the start
+    changes: each point's multipliers still come from a block tested invariant there."""
+    k = q.shape[1]
+    moduli = np.abs(ritz)
+    for j in range(_LEADING, k):
+        if moduli[j] <= _TAIL * moduli[0] and moduli[j] <= _GAP * moduli[j - 1]:
+            threshold = 0.5 * (moduli[j] + moduli[j - 1])
+            _, z, kept = scipy.linalg.schur(
+                b, output="real", sort=lambda re, im, cut=threshold: math.hypot(re, im) > cut
+            )
+            if kept != j:  # rounding put a Ritz value on the other side: keep them all
+                return q
+            return np.asarray(q @ z[:, :j], dtype=np.float64)
+    return q
+
+
+def _invariant_part(q: FloatArray, z: FloatArray, b: FloatArray) -> NDArray[np.complex128] | None:
+    """The Ritz values of the leading part of a block q (2N, k) that is invariant although
+    q is not: z = Phi q, B = Q^T Phi Q. For each p < k (largest first) where the Ritz
+    values' moduli have a gap (the (p + 1)-th at most ``_GAP`` times the p-th, so no
+    complex pair is split), the Schur vectors Z_p of B's leading p Ritz values give Q_p =
+    Q Z_p and Phi Q_p = z Z_p (exactly: Phi is linear), and the part is accepted by the
+    same test as the whole block, ||Phi Q_p - Q_p T_p|| <= ``_INVARIANT`` ||Phi Q_p||.
+    Returns its p Ritz values (largest modulus first), or None.
+
+    Why: a warm start whose last columns split a complex pair of the new orbit's
+    multipliers (or sit where they are close together) is never invariant as a whole,
+    and would send the point to the cold start; its leading part may already be."""
+    k = q.shape[1]
+    ritz = np.linalg.eigvals(b)
+    ritz = ritz[np.argsort(-np.abs(ritz), kind="stable")]
+    moduli = np.abs(ritz)
+    for p in range(k - 1, 0, -1):
+        if not moduli[p] <= _GAP * moduli[p - 1]:
+            continue
+        threshold = 0.5 * (moduli[p] + moduli[p - 1])
+        t, vectors, kept = scipy.linalg.schur(
+            b, output="real", sort=lambda re, im, cut=threshold: math.hypot(re, im) > cut
+        )
+        if kept != p:
+            continue
+        qp, zp = q @ vectors[:, :p], z @ vectors[:, :p]
+        miss = float(np.linalg.norm(zp - qp @ t[:p, :p]))
+        if miss <= _INVARIANT * max(float(np.linalg.norm(zp)), 1e-300):
+            return np.asarray(ritz[:p], dtype=np.complex128)
+    return None
 
 
 def _transition(
