@@ -319,8 +319,15 @@ def _product(
     eigen = method == "eigen" and (fits or short)
     local: dict[bytes, _Flow | None] | None = None if fits else {}
     system_key = _fingerprint(system) if eigen else b""
-    if eigen:  # the long patterns not held yet, decomposed side by side
-        _decompose_patterns(system, system_key, states, keys, decomposed, a, local)
+    if eigen:  # the patterns flow_of would decompose, side by side beforehand
+        wanted = list(decomposed)
+        if short and local is None and room:  # short ones met by another orbit before
+            for key, t in longest.items():
+                if bound * t <= SHORT_LIMIT and not _FLOWS.get((system_key, key))[0]:
+                    seen, _ = _SEEN_SHORT.get((system_key, key))
+                    if seen:
+                        wanted.append(key)
+        _decompose_patterns(system, system_key, states, keys, wanted, a, local)
     # on a block, a transition V_q^-1 V_p costs (2N)^3 to form against 2 (2N)^2 k to pass
     # through y: formed and cached only if the orbit's would fit in the cache
     pairs = len(set(itertools.pairwise(keys)))
@@ -346,17 +353,19 @@ def _product(
                         taylor[key] = _short_flow(system_key, key, system, inv_m, states[i])
                     return taylor[key]
             if not found:
-                a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
-                cached = _decompose(a)
+                generator = a.copy()  # a copy: leading_block runs passes in threads
+                generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
+                cached = _decompose(generator)
                 if local is None:
                     _FLOWS.put((system_key, key), cached, 2 * a.nbytes if cached else 0)
                 else:
                     local[key] = cached
             if isinstance(cached, _Flow):
                 return cached
-        # the plain exponential (the reference and the fallback): chain uses a at once
-        a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
-        return a
+        # the plain exponential (the reference and the fallback)
+        generator = a.copy()
+        generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
+        return generator
 
     def apply(start: FloatArray) -> FloatArray:
         return chain(start, widths / omega, keys, flow_of, transition)
@@ -581,7 +590,7 @@ def leading_block(
     size = 2 * system.n_dof
     if system.friction_force is not None or size <= LEADING_ABOVE:
         return LeadingBlock(multipliers(system, basis, coefficients, omega), None, False, 0)
-    apply = _product(system, basis, coefficients, omega, short=True)
+    apply = _split(_product(system, basis, coefficients, omega, short=True))
     passes = [0]
 
     def iterate(q: FloatArray, limit: int) -> NDArray[np.complex128] | None:
@@ -654,6 +663,23 @@ def _narrowed(q: FloatArray, b: FloatArray, ritz: NDArray[np.complex128]) -> Flo
                 return q
             return np.asarray(q @ z[:, :j], dtype=np.float64)
     return q
+
+
+def _split(apply: Callable[[FloatArray], FloatArray]) -> Callable[[FloatArray], FloatArray]:
+    """``apply`` run on the block's columns split among ``_WORKERS`` threads, BLAS on one
+    thread meanwhile: each column's product is its own (the same arithmetic as on the
+    whole block), two cores share a pass, and OpenBLAS's threads, slow on a shared
+    machine for these thin (2N, k) products, stay idle."""
+
+    def split(q: FloatArray) -> FloatArray:
+        parts = min(_WORKERS, q.shape[1] // 4)
+        if parts < 2:
+            return apply(q)
+        with _one_blas_thread(), ThreadPoolExecutor(parts) as pool:
+            done = list(pool.map(apply, np.array_split(q, parts, axis=1)))
+        return np.asarray(np.hstack(done), dtype=np.float64)
+
+    return split
 
 
 def _invariant_part(q: FloatArray, z: FloatArray, b: FloatArray) -> NDArray[np.complex128] | None:
