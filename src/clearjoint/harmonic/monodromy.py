@@ -665,6 +665,13 @@ def _narrowed(q: FloatArray, b: FloatArray, ritz: NDArray[np.complex128]) -> Flo
     return q
 
 
+#: From this many states (2N) on, :func:`leading_block` splits a pass among threads: below,
+#: each stretch's products (2N x 2N by 2N x 8) are too thin for two threads to gain over
+#: the Python between them (the 20-bay mast, 2N = 160: the verdict took 62 ms a point
+#: split against 25 ms whole, at load 2.5).
+SPLIT_ABOVE = 480
+
+
 def _split(apply: Callable[[FloatArray], FloatArray]) -> Callable[[FloatArray], FloatArray]:
     """``apply`` run on the block's columns split among ``_WORKERS`` threads, BLAS on one
     thread meanwhile: each column's product is its own (the same arithmetic as on the
@@ -673,7 +680,7 @@ def _split(apply: Callable[[FloatArray], FloatArray]) -> Callable[[FloatArray], 
 
     def split(q: FloatArray) -> FloatArray:
         parts = min(_WORKERS, q.shape[1] // 4)
-        if parts < 2:
+        if parts < 2 or q.shape[0] < SPLIT_ABOVE:
             return apply(q)
         with _one_blas_thread(), ThreadPoolExecutor(parts) as pool:
             done = list(pool.map(apply, np.array_split(q, parts, axis=1)))
