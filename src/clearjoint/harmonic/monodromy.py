@@ -502,8 +502,12 @@ def leading_multipliers(
     decompositions, as :func:`monodromy`) is applied to a block of k random columns (16
     first), orthonormalised, applied again (subspace iteration), and the Ritz values of
     B = Q^T Phi Q are the leading multipliers. Accepted when Q spans an invariant subspace
-    of Phi to ``_INVARIANT`` (the residual ||Phi Q - Q B|| measured, not assumed); else
-    one more pass, up to ``_PASSES``, then k doubles. A structure's multipliers fall off
+    of Phi to ``_INVARIANT`` (the residual ||Phi Q - Q B|| measured, not assumed), or when
+    the Schur vectors of B's leading p Ritz values (p at a gap in their moduli) do, by the
+    same test (:func:`_invariant_part`: a block whose last columns split a complex pair;
+    the p found are returned, the rest 0); else one more pass, up to ``_PASSES``, then k
+    doubles. On a large structure (``SPLIT_ABOVE``) a pass is split by columns among
+    threads. A structure's multipliers fall off
     fast (the mast: fewer than 5 above 0.5, none of the 20th above 1e-6), so k stays far
     below 2N and the cost per point is about 2 k products of (2N)^2 per stretch instead of
     one of (2N)^3. The multipliers
