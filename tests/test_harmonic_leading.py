@@ -357,3 +357,34 @@ def test_a_doubled_block_is_narrowed_to_its_leading_directions_for_the_next_poin
     assert np.linalg.norm(resid) <= 1e-9 * np.linalg.norm(phi @ narrow)
     b = np.diag(1.0 - 0.01 * np.arange(24))  # no gap anywhere inside the block
     assert monodromy._narrowed(q, b, np.diag(b).astype(complex)) is q
+
+
+def test_a_pass_split_among_threads_gives_the_same_multipliers(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The leading block's passes split by columns among two threads (forced on the 4-bay
+    mast, below SPLIT_ABOVE), with the orbit's patterns decomposed side by side: the same
+    multipliers as one thread to rounding, and the eigenvalues of the whole monodromy
+    (formed on one thread) to 1e-9 of the largest."""
+    structure, fr, basis = curve
+    model = build(structure, None, 1.0)
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)
+    coef, w = fr.coefficients[-1], float(fr.omega[-1])
+    monkeypatch.setattr(monodromy, "_WORKERS", 1)
+    monodromy.clear_cache()
+    exact = monodromy.multipliers(model, basis, coef, w)
+    monodromy.clear_cache()
+    alone = monodromy.leading_block(model, basis, coef, w)
+    monkeypatch.setattr(monodromy, "_WORKERS", 2)
+    monkeypatch.setattr(monodromy, "SPLIT_ABOVE", 0)
+    monodromy.clear_cache()
+    split = monodromy.leading_block(model, basis, coef, w)
+    k = np.count_nonzero(split.multipliers)
+    assert k >= 1
+    np.testing.assert_allclose(
+        np.abs(split.multipliers[:k]), np.abs(alone.multipliers[:k]), rtol=1e-12, atol=1e-13
+    )
+    np.testing.assert_allclose(
+        np.abs(split.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
+    )
+    monodromy.clear_cache()

@@ -544,7 +544,9 @@ class LeadingBlock:
         Largest modulus first; those outside the block 0.
     block : (2N, k) ndarray or None
         An orthonormal basis of Phi's leading invariant subspace (the next point's start);
-        None where all 2N multipliers were computed.
+        where only its leading part passed the invariance test (:func:`_invariant_part`)
+        the whole block, whose first columns' span is that part (``multipliers`` then
+        holds that part's values only). None where all 2N multipliers were computed.
     full : bool
         True where the block did not become invariant at any size and the whole monodromy
         was decomposed instead (the fallback: the caller says so).
