@@ -292,3 +292,99 @@ def test_short_patterns_stay_taylor_when_the_orbits_patterns_would_not_all_fit(
         block = found.block
     assert len(decomposed) == len(long_keys)  # each long pattern once, no short one
     monodromy.clear_cache()
+
+
+def _operator_with(moduli: list[float], size: int, seed: int) -> np.ndarray:
+    """A real (size, size) matrix with the given eigenvalue moduli (pairs where a modulus
+    repeats: a +- ib at that modulus), the rest 1e-12, in random well-conditioned axes."""
+    rng = np.random.default_rng(seed)
+    blocks = np.zeros((size, size))
+    i, j = 0, 0
+    while i < len(moduli):
+        if i + 1 < len(moduli) and moduli[i + 1] == moduli[i]:
+            r = moduli[i]
+            blocks[j : j + 2, j : j + 2] = r * np.array([[0.6, 0.8], [-0.8, 0.6]])
+            i, j = i + 2, j + 2
+        else:
+            blocks[j, j] = moduli[i]
+            i, j = i + 1, j + 1
+    for m in range(j, size):
+        blocks[m, m] = 1e-12
+    axes = np.linalg.qr(rng.standard_normal((size, size)))[0] + 0.1 * np.eye(size)
+    return np.asarray(axes @ blocks @ np.linalg.inv(axes), dtype=np.float64)
+
+
+def test_the_leading_part_of_a_block_splitting_a_pair_is_accepted_and_exact() -> None:
+    """A block of 4 columns whose last two split a complex pair is never invariant as a
+    whole; its leading part (3 multipliers, a gap below them) is, and its Ritz values are
+    the matrix's own eigenvalues (numpy's eigvals of the whole matrix, an independent
+    route). A random block that is not converged gives None."""
+    phi = _operator_with([5.0, 2.0, 0.9, 1e-3, 1e-3], 40, seed=1)
+    rng = np.random.default_rng(2)
+    q = np.linalg.qr(rng.standard_normal((40, 4)))[0]
+    assert monodromy._invariant_part(q, phi @ q, q.T @ phi @ q) is None
+    for _ in range(60):  # subspace iteration: the leading 3 converge, the pair rotates
+        q = np.linalg.qr(phi @ q)[0]
+    z = phi @ q
+    b = q.T @ z
+    assert np.linalg.norm(z - q @ b) > 1e-6 * np.linalg.norm(z)  # the whole block is not
+    part = monodromy._invariant_part(q, z, b)
+    assert part is not None
+    assert part.size == 3
+    exact = np.linalg.eigvals(phi)
+    exact = exact[np.argsort(-np.abs(exact))][:3]
+    np.testing.assert_allclose(np.sort(part.real), np.sort(exact.real), rtol=1e-9)
+
+
+def test_a_doubled_block_is_narrowed_to_its_leading_directions_for_the_next_point() -> None:
+    """An invariant block of 24 columns on a matrix with 16 multipliers from 3 down, a pair
+    at 1e-6 (above 1e-7 of the largest: kept) and the rest 1e-12 is narrowed to the 18
+    leading Schur vectors (at least _LEADING = 16, at a gap below 1e-7 of the largest),
+    which span an invariant subspace of the matrix (its
+    own residual, measured); with no such gap the block is kept whole."""
+    moduli = [3.0 / 1.5**i for i in range(16)] + [1e-6, 1e-6]
+    phi = _operator_with(moduli, 60, seed=3)
+    q = np.linalg.qr(np.random.default_rng(4).standard_normal((60, 24)))[0]
+    for _ in range(40):
+        q = np.linalg.qr(phi @ q)[0]
+    b = q.T @ phi @ q
+    ritz = np.linalg.eigvals(b)
+    ritz = ritz[np.argsort(-np.abs(ritz))]
+    narrow = monodromy._narrowed(q, b, ritz)
+    assert narrow.shape == (60, 18)
+    np.testing.assert_allclose(narrow.T @ narrow, np.eye(18), atol=1e-12)
+    resid = phi @ narrow - narrow @ (narrow.T @ phi @ narrow)
+    assert np.linalg.norm(resid) <= 1e-9 * np.linalg.norm(phi @ narrow)
+    b = np.diag(1.0 - 0.01 * np.arange(24))  # no gap anywhere inside the block
+    assert monodromy._narrowed(q, b, np.diag(b).astype(complex)) is q
+
+
+def test_a_pass_split_among_threads_gives_the_same_multipliers(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The leading block's passes split by columns among two threads (forced on the 4-bay
+    mast, below SPLIT_ABOVE), with the orbit's patterns decomposed side by side: the same
+    multipliers as one thread to rounding, and the eigenvalues of the whole monodromy
+    (formed on one thread) to 1e-9 of the largest."""
+    structure, fr, basis = curve
+    model = build(structure, None, 1.0)
+    monkeypatch.setattr(monodromy, "LEADING_ABOVE", 0)
+    coef, w = fr.coefficients[-1], float(fr.omega[-1])
+    monkeypatch.setattr(monodromy, "_WORKERS", 1)
+    monodromy.clear_cache()
+    exact = monodromy.multipliers(model, basis, coef, w)
+    monodromy.clear_cache()
+    alone = monodromy.leading_block(model, basis, coef, w)
+    monkeypatch.setattr(monodromy, "_WORKERS", 2)
+    monkeypatch.setattr(monodromy, "SPLIT_ABOVE", 0)
+    monodromy.clear_cache()
+    split = monodromy.leading_block(model, basis, coef, w)
+    k = np.count_nonzero(split.multipliers)
+    assert k >= 1
+    np.testing.assert_allclose(
+        np.abs(split.multipliers[:k]), np.abs(alone.multipliers[:k]), rtol=1e-12, atol=1e-13
+    )
+    np.testing.assert_allclose(
+        np.abs(split.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
+    )
+    monodromy.clear_cache()

@@ -51,16 +51,20 @@ so does an orbit whose patterns would not fit in the cache.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import itertools
 import math
+import os
 import threading
 from collections import OrderedDict
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+import scipy.linalg
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
@@ -189,16 +193,24 @@ class _Cache:
 
 _FLOWS = _Cache(_FLOW_BYTES)
 _TRANSITIONS = _Cache(_TRANSITION_BYTES)
+#: The short patterns' Taylor flows (:class:`ShortFlow`: a sparse A, about 100 kB at 2N =
+#: 640), kept across orbits: building one costs a dense (N, N) pattern stiffness and its
+#: conversion, 0.7 s a point on the 80-bay mast's 134 short patterns before issue 25's
+#: fourth round, when each orbit built its own.
+_SHORT_FLOW_BYTES = 64 * 2**20
+_SHORT_FLOWS = _Cache(_SHORT_FLOW_BYTES)
 #: The short patterns met so far (each counted as 1 "byte": up to 65536 of them), marked
 #: by the orbit that met them first.
 _SEEN_SHORT = _Cache(2**16)
 
 
 def clear_cache() -> None:
-    """Free the cached decompositions and transitions (up to 1.25 GiB; module docstring)."""
+    """Free the cached decompositions, transitions and short flows (up to 1.3 GiB; module
+    docstring)."""
     _FLOWS.clear()
     _TRANSITIONS.clear()
     _SEEN_SHORT.clear()
+    _SHORT_FLOWS.clear()
 
 
 def _fingerprint(system: LinearSystem) -> bytes:
@@ -307,6 +319,15 @@ def _product(
     eigen = method == "eigen" and (fits or short)
     local: dict[bytes, _Flow | None] | None = None if fits else {}
     system_key = _fingerprint(system) if eigen else b""
+    if eigen:  # the patterns flow_of would decompose, side by side beforehand
+        wanted = list(decomposed)
+        if short and local is None and room:  # short ones met by another orbit before
+            for key, t in longest.items():
+                if bound * t <= SHORT_LIMIT and not _FLOWS.get((system_key, key))[0]:
+                    seen, _ = _SEEN_SHORT.get((system_key, key))
+                    if seen:
+                        wanted.append(key)
+        _decompose_patterns(system, system_key, states, keys, wanted, a, local)
     # on a block, a transition V_q^-1 V_p costs (2N)^3 to form against 2 (2N)^2 k to pass
     # through y: formed and cached only if the orbit's would fit in the cache
     pairs = len(set(itertools.pairwise(keys)))
@@ -329,22 +350,22 @@ def _product(
                 if local is not None or not room or not seen or mark is token:
                     _SEEN_SHORT.put((system_key, key), token, 1)
                     if key not in taylor:
-                        taylor[key] = ShortFlow.for_structure(
-                            inv_m, _pattern_stiffness(system, states[i]), system.damping
-                        )
+                        taylor[key] = _short_flow(system_key, key, system, inv_m, states[i])
                     return taylor[key]
             if not found:
-                a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
-                cached = _decompose(a)
+                generator = a.copy()  # a copy: leading_block runs passes in threads
+                generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
+                cached = _decompose(generator)
                 if local is None:
                     _FLOWS.put((system_key, key), cached, 2 * a.nbytes if cached else 0)
                 else:
                     local[key] = cached
             if isinstance(cached, _Flow):
                 return cached
-        # the plain exponential (the reference and the fallback): chain uses a at once
-        a[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
-        return a
+        # the plain exponential (the reference and the fallback)
+        generator = a.copy()
+        generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
+        return generator
 
     def apply(start: FloatArray) -> FloatArray:
         return chain(start, widths / omega, keys, flow_of, transition)
@@ -359,12 +380,86 @@ def _product(
     return apply
 
 
+#: Threads that decompose an orbit's new patterns side by side (each with one BLAS thread:
+#: LAPACK's eigensolver gains little from more, and on a shared machine OpenBLAS's own
+#: threads slowed one decomposition of the 80-bay mast's 640 x 640 A tenfold, 0.5 s to
+#: 2-9 s, when another process held a core).
+_WORKERS = max(1, min(4, os.cpu_count() or 1))
+
+
+def _decompose_patterns(
+    system: LinearSystem,
+    system_key: bytes,
+    states: NDArray[np.int64],
+    keys: list[bytes],
+    wanted: list[bytes],
+    a: FloatArray,
+    local: dict[bytes, _Flow | None] | None,
+) -> None:
+    """Decompose the patterns of ``wanted`` not held yet (in the cache, or in ``local`` for
+    an orbit too big for it) in ``_WORKERS`` threads, BLAS on one thread meanwhile, and
+    store them as :func:`_product`'s ``flow_of`` would one by one: the same
+    decompositions (each is its own LAPACK call), only side by side. The first point of
+    the 80-bay curve decomposes 137 patterns (0.5 s each on one core)."""
+    first: dict[bytes, int] = {}
+    for i, key in enumerate(keys):
+        first.setdefault(key, i)
+    if local is None:
+        missing = [key for key in wanted if not _FLOWS.get((system_key, key))[0]]
+    else:
+        missing = [key for key in wanted if key not in local]
+    if len(missing) < 2 or _WORKERS < 2:
+        return
+    n = system.n_dof
+    inv_m = 1.0 / np.diag(system.mass)
+
+    def one(key: bytes) -> _Flow | None:
+        generator = a.copy()
+        generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[first[key]])
+        return _decompose(generator)
+
+    with _one_blas_thread(), ThreadPoolExecutor(_WORKERS) as pool:
+        flows = list(pool.map(one, missing))
+    for key, flow in zip(missing, flows, strict=True):
+        if local is None:
+            _FLOWS.put((system_key, key), flow, 2 * a.nbytes if flow else 0)
+        else:
+            local[key] = flow
+
+
+def _one_blas_thread() -> contextlib.AbstractContextManager[object]:
+    """BLAS held to one thread (threadpoolctl, if installed; else nothing changes)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+        return contextlib.nullcontext()
+    limits: contextlib.AbstractContextManager[object] = threadpool_limits(limits=1, user_api="blas")
+    return limits
+
+
 #: A pattern none of whose stretches in an orbit exceeds this many units of the scaled
 #: norm bound (``ShortFlow.bound * t``; about 30 sparse products per unit of 4) is not
 #: decomposed: its stretches are taken by Taylor's series on the block. On the 40-bay mast
 #: half the patterns of an orbit last below 4 units (two joints crossing their edges
 #: within 0.2 ms), the others above 64.
 SHORT_LIMIT = 16.0
+
+
+def _short_flow(
+    system_key: bytes,
+    key: bytes,
+    system: LinearSystem,
+    inv_m: FloatArray,
+    state: NDArray[np.int64],
+) -> ShortFlow:
+    """The pattern's :class:`ShortFlow`, built once per system and pattern (cached)."""
+    found, cached = _SHORT_FLOWS.get((system_key, key))
+    if found and isinstance(cached, ShortFlow):
+        return cached
+    flow = ShortFlow.for_structure(inv_m, _pattern_stiffness(system, state), system.damping)
+    g = flow.generator
+    _SHORT_FLOWS.put((system_key, key), flow, g.data.nbytes + g.indices.nbytes + g.indptr.nbytes)
+    return flow
 
 
 def _short_bound(system: LinearSystem) -> float:
@@ -408,8 +503,12 @@ def leading_multipliers(
     decompositions, as :func:`monodromy`) is applied to a block of k random columns (16
     first), orthonormalised, applied again (subspace iteration), and the Ritz values of
     B = Q^T Phi Q are the leading multipliers. Accepted when Q spans an invariant subspace
-    of Phi to ``_INVARIANT`` (the residual ||Phi Q - Q B|| measured, not assumed); else
-    one more pass, up to ``_PASSES``, then k doubles. A structure's multipliers fall off
+    of Phi to ``_INVARIANT`` (the residual ||Phi Q - Q B|| measured, not assumed), or when
+    the Schur vectors of B's leading p Ritz values (p at a gap in their moduli) do, by the
+    same test (:func:`_invariant_part`: a block whose last columns split a complex pair;
+    the p found are returned, the rest 0); else one more pass, up to ``_PASSES``, then k
+    doubles. On a large structure (``SPLIT_ABOVE``) a pass is split by columns among
+    threads. A structure's multipliers fall off
     fast (the mast: fewer than 5 above 0.5, none of the 20th above 1e-6), so k stays far
     below 2N and the cost per point is about 2 k products of (2N)^2 per stretch instead of
     one of (2N)^3. The multipliers
@@ -445,7 +544,9 @@ class LeadingBlock:
         Largest modulus first; those outside the block 0.
     block : (2N, k) ndarray or None
         An orthonormal basis of Phi's leading invariant subspace (the next point's start);
-        None where all 2N multipliers were computed.
+        where only its leading part passed the invariance test (:func:`_invariant_part`)
+        the whole block, whose first columns' span is that part (``multipliers`` then
+        holds that part's values only). None where all 2N multipliers were computed.
     full : bool
         True where the block did not become invariant at any size and the whole monodromy
         was decomposed instead (the fallback: the caller says so).
@@ -496,7 +597,7 @@ def leading_block(
     size = 2 * system.n_dof
     if system.friction_force is not None or size <= LEADING_ABOVE:
         return LeadingBlock(multipliers(system, basis, coefficients, omega), None, False, 0)
-    apply = _product(system, basis, coefficients, omega, short=True)
+    apply = _split(_product(system, basis, coefficients, omega, short=True))
     passes = [0]
 
     def iterate(q: FloatArray, limit: int) -> NDArray[np.complex128] | None:
@@ -510,6 +611,12 @@ def leading_block(
                 mu = np.zeros(size, dtype=np.complex128)
                 ritz = np.linalg.eigvals(b)
                 mu[: ritz.size] = ritz[np.argsort(-np.abs(ritz), kind="stable")]
+                found[0] = _narrowed(q, b, mu[: ritz.size])
+                return mu
+            part = _invariant_part(q, z, b)
+            if part is not None:  # the block's leading part is invariant already
+                mu = np.zeros(size, dtype=np.complex128)
+                mu[: part.size] = part
                 found[0] = q
                 return mu
             q = np.linalg.qr(z)[0]  # not invariant yet: one more pass
@@ -530,6 +637,95 @@ def leading_block(
             return LeadingBlock(mu, found[0], False, passes[0])
         k *= 2
     return LeadingBlock(multipliers(system, basis, coefficients, omega), None, True, passes[0])
+
+
+#: The next point's start keeps the leading j >= ``_LEADING`` directions of an invariant
+#: block where the (j + 1)-th Ritz value's modulus is at most ``_TAIL`` times the largest
+#: and at most ``_GAP`` times the j-th (a gap, so never inside a complex pair).
+_TAIL = 1e-7
+_GAP = 0.5
+
+
+def _narrowed(q: FloatArray, b: FloatArray, ritz: NDArray[np.complex128]) -> FloatArray:
+    """The next point's start from an invariant block q (2N, k), B = Q^T Phi Q and its
+    Ritz values ``ritz`` (largest modulus first): the Schur vectors of the leading j of
+    them, j the least from ``_LEADING`` on with abs(ritz[j]) <= ``_TAIL`` abs(ritz[0])
+    and <= ``_GAP`` abs(ritz[j - 1]), or q itself where there is no such j < k.
+
+    Why: a block doubled where the leading 16 directions split a complex pair (the 80-bay
+    mast's 11th point: 32 columns) would otherwise stay doubled for the rest of the curve,
+    each pass costing twice. The directions dropped have multipliers below 1e-7 of the
+    largest, so their part of the next point's invariance residual (at most that times
+    the start's own error) is far below ``_INVARIANT`` after one pass. Only the start
+    changes: each point's multipliers still come from a block tested invariant there."""
+    k = q.shape[1]
+    moduli = np.abs(ritz)
+    for j in range(_LEADING, k):
+        if moduli[j] <= _TAIL * moduli[0] and moduli[j] <= _GAP * moduli[j - 1]:
+            threshold = 0.5 * (moduli[j] + moduli[j - 1])
+            _, z, kept = scipy.linalg.schur(
+                b, output="real", sort=lambda re, im, cut=threshold: math.hypot(re, im) > cut
+            )
+            if kept != j:  # rounding put a Ritz value on the other side: keep them all
+                return q
+            return np.asarray(q @ z[:, :j], dtype=np.float64)
+    return q
+
+
+#: From this many states (2N) on, :func:`leading_block` splits a pass among threads: below,
+#: each stretch's products (2N x 2N by 2N x 8) are too thin for two threads to gain over
+#: the Python between them (the 20-bay mast, 2N = 160: the verdict took 62 ms a point
+#: split against 25 ms whole, at load 2.5).
+SPLIT_ABOVE = 480
+
+
+def _split(apply: Callable[[FloatArray], FloatArray]) -> Callable[[FloatArray], FloatArray]:
+    """``apply`` run on the block's columns split among ``_WORKERS`` threads, BLAS on one
+    thread meanwhile: each column's product is its own (the same arithmetic as on the
+    whole block), two cores share a pass, and OpenBLAS's threads, slow on a shared
+    machine for these thin (2N, k) products, stay idle."""
+
+    def split(q: FloatArray) -> FloatArray:
+        parts = min(_WORKERS, q.shape[1] // 4)
+        if parts < 2 or q.shape[0] < SPLIT_ABOVE:
+            return apply(q)
+        with _one_blas_thread(), ThreadPoolExecutor(parts) as pool:
+            done = list(pool.map(apply, np.array_split(q, parts, axis=1)))
+        return np.asarray(np.hstack(done), dtype=np.float64)
+
+    return split
+
+
+def _invariant_part(q: FloatArray, z: FloatArray, b: FloatArray) -> NDArray[np.complex128] | None:
+    """The Ritz values of the leading part of a block q (2N, k) that is invariant although
+    q is not: z = Phi q, B = Q^T Phi Q. For each p < k (largest first) where the Ritz
+    values' moduli have a gap (the (p + 1)-th at most ``_GAP`` times the p-th, so no
+    complex pair is split), the Schur vectors Z_p of B's leading p Ritz values give Q_p =
+    Q Z_p and Phi Q_p = z Z_p (exactly: Phi is linear), and the part is accepted by the
+    same test as the whole block, ||Phi Q_p - Q_p T_p|| <= ``_INVARIANT`` ||Phi Q_p||.
+    Returns its p Ritz values (largest modulus first), or None.
+
+    Why: a warm start whose last columns split a complex pair of the new orbit's
+    multipliers (or sit where they are close together) is never invariant as a whole,
+    and would send the point to the cold start; its leading part may already be."""
+    k = q.shape[1]
+    ritz = np.linalg.eigvals(b)
+    ritz = ritz[np.argsort(-np.abs(ritz), kind="stable")]
+    moduli = np.abs(ritz)
+    for p in range(k - 1, 0, -1):
+        if not moduli[p] <= _GAP * moduli[p - 1]:
+            continue
+        threshold = 0.5 * (moduli[p] + moduli[p - 1])
+        t, vectors, kept = scipy.linalg.schur(
+            b, output="real", sort=lambda re, im, cut=threshold: math.hypot(re, im) > cut
+        )
+        if kept != p:
+            continue
+        qp, zp = q @ vectors[:, :p], z @ vectors[:, :p]
+        miss = float(np.linalg.norm(zp - qp @ t[:p, :p]))
+        if miss <= _INVARIANT * max(float(np.linalg.norm(zp)), 1e-300):
+            return np.asarray(ritz[:p], dtype=np.complex128)
+    return None
 
 
 def _transition(
