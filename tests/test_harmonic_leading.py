@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
 
 import numpy as np
 import pytest
@@ -388,3 +389,44 @@ def test_a_pass_split_among_threads_gives_the_same_multipliers(
         np.abs(split.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
     )
     monodromy.clear_cache()
+
+
+def test_overlapping_one_blas_thread_sections_restore_the_callers_limit() -> None:
+    """Two threads inside the BLAS limit at once, the first leaving first (two orbits'
+    passes side by side): BLAS stays on one thread until the last leaves, then the
+    caller's own limit is back. Read from threadpoolctl itself."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas_threads() -> set[int]:
+        return {
+            int(info["num_threads"])
+            for info in threadpoolctl.threadpool_info()
+            if info["user_api"] == "blas"
+        }
+
+    before = blas_threads()
+    if not before or before == {1}:
+        pytest.skip("BLAS runs on one thread here already: nothing to restore")
+    entered, second_in, left_first = threading.Event(), threading.Event(), threading.Event()
+    seen: dict[str, set[int]] = {}
+
+    def first() -> None:
+        with monodromy._one_blas_thread():
+            entered.set()
+            second_in.wait(5)
+        left_first.set()
+
+    def second() -> None:
+        entered.wait(5)
+        with monodromy._one_blas_thread():
+            second_in.set()
+            left_first.wait(5)
+            seen["after the first left"] = blas_threads()
+
+    threads = [threading.Thread(target=first), threading.Thread(target=second)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(10)
+    assert seen["after the first left"] == {1}
+    assert blas_threads() == before

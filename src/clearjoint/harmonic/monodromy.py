@@ -58,7 +58,7 @@ import math
 import os
 import threading
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Literal
@@ -427,14 +427,37 @@ def _decompose_patterns(
             local[key] = flow
 
 
-def _one_blas_thread() -> contextlib.AbstractContextManager[object]:
-    """BLAS held to one thread (threadpoolctl, if installed; else nothing changes)."""
+#: Callers inside :func:`_one_blas_thread` now, and the limiter that set BLAS to one thread
+#: for them (threadpoolctl's limits are process-wide: one per process, not per caller).
+_BLAS_LOCK = threading.Lock()
+_BLAS_USERS = [0]
+_BLAS_LIMITER: list[object] = []
+
+
+@contextlib.contextmanager
+def _one_blas_thread() -> Iterator[None]:
+    """BLAS held to one thread (threadpoolctl, if installed; else nothing changes).
+
+    The limit is process-wide, so it is set by the first caller in and restored by the
+    last one out: two orbits' passes run side by side (two threads of a caller) would
+    otherwise restore each other's limits in the wrong order and leave the process on
+    one BLAS thread for good."""
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-        return contextlib.nullcontext()
-    limits: contextlib.AbstractContextManager[object] = threadpool_limits(limits=1, user_api="blas")
-    return limits
+        yield
+        return
+    with _BLAS_LOCK:
+        if _BLAS_USERS[0] == 0:
+            _BLAS_LIMITER.append(threadpool_limits(limits=1, user_api="blas"))
+        _BLAS_USERS[0] += 1
+    try:
+        yield
+    finally:
+        with _BLAS_LOCK:
+            _BLAS_USERS[0] -= 1
+            if _BLAS_USERS[0] == 0:
+                _BLAS_LIMITER.pop().restore_original_limits()  # type: ignore[attr-defined]
 
 
 #: A pattern none of whose stretches in an orbit exceeds this many units of the scaled
