@@ -668,6 +668,12 @@ def leading_block(
 _TAIL = 1e-7
 _GAP = 0.5
 
+#: :func:`_invariant_part` leaves out only Ritz values of modulus at most this: far inside
+#: the unit circle, so no test on the multipliers (the verdict, a multiplier through -1, a
+#: complex pair through the circle; :func:`clearjoint.harmonic.response.curve_events`)
+#: can turn on one of the directions left out, whose Ritz values are not converged.
+_DROPPED = 0.5
+
 
 def _narrowed(q: FloatArray, b: FloatArray, ritz: NDArray[np.complex128]) -> FloatArray:
     """The next point's start from an invariant block q (2N, k), B = Q^T Phi Q and its
@@ -725,8 +731,16 @@ def _invariant_part(q: FloatArray, z: FloatArray, b: FloatArray) -> NDArray[np.c
     values' moduli have a gap (the (p + 1)-th at most ``_GAP`` times the p-th, so no
     complex pair is split), the Schur vectors Z_p of B's leading p Ritz values give Q_p =
     Q Z_p and Phi Q_p = z Z_p (exactly: Phi is linear), and the part is accepted by the
-    same test as the whole block, ||Phi Q_p - Q_p T_p|| <= ``_INVARIANT`` ||Phi Q_p||.
+    same test as the whole block, ||Phi Q_p - Q_p T_p|| <= ``_INVARIANT`` ||Phi Q_p||,
+    and only where every Ritz value left out has modulus at most ``_DROPPED``.
     Returns its p Ritz values (largest modulus first), or None.
+
+    What the test proves: the p values are eigenvalues of a matrix within ``_INVARIANT``
+    (relative) of Phi. That no multiplier of Phi outside the part exceeds them is not
+    proved by it, for the part as for a whole block: it rests, as there, on the block
+    having passed through Phi from a start spanning the leading directions (subspace
+    iteration; the previous point's block along a curve). ``_DROPPED`` keeps the Ritz
+    values left out far from the unit circle, so no verdict or event turns on them.
 
     Why: a warm start whose last columns split a complex pair of the new orbit's
     multipliers (or sit where they are close together) is never invariant as a whole,
@@ -736,6 +750,8 @@ def _invariant_part(q: FloatArray, z: FloatArray, b: FloatArray) -> NDArray[np.c
     ritz = ritz[np.argsort(-np.abs(ritz), kind="stable")]
     moduli = np.abs(ritz)
     for p in range(k - 1, 0, -1):
+        if not moduli[p] <= _DROPPED:  # and so for every smaller p: none left out near 1
+            return None
         if not moduli[p] <= _GAP * moduli[p - 1]:
             continue
         threshold = 0.5 * (moduli[p] + moduli[p - 1])
