@@ -467,3 +467,41 @@ def test_no_leading_part_is_accepted_that_leaves_out_a_ritz_value_near_the_circl
             assert part is not None
             assert part.size == 3
             np.testing.assert_allclose(np.abs(part), [5.0, 2.0, 1.8], rtol=1e-9)
+
+
+def test_patterns_decomposed_side_by_side_enter_the_cache_as_each_is_done(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Eight new patterns of the 4-bay mast decomposed by two threads: each enters the
+    cache as soon as it is done, so when the i-th decomposition starts at least i - 1
+    are stored (the two threads' in flight aside), and no more than two are ever held
+    outside the cache (its 1 GiB cap then bounds the memory); all eight end stored."""
+    structure, _, _ = curve
+    model = build(structure, None, 1.0)
+    rng = np.random.default_rng(7)
+    n_j = model.directions.shape[0]
+    states = np.unique(rng.integers(-1, 2, size=(40, n_j)), axis=0)[:8]
+    keys = [state.tobytes() for state in states]
+    n = model.n_dof
+    a = np.zeros((2 * n, 2 * n))
+    a[:n, n:] = np.eye(n)
+    a[n:, n:] = -(1.0 / np.diag(model.mass))[:, None] * model.damping
+    system_key = monodromy._fingerprint(model)
+    lock = threading.Lock()
+    stored_at_start: list[int] = []
+    decompose = monodromy._decompose
+
+    def counting(generator: np.ndarray) -> object:
+        with lock:
+            held = sum(monodromy._FLOWS.get((system_key, key))[0] for key in keys)
+            stored_at_start.append(int(held))
+        return decompose(generator)
+
+    monkeypatch.setattr(monodromy, "_decompose", counting)
+    monkeypatch.setattr(monodromy, "_WORKERS", 2)
+    monodromy.clear_cache()
+    monodromy._decompose_patterns(model, system_key, states, keys, keys, a, None)
+    assert len(stored_at_start) == 8
+    assert all(held >= i - 1 for i, held in enumerate(stored_at_start))
+    assert all(monodromy._FLOWS.get((system_key, key))[0] for key in keys)
+    monodromy.clear_cache()

@@ -413,18 +413,20 @@ def _decompose_patterns(
     n = system.n_dof
     inv_m = 1.0 / np.diag(system.mass)
 
-    def one(key: bytes) -> _Flow | None:
+    def one(key: bytes) -> None:
         generator = a.copy()
         generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[first[key]])
-        return _decompose(generator)
-
-    with _one_blas_thread(), ThreadPoolExecutor(_WORKERS) as pool:
-        flows = list(pool.map(one, missing))
-    for key, flow in zip(missing, flows, strict=True):
+        flow = _decompose(generator)
+        # stored at once (the cache evicts as it goes): held until all were done, an
+        # orbit's new decompositions would sit beside a full cache, up to twice its 1 GiB
         if local is None:
             _FLOWS.put((system_key, key), flow, 2 * a.nbytes if flow else 0)
         else:
             local[key] = flow
+
+    with _one_blas_thread(), ThreadPoolExecutor(_WORKERS) as pool:
+        for _ in pool.map(one, missing):  # a worker's exception is raised here
+            pass
 
 
 #: Callers inside :func:`_one_blas_thread` now, and the limiter that set BLAS to one thread
