@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
 
 import numpy as np
 import pytest
@@ -387,4 +388,120 @@ def test_a_pass_split_among_threads_gives_the_same_multipliers(
     np.testing.assert_allclose(
         np.abs(split.multipliers[:k]), np.abs(exact[:k]), rtol=0, atol=1e-9 * abs(exact[0])
     )
+    monodromy.clear_cache()
+
+
+def test_overlapping_one_blas_thread_sections_restore_the_callers_limit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Two threads inside the BLAS limit at once, the first leaving first (two orbits'
+    passes side by side): BLAS stays on one thread until the last leaves, then the
+    caller's own limit (2) is back. threadpoolctl's limiter is replaced by a stand-in
+    with its semantics (process-wide, each limiter restores what it found when made):
+    OpenBLAS's own count, read back from threads, depends on which thread set it last."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    current = [2]
+
+    class Limits:
+        def __init__(self, limits: int, user_api: str) -> None:
+            self.original = current[0]
+            current[0] = limits
+
+        def restore_original_limits(self) -> None:
+            current[0] = self.original
+
+        def __enter__(self) -> Limits:
+            return self
+
+        def __exit__(self, *exc: object) -> None:
+            self.restore_original_limits()
+
+    monkeypatch.setattr(threadpoolctl, "threadpool_limits", Limits)
+    entered, second_in, left_first = threading.Event(), threading.Event(), threading.Event()
+    seen: list[int] = []
+
+    def first() -> None:
+        with monodromy._one_blas_thread():
+            entered.set()
+            second_in.wait(5)
+        left_first.set()
+
+    def second() -> None:
+        entered.wait(5)
+        with monodromy._one_blas_thread():
+            second_in.set()
+            left_first.wait(5)
+            seen.append(current[0])
+
+    threads = [threading.Thread(target=first), threading.Thread(target=second)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(10)
+    assert seen == [1]
+    assert current == [2]
+
+
+def test_no_leading_part_is_accepted_that_leaves_out_a_ritz_value_near_the_circle() -> None:
+    """Multipliers 5, 2, 1.8, then 0.8 and 0.79 (then 1e-12), a block of 4 columns after
+    subspace iteration: the leading 3 are invariant and a gap lies below them, but the
+    4th column, between 0.8 and 0.79, has not converged, and its Ritz value (near 0.8,
+    above _DROPPED = 0.5) is left out: the part is refused (a multiplier near the circle
+    must not drop out of the events' tests). With 0.1 and 0.099 instead the same part is
+    accepted (5, 2, 1.8: numpy's eigvals of the matrix)."""
+    for low, accepted in ((0.8, False), (0.1, True)):
+        phi = _operator_with([5.0, 2.0, 1.8, low, 0.9875 * low], 40, seed=5)
+        q = np.linalg.qr(np.random.default_rng(6).standard_normal((40, 4)))[0]
+        for _ in range(80):
+            q = np.linalg.qr(phi @ q)[0]
+        z = phi @ q
+        b = q.T @ z
+        assert np.linalg.norm(z - q @ b) > 1e-6 * np.linalg.norm(z)  # not invariant whole
+        ritz = np.sort(np.abs(np.linalg.eigvals(b)))[::-1]
+        assert ritz[3] <= monodromy._GAP * ritz[2]  # a gap: the part would pass the residual
+        part = monodromy._invariant_part(q, z, b)
+        if not accepted:
+            assert ritz[3] > 0.5
+            assert part is None
+        else:
+            assert part is not None
+            assert part.size == 3
+            np.testing.assert_allclose(np.abs(part), [5.0, 2.0, 1.8], rtol=1e-9)
+
+
+def test_patterns_decomposed_side_by_side_enter_the_cache_as_each_is_done(
+    curve: tuple[object, object, aft.Basis], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Eight new patterns of the 4-bay mast decomposed by two threads: each enters the
+    cache as soon as it is done, so when the i-th decomposition starts at least i - 1
+    are stored (the two threads' in flight aside), and no more than two are ever held
+    outside the cache (its 1 GiB cap then bounds the memory); all eight end stored."""
+    structure, _, _ = curve
+    model = build(structure, None, 1.0)
+    rng = np.random.default_rng(7)
+    n_j = model.directions.shape[0]
+    states = np.unique(rng.integers(-1, 2, size=(40, n_j)), axis=0)[:8]
+    keys = [state.tobytes() for state in states]
+    n = model.n_dof
+    a = np.zeros((2 * n, 2 * n))
+    a[:n, n:] = np.eye(n)
+    a[n:, n:] = -(1.0 / np.diag(model.mass))[:, None] * model.damping
+    system_key = monodromy._fingerprint(model)
+    lock = threading.Lock()
+    stored_at_start: list[int] = []
+    decompose = monodromy._decompose
+
+    def counting(generator: np.ndarray) -> object:
+        with lock:
+            held = sum(monodromy._FLOWS.get((system_key, key))[0] for key in keys)
+            stored_at_start.append(int(held))
+        return decompose(generator)
+
+    monkeypatch.setattr(monodromy, "_decompose", counting)
+    monkeypatch.setattr(monodromy, "_WORKERS", 2)
+    monodromy.clear_cache()
+    monodromy._decompose_patterns(model, system_key, states, keys, keys, a, None)
+    assert len(stored_at_start) == 8
+    assert all(held >= i - 1 for i, held in enumerate(stored_at_start))
+    assert all(monodromy._FLOWS.get((system_key, key))[0] for key in keys)
     monodromy.clear_cache()

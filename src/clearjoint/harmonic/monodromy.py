@@ -58,7 +58,7 @@ import math
 import os
 import threading
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Literal
@@ -413,28 +413,53 @@ def _decompose_patterns(
     n = system.n_dof
     inv_m = 1.0 / np.diag(system.mass)
 
-    def one(key: bytes) -> _Flow | None:
+    def one(key: bytes) -> None:
         generator = a.copy()
         generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[first[key]])
-        return _decompose(generator)
-
-    with _one_blas_thread(), ThreadPoolExecutor(_WORKERS) as pool:
-        flows = list(pool.map(one, missing))
-    for key, flow in zip(missing, flows, strict=True):
+        flow = _decompose(generator)
+        # stored at once (the cache evicts as it goes): held until all were done, an
+        # orbit's new decompositions would sit beside a full cache, up to twice its 1 GiB
         if local is None:
             _FLOWS.put((system_key, key), flow, 2 * a.nbytes if flow else 0)
         else:
             local[key] = flow
 
+    with _one_blas_thread(), ThreadPoolExecutor(_WORKERS) as pool:
+        for _ in pool.map(one, missing):  # a worker's exception is raised here
+            pass
 
-def _one_blas_thread() -> contextlib.AbstractContextManager[object]:
-    """BLAS held to one thread (threadpoolctl, if installed; else nothing changes)."""
+
+#: Callers inside :func:`_one_blas_thread` now, and the limiter that set BLAS to one thread
+#: for them (threadpoolctl's limits are process-wide: one per process, not per caller).
+_BLAS_LOCK = threading.Lock()
+_BLAS_USERS = [0]
+_BLAS_LIMITER: list[object] = []
+
+
+@contextlib.contextmanager
+def _one_blas_thread() -> Iterator[None]:
+    """BLAS held to one thread (threadpoolctl, if installed; else nothing changes).
+
+    The limit is process-wide, so it is set by the first caller in and restored by the
+    last one out: two orbits' passes run side by side (two threads of a caller) would
+    otherwise restore each other's limits in the wrong order and leave the process on
+    one BLAS thread for good."""
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-        return contextlib.nullcontext()
-    limits: contextlib.AbstractContextManager[object] = threadpool_limits(limits=1, user_api="blas")
-    return limits
+        yield
+        return
+    with _BLAS_LOCK:
+        if _BLAS_USERS[0] == 0:
+            _BLAS_LIMITER.append(threadpool_limits(limits=1, user_api="blas"))
+        _BLAS_USERS[0] += 1
+    try:
+        yield
+    finally:
+        with _BLAS_LOCK:
+            _BLAS_USERS[0] -= 1
+            if _BLAS_USERS[0] == 0:
+                _BLAS_LIMITER.pop().restore_original_limits()  # type: ignore[attr-defined]
 
 
 #: A pattern none of whose stretches in an orbit exceeds this many units of the scaled
@@ -645,6 +670,12 @@ def leading_block(
 _TAIL = 1e-7
 _GAP = 0.5
 
+#: :func:`_invariant_part` leaves out only Ritz values of modulus at most this: far inside
+#: the unit circle, so no test on the multipliers (the verdict, a multiplier through -1, a
+#: complex pair through the circle; :func:`clearjoint.harmonic.response.curve_events`)
+#: can turn on one of the directions left out, whose Ritz values are not converged.
+_DROPPED = 0.5
+
 
 def _narrowed(q: FloatArray, b: FloatArray, ritz: NDArray[np.complex128]) -> FloatArray:
     """The next point's start from an invariant block q (2N, k), B = Q^T Phi Q and its
@@ -702,8 +733,16 @@ def _invariant_part(q: FloatArray, z: FloatArray, b: FloatArray) -> NDArray[np.c
     values' moduli have a gap (the (p + 1)-th at most ``_GAP`` times the p-th, so no
     complex pair is split), the Schur vectors Z_p of B's leading p Ritz values give Q_p =
     Q Z_p and Phi Q_p = z Z_p (exactly: Phi is linear), and the part is accepted by the
-    same test as the whole block, ||Phi Q_p - Q_p T_p|| <= ``_INVARIANT`` ||Phi Q_p||.
+    same test as the whole block, ||Phi Q_p - Q_p T_p|| <= ``_INVARIANT`` ||Phi Q_p||,
+    and only where every Ritz value left out has modulus at most ``_DROPPED``.
     Returns its p Ritz values (largest modulus first), or None.
+
+    What the test proves: the p values are eigenvalues of a matrix within ``_INVARIANT``
+    (relative) of Phi. That no multiplier of Phi outside the part exceeds them is not
+    proved by it, for the part as for a whole block: it rests, as there, on the block
+    having passed through Phi from a start spanning the leading directions (subspace
+    iteration; the previous point's block along a curve). ``_DROPPED`` keeps the Ritz
+    values left out far from the unit circle, so no verdict or event turns on them.
 
     Why: a warm start whose last columns split a complex pair of the new orbit's
     multipliers (or sit where they are close together) is never invariant as a whole,
@@ -713,6 +752,8 @@ def _invariant_part(q: FloatArray, z: FloatArray, b: FloatArray) -> NDArray[np.c
     ritz = ritz[np.argsort(-np.abs(ritz), kind="stable")]
     moduli = np.abs(ritz)
     for p in range(k - 1, 0, -1):
+        if not moduli[p] <= _DROPPED:  # and so for every smaller p: none left out near 1
+            return None
         if not moduli[p] <= _GAP * moduli[p - 1]:
             continue
         threshold = 0.5 * (moduli[p] + moduli[p - 1])
