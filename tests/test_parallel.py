@@ -351,3 +351,24 @@ def _warn_into(errors: list[BaseException]) -> None:
         warnings.warn("shown", UserWarning, stacklevel=1)
     except BaseException as exc:  # RecursionError when showwarning calls itself
         errors.append(exc)
+
+
+def test_only_distributeds_sync_cancel_noise_is_dropped_from_tornados_log() -> None:
+    """After a Ctrl-C inside distributed's ``sync``, tornado logs that function's cancel
+    callback failing (a NameError of distributed's); that record is dropped, no other."""
+    import logging
+
+    from clearjoint import parallel
+
+    parallel._drop_sync_cancel_noise()
+    parallel._drop_sync_cancel_noise()  # once only
+    logger = logging.getLogger("tornado.application")
+    filters = [f for f in logger.filters if isinstance(f, parallel._SyncCancelNoise)]
+    assert len(filters) == 1
+
+    def record(message: str) -> logging.LogRecord:
+        return logging.LogRecord("tornado.application", logging.ERROR, "x", 1, message, (), None)
+
+    noise = "Exception in callback functools.partial(<function sync.<locals>.cancel at 0x7f>)"
+    assert not filters[0].filter(record(noise))
+    assert filters[0].filter(record("Exception in callback functools.partial(<function f>)"))
