@@ -217,29 +217,18 @@ def argument_kinds(signature: str) -> tuple[str, ...]:
     return tuple(part.strip() for part in parts)
 
 
-def _array(dtype: type, rank: int) -> Callable[[Any], bool]:
+def _array(dtype: type, rank: int, order: str = "C") -> Callable[[Any], bool]:
     def accepts(value: Any) -> bool:
         return (
             type(value) is np.ndarray
             and value.dtype == dtype
             and value.ndim == rank
-            and value.flags.c_contiguous
+            and (value.flags.c_contiguous if order == "C" else value.flags.f_contiguous)
             and value.flags.writeable
             and value.flags.aligned
         )
 
     return accepts
-
-
-def _fortran(value: Any) -> bool:
-    return (
-        type(value) is np.ndarray
-        and value.dtype == np.float64
-        and value.ndim == 2
-        and value.flags.f_contiguous
-        and value.flags.writeable
-        and value.flags.aligned
-    )
 
 
 def _integer(value: Any) -> bool:
@@ -263,7 +252,7 @@ _ACCEPTS: dict[str, Callable[[Any], bool]] = {
     _I1: _array(np.int64, 1),
     _B1: _array(np.int8, 1),
     _B2: _array(np.int8, 2),
-    _F2: _fortran,
+    _F2: _array(np.float64, 2, order="F"),
     "i8": _integer,
     "f8": _real,
     "b1": _boolean,

@@ -141,7 +141,7 @@ def periods_left(
             break
         dx = np.abs(strobe[lag:, kn.S_X] - strobe[:-lag, kn.S_X]) / x_scale
         dv = np.abs(strobe[lag:, kn.S_V] - strobe[:-lag, kn.S_V]) / v_scale
-        distance = np.maximum(dx, dv)[distance_start(strobe.shape[0] - lag) :]
+        distance = np.maximum(dx, dv)[(strobe.shape[0] - lag) // 2 :]  # the latter half
         if not np.all(distance > 0.0) or not np.all(np.isfinite(distance)):
             continue
         periods = np.arange(distance.size, dtype=np.float64)
@@ -155,11 +155,6 @@ def periods_left(
         if best is None or level < best[0]:
             best = (level, left)
     return None if best is None else best[1]
-
-
-def distance_start(size: int) -> int:
-    """Where the fit of :func:`periods_left` starts: the latter half of what is known."""
-    return size // 2
 
 
 def _smallest_multiple(
