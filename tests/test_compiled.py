@@ -110,29 +110,29 @@ def test_the_compiled_kernels_give_the_jit_kernels_results_to_the_bit(
             assert np.asarray(a).tobytes() == np.asarray(b).tobytes()
 
 
+def _small_mast_motion() -> xr.Dataset:
+    """Two forcing periods of a 3-bay mast near its first closed mode: over 40 events."""
+    from clearjoint import ClearanceJoint
+    from clearjoint.structure import mast, time_response
+
+    s = mast(3, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), rayleigh=(0.5, 2e-6))
+    force = np.zeros(s.n_dof)
+    force[-2] = 20.0
+    omega = 0.9 * float(s.modes("closed").omega[0])
+    motion = time_response(s, force, omega, 4.0 * math.pi / omega, samples_per_period=32)
+    assert motion.events > 40
+    return motion.to_xarray()
+
+
 def test_a_structures_exact_motion_is_the_jit_kernels_to_the_bit(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """The event-driven march of a small mast (structure/motion.py: march, the state
     tables, the contact states, the pattern history): the same motion to the bit."""
     _require_module()
-    from clearjoint import ClearanceJoint
-    from clearjoint.structure import mast, time_response
-
-    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
-
-    def run() -> xr.Dataset:
-        s = mast(3, joints=hinge, rayleigh=(0.5, 2e-6))
-        force = np.zeros(s.n_dof)
-        force[-2] = 20.0
-        omega = 0.9 * float(s.modes("closed").omega[0])
-        motion = time_response(s, force, omega, 4.0 * math.pi / omega, samples_per_period=32)
-        assert motion.events > 40
-        return motion.to_xarray()
-
-    ours = run()
+    ours = _small_mast_motion()
     _jit_only(monkeypatch)
-    theirs = run()
+    theirs = _small_mast_motion()
     assert ours.sizes == theirs.sizes
     assert _same_bits(ours, theirs) == []
 
@@ -170,6 +170,9 @@ def test_arguments_the_export_cannot_take_go_to_the_jit_kernel(samples: np.ndarr
         ("f8[::1]", [0.0, 0.0], False),
         ("f8[:, ::1]", np.zeros((2, 3)), True),
         ("f8[:, ::1]", np.zeros((2, 3), order="F"), False),
+        ("f8[::1, :]", np.zeros((2, 3), order="F"), True),
+        ("f8[::1, :]", np.zeros((2, 3)), False),
+        ("f8[::1, :]", np.zeros((2, 3), dtype=np.float32, order="F"), False),
         ("i1[::1]", np.zeros(3, dtype=np.int8), True),
         ("i1[::1]", np.zeros(3, dtype=np.int64), False),
         ("i8[::1]", np.zeros(3, dtype=np.int64), True),
@@ -368,18 +371,9 @@ def test_a_structures_motion_reaches_the_compiled_kernels(monkeypatch: pytest.Mo
     kernels (an argument the checks refuse): the structure's march, state tables, contact
     states and pattern history must each reach the module."""
     _require_module()
-    from clearjoint import ClearanceJoint
-    from clearjoint.structure import mast, time_response
-
     counting = _Counting(compiled.load())
     monkeypatch.setattr(compiled, "_loaded", counting)
     monkeypatch.setattr(compiled, "_preferred", {})
-    hinge = ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5)
-    s = mast(3, joints=hinge, rayleigh=(0.5, 2e-6))
-    force = np.zeros(s.n_dof)
-    force[-2] = 20.0
-    omega = 0.9 * float(s.modes("closed").omega[0])
-    motion = time_response(s, force, omega, 4.0 * math.pi / omega, samples_per_period=32)
-    assert motion.events > 40
+    _small_mast_motion()
     for name in ("march", "state_tables", "contact_states", "pattern_history"):
         assert counting.calls.get(name, 0) >= 1, (name, counting.calls)
