@@ -35,8 +35,9 @@ LU calls go to the table's "modes"). ``--plot FILE.png`` draws the cost per poin
 the unknowns (log-log) with the fitted exponent. ``--pyharm PYTHON`` runs pyHarm's SDOF comparison
 (``bench_harmonic.py --pyharm PYTHON``, in its own interpreter) after the sizes.
 
-BLAS runs on one thread (the machine's 2 cores are shared); every timing is on a loaded
-machine: the 1-minute load average is printed beside it.
+BLAS runs on one thread unless ``OPENBLAS_NUM_THREADS`` says otherwise (the JSON's
+"machine" says which); every timing is on a shared machine: the 1-minute load average is
+printed beside it.
 """
 
 from __future__ import annotations
@@ -345,6 +346,16 @@ TABLE_KEYS = (
 )
 
 
+def blas_threads() -> str:
+    """What BLAS ran on: its threads as threadpoolctl reads them, and the environment's
+    setting (``OPENBLAS_NUM_THREADS``, one unless the caller set it)."""
+    from threadpoolctl import threadpool_info
+
+    counts = sorted({int(p["num_threads"]) for p in threadpool_info() if p["user_api"] == "blas"})
+    setting = os.environ.get("OPENBLAS_NUM_THREADS")
+    return f"BLAS on {'/'.join(map(str, counts)) or '?'} thread(s) (OPENBLAS_NUM_THREADS={setting})"
+
+
 def write_json(
     path: str,
     rows: list[dict[str, Any]],
@@ -374,7 +385,7 @@ def write_json(
         "date": started,
         "source": str(Path(_response.__file__).parents[2]),
         "harmonics": H,
-        "machine": f"{os.cpu_count()} cores shared with other sessions; BLAS on one thread",
+        "machine": f"{os.cpu_count()} cores shared with other sessions; {blas_threads()}",
         "sizes": table,
         "no_curve": failed,
         "fit": {
