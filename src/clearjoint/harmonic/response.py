@@ -781,6 +781,14 @@ def _turning_points(lam: FloatArray, tolerance: float) -> list[int]:
 #: A multiplier counts as one of a complex pair when abs(Im mu) exceeds this fraction of abs(mu).
 COMPLEX_PAIR = 1e-3
 
+#: Complex multipliers of modulus at most this are not counted when a Neimark-Sacker
+#: crossing is told from a pair meeting the real axis: far inside the unit circle they take
+#: no part in a crossing, and a route that returns only the leading multipliers (the
+#: monodromy's leading block: 0 outside a block whose size changes from point to point;
+#: it never leaves out one above 0.5, ``monodromy._DROPPED``) returns them at some points
+#: and not at others.
+PAIR_COUNTED = 0.5
+
 
 def _complex_pair_test(multipliers: NDArray[np.complex128]) -> FloatArray:
     """Largest abs(mu) - 1 over each point's complex multipliers (NaN where it has none):
@@ -839,7 +847,7 @@ def curve_events(
         tests.append(("grazing", d_max[:, j] - model.g_c[j], f"touches the compression edge{name}"))
         tests.append(("grazing", -model.g_t[j] - d_min[:, j], f"touches the tension edge{name}"))
     mag = np.abs(multipliers)
-    pairs = np.sum(np.abs(multipliers.imag) > COMPLEX_PAIR * mag, axis=1)
+    pairs = np.sum((np.abs(multipliers.imag) > COMPLEX_PAIR * mag) & (mag > PAIR_COUNTED), axis=1)
     for kind, g, note in tests:
         for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
             if kind == "neimark_sacker" and pairs[i] != pairs[i + 1]:
