@@ -78,8 +78,9 @@ START_STALL = 10
 #: to ``TOLERANCE`` (:func:`_newton_at`). Each path point then takes one or two corrector
 #: iterations instead of four, the steps grow, and the 40-bay mast's homotopy takes 32
 #: points instead of 102 (issue 25: its start from 7.7 s to 2.4 s, by
-#: ``benchmarks/bench_scale.py --bays 40:30``). If the polish fails, the path is followed
-#: again at ``TOLERANCE``, as before.
+#: ``benchmarks/bench_scale.py --bays 40:30``). If the polish fails, or the path does not
+#: reach the full force (its larger steps can lose a path the tight one follows), the
+#: path is followed again at ``TOLERANCE``, as before.
 START_TOLERANCE = 1e-7
 
 
