@@ -11,7 +11,7 @@ import pytest
 from clearjoint import ClearanceJoint
 from clearjoint.harmonic import HarmonicError, aft, frequency_response, response
 from clearjoint.harmonic.system import LinearSystem, from_structure
-from clearjoint.structure import Structure, mast
+from clearjoint.structure import Structure, chain, mast
 
 FORCE = np.array([0.0, 0.0, 40.0])
 #: At 800 rad/s Newton from the linear responses misses this chain's orbit; the start's
@@ -138,3 +138,33 @@ def test_an_end_that_does_not_polish_is_followed_again_at_the_tolerance(
     assert tolerances == [response.START_TOLERANCE, response.TOLERANCE]
     assert any("following it again" in r.getMessage() for r in caplog.records)
     assert _residual(model, basis, q, OMEGA, FORCE) <= 1e-9 * float(np.max(np.abs(q)))
+
+
+def test_a_loose_path_that_does_not_reach_the_force_is_followed_again_at_the_tolerance(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    # examples/chain.toml's chain at 5 N and 42.5 Hz: the force path followed to
+    # START_TOLERANCE runs out of points (its larger steps lose the path near a grazing),
+    # the path followed to TOLERANCE (the start before issue 25's fifth round) reaches the
+    # full force in about 400 points: the start must still find that orbit
+    joint = ClearanceJoint(clearance=0.2e-3, compression_stiffness=4e5, gap_stiffness=2e4)
+    structure = chain([0.5] * 5, [np.inf] * 5, [joint] * 5, dampers=[2.0] * 5)
+    force = np.array([0.0, 0.0, 0.0, 0.0, 5.0])
+    omega = 2.0 * np.pi * 42.5
+    runs: list[tuple[float, str]] = []
+    real = response.continue_branch
+
+    def recorded(*args, **kwargs):
+        branch = real(*args, **kwargs)
+        runs.append((kwargs["settings"].tolerance, branch.reason))
+        return branch
+
+    monkeypatch.setattr(response, "continue_branch", recorded)
+    with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
+        q, model, basis = _start_of(structure, force, omega)
+    assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE, response.TOLERANCE]
+    assert runs[0][1] != "reached", runs
+    assert runs[1][1] == "reached", runs
+    assert any("did not reach the full force" in r.getMessage() for r in caplog.records)
+    # an HB orbit at the full force by a residual evaluated here
+    assert _residual(model, basis, q, omega, force) <= 1e-9 * float(np.max(np.abs(q)))
