@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from clearjoint import ClearanceJoint
-from clearjoint.harmonic import HarmonicError, aft, frequency_response, response
+from clearjoint.harmonic import HarmonicError, aft, frequency_response, response, solve
 from clearjoint.harmonic.system import LinearSystem, from_structure
 from clearjoint.structure import Structure, chain, mast
 
@@ -85,23 +85,17 @@ def _residual(
     return float(np.max(np.abs(ev.residual))) / model.reference_stiffness
 
 
-@pytest.mark.parametrize("case", ["chain", "20-bay mast"])
 def test_the_loose_force_path_ends_on_the_tight_paths_orbit(
-    three_links: Structure, case: str, monkeypatch: pytest.MonkeyPatch
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    # the homotopy follows its path to START_TOLERANCE and Newton polishes the end at the
-    # full force: the orbit must be the one the path followed to TOLERANCE (as before)
-    # ends on, to that tolerance, and it must be a converged HB orbit by a residual
-    # evaluated here, not by the solver's own report
-    if case == "chain":
-        structure, force, omega = three_links, FORCE, OMEGA
-    else:
-        structure = mast(
-            20, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), rayleigh=(0.0, 2e-6)
-        )
-        force = np.zeros(structure.n_dof)
-        force[list(structure.dof_names).index("n41x")] = 0.1
-        omega = 0.8 * float(structure.modes("open").omega[0])
+    # the 20-bay mast (sparse route): the homotopy follows its path to START_TOLERANCE
+    # and Newton polishes the end at the full force: the orbit must be the one the path
+    # followed to TOLERANCE (as before) ends on, to that tolerance, and it must be a
+    # converged HB orbit by a residual evaluated here, not by the solver's own report
+    structure = mast(20, joints=ClearanceJoint(50e-6, 5e7, gap_stiffness=1e5), rayleigh=(0.0, 2e-6))
+    force = np.zeros(structure.n_dof)
+    force[list(structure.dof_names).index("n41x")] = 0.1
+    omega = 0.8 * float(structure.modes("open").omega[0])
     tolerances: list[float] = []
     real = response.continue_branch
 
@@ -133,6 +127,7 @@ def test_an_end_that_does_not_polish_is_followed_again_at_the_tolerance(
 
     monkeypatch.setattr(response, "continue_branch", recorded)
     monkeypatch.setattr(response, "_newton_at", lambda *args, **kwargs: None)
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
     with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
         q, model, basis = _start_of(three_links, FORCE, OMEGA)
     assert tolerances == [response.START_TOLERANCE, response.TOLERANCE]
@@ -160,6 +155,8 @@ def test_a_loose_path_that_does_not_reach_the_force_is_followed_again_at_the_tol
         return branch
 
     monkeypatch.setattr(response, "continue_branch", recorded)
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    monkeypatch.setattr(response, "START_POINTS", (600, 600))  # the tight path: ~400
     with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
         q, model, basis = _start_of(structure, force, omega)
     assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE, response.TOLERANCE]
@@ -167,4 +164,53 @@ def test_a_loose_path_that_does_not_reach_the_force_is_followed_again_at_the_tol
     assert runs[1][1] == "reached", runs
     assert any("did not reach the full force" in r.getMessage() for r in caplog.records)
     # an HB orbit at the full force by a residual evaluated here
+    assert _residual(model, basis, q, omega, force) <= 1e-9 * float(np.max(np.abs(q)))
+
+
+def test_a_small_structure_follows_the_tight_path_alone(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Below solve.SPARSE_ABOVE unknowns the start's homotopy is as before issue 25's fifth
+    round: one path, to the curve's tolerance (small paths are cheap and fold often)."""
+    tolerances: list[float] = []
+    real = response.continue_branch
+
+    def recorded(*args, **kwargs):
+        tolerances.append(kwargs["settings"].tolerance)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(response, "continue_branch", recorded)
+    _start_of(three_links, FORCE, OMEGA)
+    assert tolerances == [response.TOLERANCE]
+
+
+def test_a_loose_path_that_turns_back_is_followed_again_at_the_tolerance(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    # examples/chain.toml's chain at 10 N and 50 Hz (on the sparse route): the path folds
+    # in the force several times; followed to START_TOLERANCE it ended, polished, on an HB
+    # orbit 32 % from the one the path followed to TOLERANCE ends on (review of issue 25).
+    # A path that turns back is followed again at TOLERANCE: the start is that path's end
+    joint = ClearanceJoint(clearance=0.2e-3, compression_stiffness=4e5, gap_stiffness=2e4)
+    structure = chain([0.5] * 5, [np.inf] * 5, [joint] * 5, dampers=[2.0] * 5)
+    force = np.array([0.0, 0.0, 0.0, 0.0, 10.0])
+    omega = 2.0 * np.pi * 50.0
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    runs: list[tuple[float, np.ndarray]] = []
+    real = response.continue_branch
+
+    def recorded(*args, **kwargs):
+        branch = real(*args, **kwargs)
+        runs.append((kwargs["settings"].tolerance, np.asarray(branch.lam)))
+        return branch
+
+    monkeypatch.setattr(response, "continue_branch", recorded)
+    with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
+        q, model, basis = _start_of(structure, force, omega)
+    assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE, response.TOLERANCE]
+    assert np.any(np.diff(runs[0][1]) < 0.0)  # the loose path turned back
+    assert any("turned back in the force" in r.getMessage() for r in caplog.records)
+    monkeypatch.setattr(response, "START_TOLERANCE", response.TOLERANCE)
+    tight, *_ = _start_of(structure, force, omega)
+    np.testing.assert_array_equal(q, tight)
     assert _residual(model, basis, q, omega, force) <= 1e-9 * float(np.max(np.abs(q)))
