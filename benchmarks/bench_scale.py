@@ -259,6 +259,49 @@ def compare(rows: list[dict[str, Any]], path: str) -> None:
             f"orbits differ by {diff:.2e} of the largest coefficient, omega by {dw:.2e} rad/s, "
             f"{verdicts} verdicts differ; {first}"
         )
+        if apart.size:
+            on, gap, nearest = on_old_curve(b, a_old, row, apart)
+            other = int(np.sum(old[f"stable_{b}"][nearest] != row["stable"][apart]))
+            print(
+                f"          the {apart.size} points beyond 1e-8: the nearest old orbit is "
+                f"{np.median(gap):.1e} (median), {np.max(gap):.1e} (largest) of the largest "
+                f"coefficient away, and for {on} of them it solves HB at the new point's "
+                f"frequency to the curve's tolerance, as the new orbit does (the two are one "
+                f"solution to that tolerance); {other} verdicts differ from the nearest old "
+                f"orbit's"
+            )
+
+
+def on_old_curve(
+    bays: int, old: np.ndarray, row: dict[str, Any], points: np.ndarray
+) -> tuple[int, np.ndarray, np.ndarray]:
+    """For each of the new curve's ``points``: its distance to the nearest old orbit
+    (relative to the largest coefficient), and whether that old orbit solves harmonic
+    balance at the new point's frequency to the curve's tolerance (``solve.TOLERANCE``
+    times Newton's scale, as ``response._newton_at`` accepts an orbit): the count of those,
+    the distances, and the nearest old points' indices."""
+    from clearjoint.harmonic import aft, response, solve
+
+    structure = model(bays)
+    system = _system(structure)
+    basis = aft.Basis.make(*aft.check_harmonics(H, None))
+    force = tip_force(structure, bays, 0.1)
+    k_ref = system.reference_stiffness
+    scale = 0.5 * response.scale_length(system)
+    peak = float(np.max(np.abs(old)))
+    flat_old = old.reshape(old.shape[0], -1)
+    on, gaps, index = 0, [], []
+    for i in points:
+        new = np.asarray(row["coefficients"][i]).reshape(-1)
+        distance = np.max(np.abs(flat_old - new), axis=1)
+        gaps.append(float(np.min(distance)) / peak)
+        index.append(int(np.argmin(distance)))
+        nearest = flat_old[index[-1]]
+        ev = aft.evaluate(system, basis, nearest, float(row["omega"][i]), force, jacobian=False)
+        size = float(np.max(np.abs(ev.residual))) / k_ref
+        if size <= solve.TOLERANCE * max(scale, float(np.max(np.abs(nearest)))):
+            on += 1
+    return on, np.asarray(gaps), np.asarray(index)
 
 
 def modes(bays: int) -> dict[str, Any]:
