@@ -35,8 +35,9 @@ LU calls go to the table's "modes"). ``--plot FILE.png`` draws the cost per poin
 the unknowns (log-log) with the fitted exponent. ``--pyharm PYTHON`` runs pyHarm's SDOF comparison
 (``bench_harmonic.py --pyharm PYTHON``, in its own interpreter) after the sizes.
 
-BLAS runs on one thread (the machine's 2 cores are shared); every timing is on a loaded
-machine: the 1-minute load average is printed beside it.
+BLAS runs on one thread unless ``OPENBLAS_NUM_THREADS`` says otherwise (the JSON's
+"machine" says which); every timing is on a shared machine: the 1-minute load average is
+printed beside it.
 """
 
 from __future__ import annotations
@@ -258,6 +259,49 @@ def compare(rows: list[dict[str, Any]], path: str) -> None:
             f"orbits differ by {diff:.2e} of the largest coefficient, omega by {dw:.2e} rad/s, "
             f"{verdicts} verdicts differ; {first}"
         )
+        if apart.size:
+            on, gap, nearest = on_old_curve(b, a_old, row, apart)
+            other = int(np.sum(old[f"stable_{b}"][nearest] != row["stable"][apart]))
+            print(
+                f"          the {apart.size} points beyond 1e-8: the nearest old orbit is "
+                f"{np.median(gap):.1e} (median), {np.max(gap):.1e} (largest) of the largest "
+                f"coefficient away, and for {on} of them it solves HB at the new point's "
+                f"frequency to the curve's tolerance, as the new orbit does (the two are one "
+                f"solution to that tolerance); {other} verdicts differ from the nearest old "
+                f"orbit's"
+            )
+
+
+def on_old_curve(
+    bays: int, old: np.ndarray, row: dict[str, Any], points: np.ndarray
+) -> tuple[int, np.ndarray, np.ndarray]:
+    """For each of the new curve's ``points``: its distance to the nearest old orbit
+    (relative to the largest coefficient), and whether that old orbit solves harmonic
+    balance at the new point's frequency to the curve's tolerance (``solve.TOLERANCE``
+    times Newton's scale, as ``response._newton_at`` accepts an orbit): the count of those,
+    the distances, and the nearest old points' indices."""
+    from clearjoint.harmonic import aft, response, solve
+
+    structure = model(bays)
+    system = _system(structure)
+    basis = aft.Basis.make(*aft.check_harmonics(H, None))
+    force = tip_force(structure, bays, 0.1)
+    k_ref = system.reference_stiffness
+    scale = 0.5 * response.scale_length(system)
+    peak = float(np.max(np.abs(old)))
+    flat_old = old.reshape(old.shape[0], -1)
+    on, gaps, index = 0, [], []
+    for i in points:
+        new = np.asarray(row["coefficients"][i]).reshape(-1)
+        distance = np.max(np.abs(flat_old - new), axis=1)
+        gaps.append(float(np.min(distance)) / peak)
+        index.append(int(np.argmin(distance)))
+        nearest = flat_old[index[-1]]
+        ev = aft.evaluate(system, basis, nearest, float(row["omega"][i]), force, jacobian=False)
+        size = float(np.max(np.abs(ev.residual))) / k_ref
+        if size <= solve.TOLERANCE * max(scale, float(np.max(np.abs(nearest)))):
+            on += 1
+    return on, np.asarray(gaps), np.asarray(index)
 
 
 def modes(bays: int) -> dict[str, Any]:
@@ -345,6 +389,16 @@ TABLE_KEYS = (
 )
 
 
+def blas_threads() -> str:
+    """What BLAS ran on: its threads as threadpoolctl reads them, and the environment's
+    setting (``OPENBLAS_NUM_THREADS``, one unless the caller set it)."""
+    from threadpoolctl import threadpool_info
+
+    counts = sorted({int(p["num_threads"]) for p in threadpool_info() if p["user_api"] == "blas"})
+    setting = os.environ.get("OPENBLAS_NUM_THREADS")
+    return f"BLAS on {'/'.join(map(str, counts)) or '?'} thread(s) (OPENBLAS_NUM_THREADS={setting})"
+
+
 def write_json(
     path: str,
     rows: list[dict[str, Any]],
@@ -374,7 +428,7 @@ def write_json(
         "date": started,
         "source": str(Path(_response.__file__).parents[2]),
         "harmonics": H,
-        "machine": f"{os.cpu_count()} cores shared with other sessions; BLAS on one thread",
+        "machine": f"{os.cpu_count()} cores shared with other sessions; {blas_threads()}",
         "sizes": table,
         "no_curve": failed,
         "fit": {

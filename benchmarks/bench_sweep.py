@@ -257,8 +257,10 @@ def _worker_threads_env() -> dict[str, str | None]:
     return {k: os.environ.get(k) for k in keys}
 
 
-def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
-    """Issue 27's targets side by side in one run: client overhead, 2 workers, 200 threads.
+def store_targets(scale: float = 1.0, rounds: int = 3, parts: tuple[int, ...] = (1, 2, 3)) -> None:
+    """Issue 27's targets side by side in one run: client overhead, 2 workers, 200 threads
+    (``parts``: which of the three, e.g. ``(3,)`` for the 200 threads alone, on a machine
+    the first two parts' clusters have not just left).
 
     A *task* here is what the issue counts: one chunk of the sweep (``chunk_size`` points;
     at ``chunk_size = 1``, one point). The client groups short chunks into fewer Dask tasks
@@ -266,13 +268,25 @@ def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
     of ``rounds`` runs, the configurations alternating within a round, so that a change
     of the machine's load falls on all of them alike.
     """
+
+    print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (shared)")
+    print(f"each figure: the median of {rounds} rounds")
+    if 1 in parts:
+        _overhead(scale, rounds)
+    if 2 in parts:
+        _two_workers(scale, rounds)
+    if 3 in parts:
+        _many_threads(scale, rounds)
+    print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+
+
+def _overhead(scale: float, rounds: int) -> None:
+    """Part 1: the client's overhead a task, examples/tolerance.toml at chunk_size = 1."""
     from dataclasses import replace
 
     from clearjoint.parallel import auto_group
     from clearjoint.sweep.run import _Chunk, _column_names, _evaluate_chunk, _point_values
 
-    print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (shared)")
-    print(f"each figure: the median of {rounds} rounds")
     # 1. overhead a task: examples/tolerance.toml at chunk_size = 1 against a plain loop
     sweep = replace(Sweep.from_toml(EXAMPLES / "tolerance.toml"), chunk_size=1)
     if scale < 1:
@@ -329,6 +343,10 @@ def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
             f"   {workers} worker(s), Dask alone ({n} no-op Dask tasks, map + gather): "
             f"{_median(bare[workers]) / n * 1e3:.2f} ms a Dask task"
         )
+
+
+def _two_workers(scale: float, rounds: int) -> None:
+    """Part 2: a CPU-bound study on 2 workers against 1, with a process pool as control."""
     # 2. a CPU-bound study, chunks of 0.5 s: 2 workers against 1, with a control
     spin = spin_sweep(max(40, int(200 * scale)), 0.050, 10)
     times: dict[str, list[float]] = {"1 worker": [], "2 workers": [], "pool 1": [], "pool 2": []}
@@ -363,6 +381,12 @@ def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
         f"median {_median(control):.2f}x (rounds: {', '.join(f'{r:.2f}' for r in control)}); "
         f"load average after each round: {', '.join(f'{x:.1f}' for x in loads)}"
     )
+
+
+def _many_threads(scale: float, rounds: int) -> None:
+    """Part 3: a simulated cluster of 200 threads (see the comment below)."""
+    from dataclasses import replace
+
     # 3. a simulated cluster of 200 threads on 50 ms sleeps, chunk_size = 1; three times: a
     # LocalCluster as Dask starts it; the same with its workers' statistical profiler off
     # (it walks every thread's stack each 10 ms: here 100 threads share a worker process
@@ -371,6 +395,8 @@ def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
     # LocalCluster's scheduler runs on the client's own IO-loop thread
     import dask
     import distributed  # noqa: F401  (its config defaults in place before it is set)
+
+    from clearjoint.parallel import auto_group
 
     sleeps = replace(spin_sweep(int(10_000 * scale), 0.050, 1), task=SLEEP)
     m = sleeps.n_points
@@ -404,7 +430,6 @@ def store_targets(scale: float = 1.0, rounds: int = 3) -> None:
             f"a task), without it {m / _median(plain):.0f} tasks/s; target >= 2,000/s "
             f"(4,000/s: 200 threads never idle)"
         )
-    print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
 
 RESTART_SWEEP = """
@@ -481,9 +506,17 @@ if __name__ == "__main__":  # LocalCluster workers are spawned processes: keep t
     parser.add_argument(
         "--rounds", type=int, default=3, help="--store-targets: rounds per figure (median kept)"
     )
+    parser.add_argument(
+        "--parts",
+        default="1,2,3",
+        help="--store-targets: which targets, e.g. 3 for the 200 threads alone (1,2,3)",
+    )
     options = parser.parse_args()
     if options.store_targets:
-        store_targets(0.05 if options.smoke else 1.0, 1 if options.smoke else options.rounds)
+        parts = tuple(int(x) for x in options.parts.split(","))
+        if not parts or not set(parts) <= {1, 2, 3}:
+            parser.error(f"--parts takes 1, 2 and 3, comma-separated; got {options.parts!r}")
+        store_targets(0.05 if options.smoke else 1.0, 1 if options.smoke else options.rounds, parts)
         raise SystemExit(0)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     sizes = [(cost, points // 20, chunk // 10) for cost, points, chunk in CASES]

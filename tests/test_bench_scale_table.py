@@ -81,3 +81,21 @@ def test_write_json_round_trips_a_row(tmp_path: Path) -> None:
     assert table["fit"]["bays"] == [10]
     bench.write_json(str(path), [row], [], [row], math.nan, "now")
     assert json.loads(path.read_text())["fit"]["exponent"] is None
+
+
+def test_on_old_curve_tells_the_same_orbits_from_moved_ones() -> None:
+    """bench_scale.on_old_curve: a curve against itself has every point on it (distance 0,
+    each its own nearest); against orbits moved by 1e-3 of the largest coefficient, none
+    solves HB to the curve's tolerance at the new points' frequencies."""
+    bench = _bench()
+    row = bench.run_size(2, 5, False)
+    coef = np.asarray(row["coefficients"])
+    points = np.arange(coef.shape[0])
+    on, gaps, nearest = bench.on_old_curve(2, coef, row, points)
+    assert on == points.size
+    assert np.all(gaps == 0.0)
+    assert np.array_equal(nearest, points)
+    moved = coef + 1e-3 * float(np.max(np.abs(coef)))
+    on, gaps, _ = bench.on_old_curve(2, moved, row, points)
+    assert on == 0
+    assert np.all(gaps > 0.0)

@@ -317,3 +317,29 @@ def test_neimark_sacker_crossings_are_events_and_collisions_are_not() -> None:
         ]
     )
     assert run(collide) == []
+
+
+def test_a_neimark_sacker_crossing_is_found_whatever_the_tiny_multipliers_do() -> None:
+    """The crossing above (a pair 0.9 -> 1.1 between w = 2 and 3), where the point at w = 3
+    also returns a complex pair of modulus 1e-7 that the others return as 0 (the leading
+    block's route returns 0 outside its block, whose size changes from point to point):
+    still one "neimark_sacker" event at w = 2.5. Counting every complex multiplier,
+    however small, skipped it as a pair meeting the real axis."""
+    from clearjoint.harmonic.response import curve_events as _events
+
+    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
+    omega = np.array([1.0, 2.0, 3.0, 4.0])
+    d = np.zeros((4, 2))
+    turn = np.exp(1j * np.array([1.0, -1.0]))
+    mu = np.array(
+        [np.concatenate((r * turn, [0.3, 0.2, 0.0, 0.0])) for r in (0.8, 0.9, 1.1, 1.2)],
+        dtype=np.complex128,
+    )
+    mu[2, 4:] = 1e-7 * np.exp(1j * np.array([2.0, -2.0]))
+    # what the block route may leave out (as 0) is never counted
+    from clearjoint.harmonic import monodromy, response
+
+    assert response.PAIR_COUNTED >= monodromy._DROPPED
+    found = _events(model, omega, mu, d, d, omega, np.ones(4), np.full(4, 1e-6))
+    assert [e.kind for e in found] == ["neimark_sacker"]
+    assert found[0].omega == pytest.approx(2.5)

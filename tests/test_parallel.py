@@ -372,3 +372,22 @@ def test_only_distributeds_sync_cancel_noise_is_dropped_from_tornados_log() -> N
     noise = "Exception in callback functools.partial(<function sync.<locals>.cancel at 0x7f>)"
     assert not filters[0].filter(record(noise))
     assert filters[0].filter(record("Exception in callback functools.partial(<function f>)"))
+
+
+def test_the_default_counts_the_cores_this_process_may_run_on(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A process restricted to one core (a container's cpuset, taskset, a batch job) gets
+    one job by default, not one per core of the machine; where the system has no affinity
+    call, the machine's count."""
+    import os
+
+    from clearjoint import parallel
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 64)
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {3}, raising=False)
+    assert parallel.usable_cores() == 1
+    with parallel.process_pool(None) as pool:
+        assert pool is None  # one job: run in this process
+    monkeypatch.delattr(os, "sched_getaffinity", raising=False)
+    assert parallel.usable_cores() == 64

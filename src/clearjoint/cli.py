@@ -43,6 +43,13 @@ from clearjoint.errors import ClearjointError, ParameterError
 __all__ = ["build_parser", "main"]  # build_parser lives in clearjoint.cli_parser
 
 
+def _cores() -> int:
+    """The cores this process may run on (clearjoint.parallel.usable_cores, imported late)."""
+    from clearjoint.parallel import usable_cores
+
+    return usable_cores()
+
+
 def _plot_target(args: argparse.Namespace) -> Path | None:
     """The --plot file, checked before any work: a figure suffix, not overwritten unasked."""
     return None if args.plot is None else figure_target(args.plot, "--plot", force=args.force)
@@ -158,14 +165,13 @@ def _check_transient(study: Any) -> None:
 
 
 def _run_rig(args: argparse.Namespace) -> int:
-    import os
     import time
 
     from clearjoint.rig import load_campaign, run_campaign
 
     campaign = load_campaign(args.campaign)
     refuse_file_as_folder(args.out, "--out")
-    jobs = args.jobs or os.cpu_count() or 1  # for the progress line only
+    jobs = args.jobs or _cores()  # for the progress line only
     start = time.perf_counter()
     total = len(campaign.tests)
     with cli_progress.shown_progress(args, f"{total} tests on {jobs} processes"):
@@ -186,7 +192,7 @@ def _run_identify(args: argparse.Namespace) -> int:
         raise ParameterError(f"--tolerance must lie in (0, 1), got {args.tolerance}")
     if args.jobs is not None and args.jobs < 1:
         raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
-    jobs = args.jobs or os.cpu_count() or 1  # every core by default, as rig and reproduce
+    jobs = args.jobs or _cores()  # every core by default, as rig and reproduce
     plot = _plot_target(args)  # a figure suffix, not overwritten unless --force
     refuse_to_overwrite([out], force=args.force)
     out.parent.mkdir(parents=True, exist_ok=True)  # fails here, before the work, if it cannot
@@ -281,7 +287,7 @@ def _run_report(args: argparse.Namespace) -> int:
     refuse_file_as_folder(args.out, "--out")
     if args.jobs is not None and args.jobs < 1:
         raise ParameterError(f"--jobs must be at least 1, got {args.jobs}")
-    jobs = args.jobs or os.cpu_count() or 1  # every core by default, as identify
+    jobs = args.jobs or _cores()  # every core by default, as identify
     with cli_progress.shown_progress(args, "identifying the records") as shown:
         written = report_records(
             Path(args.records),

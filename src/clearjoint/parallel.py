@@ -64,6 +64,7 @@ __all__ = [
     "run_batches",
     "run_ordered",
     "run_unordered",
+    "usable_cores",
 ]
 
 A = TypeVar("A")
@@ -439,12 +440,24 @@ def run_ordered(
     return [results[i] for i in range(len(arguments))]
 
 
+def usable_cores() -> int:
+    """The cores this process may run on: its CPU affinity where the system reports one (a
+    container, a batch job or ``taskset`` may leave it fewer than ``os.cpu_count()``, the
+    machine's), else ``os.cpu_count()``. The default number of processes, workers and
+    threads everywhere in clearjoint. A CPU quota without an affinity (cgroup ``cpu.max``)
+    is not seen."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # not on this system (macOS, Windows)
+        return os.cpu_count() or 1
+
+
 @contextlib.contextmanager
 def process_pool(jobs: int | None) -> Iterator[Executor | None]:
     """Yield a process pool of ``jobs`` workers (None: every core), or None for one job."""
     if jobs is not None and jobs < 1:
         raise ParameterError(f"jobs must be >= 1 (--jobs), got {jobs}")
-    workers = jobs or os.cpu_count() or 1
+    workers = jobs or usable_cores()
     if workers == 1:
         yield None
         return
@@ -564,7 +577,7 @@ def dask_client(
         with client:
             yield client
         return
-    n = workers or os.cpu_count() or 1
+    n = workers or usable_cores()
     # the worker processes ignore Ctrl-C (a terminal sends it to the whole process group):
     # this process says it in one line and closes them, with no traceback of theirs
     with _interrupt_ignored_by_children():

@@ -55,7 +55,6 @@ import contextlib
 import hashlib
 import itertools
 import math
-import os
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Iterator
@@ -74,6 +73,7 @@ from clearjoint.exact.patterns import ShortFlow, Stretch, chain
 from clearjoint.exact.patterns import decompose as _decompose
 from clearjoint.harmonic.aft import Basis
 from clearjoint.harmonic.system import HarmonicError, LinearSystem
+from clearjoint.parallel import usable_cores
 
 FloatArray = NDArray[np.float64]
 
@@ -384,7 +384,7 @@ def _product(
 #: LAPACK's eigensolver gains little from more, and on a shared machine OpenBLAS's own
 #: threads slowed one decomposition of the 80-bay mast's 640 x 640 A tenfold, 0.5 s to
 #: 2-9 s, when another process held a core).
-_WORKERS = max(1, min(4, os.cpu_count() or 1))
+_WORKERS = max(1, min(4, usable_cores()))
 
 
 def _decompose_patterns(
