@@ -277,8 +277,10 @@ def on_old_curve(
 ) -> tuple[int, np.ndarray, np.ndarray]:
     """For each of the new curve's ``points``: its distance to the nearest old orbit
     (relative to the largest coefficient), and whether that old orbit solves harmonic
-    balance at the new point's frequency to the curve's tolerance (``solve.TOLERANCE``
-    times Newton's scale, as ``response._newton_at`` accepts an orbit): the count of those,
+    balance at the new point's frequency to the curve's tolerance (max abs(R) / k_ref at
+    most ``solve.TOLERANCE`` times the continuation's ``u_scale``, as
+    ``frequency_response`` accepts a point: max(scale_length / 2, max abs of the curve's
+    start), one scale for the whole curve, not each orbit's own size): the count of those,
     the distances, and the nearest old points' indices."""
     from clearjoint.harmonic import aft, response, solve
 
@@ -287,7 +289,8 @@ def on_old_curve(
     basis = aft.Basis.make(*aft.check_harmonics(H, None))
     force = tip_force(structure, bays, 0.1)
     k_ref = system.reference_stiffness
-    scale = 0.5 * response.scale_length(system)
+    start = np.asarray(row["coefficients"][0]).reshape(-1)
+    scale = max(0.5 * response.scale_length(system), float(np.max(np.abs(start))))
     peak = float(np.max(np.abs(old)))
     flat_old = old.reshape(old.shape[0], -1)
     on, gaps, index = 0, [], []
@@ -299,7 +302,7 @@ def on_old_curve(
         nearest = flat_old[index[-1]]
         ev = aft.evaluate(system, basis, nearest, float(row["omega"][i]), force, jacobian=False)
         size = float(np.max(np.abs(ev.residual))) / k_ref
-        if size <= solve.TOLERANCE * max(scale, float(np.max(np.abs(nearest)))):
+        if size <= solve.TOLERANCE * scale:
             on += 1
     return on, np.asarray(gaps), np.asarray(index)
 

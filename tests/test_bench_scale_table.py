@@ -99,3 +99,39 @@ def test_on_old_curve_tells_the_same_orbits_from_moved_ones() -> None:
     on, gaps, _ = bench.on_old_curve(2, moved, row, points)
     assert on == 0
     assert np.all(gaps > 0.0)
+
+
+def test_on_old_curve_holds_a_point_to_the_curves_own_scale() -> None:
+    """bench_scale.on_old_curve calls an old orbit "on the curve" when it solves HB as the
+    new curve's points must: max abs(R) / k_ref <= TOLERANCE times the continuation's
+    u_scale, max(scale_length / 2, max abs of the curve's start), fixed along the curve
+    (frequency_response). An orbit near the peak, moved so its residual lies between that
+    and TOLERANCE times its own size (a looser scale), is not on the curve."""
+    from clearjoint.harmonic import aft, response, solve
+
+    bench = _bench()
+    row = bench.run_size(2, 60, False)
+    coef = np.asarray(row["coefficients"])
+    sizes = np.max(np.abs(coef.reshape(coef.shape[0], -1)), axis=1)
+    i = int(np.argmax(sizes))
+    structure = bench.model(2)
+    system = bench._system(structure)
+    basis = aft.Basis.make(*aft.check_harmonics(bench.H, None))
+    force = bench.tip_force(structure, 2, 0.1)
+    floor = 0.5 * response.scale_length(system)
+    curve = solve.TOLERANCE * max(floor, float(sizes[0]))
+    own = solve.TOLERANCE * max(floor, float(sizes[i]))
+    assert own > 1.5 * curve  # the peak's orbit is larger than the start's scale
+
+    def size(q: np.ndarray) -> float:
+        ev = aft.evaluate(system, basis, q, float(row["omega"][i]), force, jacobian=False)
+        return float(np.max(np.abs(ev.residual))) / system.reference_stiffness
+
+    direction = np.full(coef[i].shape, 1e-12 * float(sizes[i]))
+    t = np.sqrt(curve * own) / size(coef[i] + direction)  # about linear: R(q) is ~0
+    moved = coef.copy()
+    moved[i] = coef[i] + t * direction
+    assert curve < size(moved[i]) < own  # between the two scales
+    on, _, nearest = bench.on_old_curve(2, moved, row, np.array([i]))
+    assert nearest[0] == i
+    assert on == 0

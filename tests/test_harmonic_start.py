@@ -3,6 +3,7 @@ has a limit, reports progress, and ends in one clear error when it finds no orbi
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import numpy as np
@@ -214,3 +215,35 @@ def test_a_loose_path_that_turns_back_is_followed_again_at_the_tolerance(
     tight, *_ = _start_of(structure, force, omega)
     np.testing.assert_array_equal(q, tight)
     assert _residual(model, basis, q, omega, force) <= 1e-9 * float(np.max(np.abs(q)))
+
+
+def test_an_end_that_does_not_polish_falls_back_even_where_the_path_does_not_turn_back(
+    three_links: Structure, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """The polish's own fallback, apart from the fold's: the 3-link chain's loose path turns
+    back in the force, so in the test above the fold guard fires first and the polish is
+    never reached. Here the loose path's parameter is made monotone (its end unchanged, at
+    the full force), so only a failed polish can send the start to the tight path: the
+    start must then be the tight path's end, as before issue 25's fifth round."""
+    runs: list[float] = []
+    real = response.continue_branch
+
+    def recorded(*args, **kwargs):
+        branch = real(*args, **kwargs)
+        runs.append(kwargs["settings"].tolerance)
+        if kwargs["settings"].tolerance != response.TOLERANCE:
+            branch = dataclasses.replace(branch, lam=np.maximum.accumulate(branch.lam))
+        return branch
+
+    monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
+    monkeypatch.setattr(response, "_newton_at", lambda *args, **kwargs: None)
+    monkeypatch.setattr(response, "continue_branch", recorded)
+    with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
+        q, *_ = _start_of(three_links, FORCE, OMEGA)
+    assert runs == [response.START_TOLERANCE, response.TOLERANCE]
+    messages = [r.getMessage() for r in caplog.records]
+    assert any("did not polish" in m for m in messages), messages
+    assert not any("turned back" in m for m in messages), messages
+    monkeypatch.setattr(response, "START_TOLERANCE", response.TOLERANCE)
+    tight, *_ = _start_of(three_links, FORCE, OMEGA)
+    np.testing.assert_array_equal(q, tight)
