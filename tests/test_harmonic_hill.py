@@ -336,10 +336,40 @@ def test_a_neimark_sacker_crossing_is_found_whatever_the_tiny_multipliers_do() -
         dtype=np.complex128,
     )
     mu[2, 4:] = 1e-7 * np.exp(1j * np.array([2.0, -2.0]))
-    # what the block route may leave out (as 0) is never counted
-    from clearjoint.harmonic import monodromy, response
-
-    assert response.PAIR_COUNTED >= monodromy._DROPPED
     found = _events(model, omega, mu, d, d, omega, np.ones(4), np.full(4, 1e-6))
     assert [e.kind for e in found] == ["neimark_sacker"]
     assert found[0].omega == pytest.approx(2.5)
+
+
+def test_a_second_pair_moving_beside_the_crossing_one_neither_hides_nor_fakes_it() -> None:
+    """Two coincidences the review of issue 25's fifth round built, which any count of
+    complex multipliers above a threshold gets wrong (here 0.5): (1) the pair 0.9 -> 1.1
+    crosses while a second pair goes 0.45 -> 0.55: still one event at w = 2.5; (2) the
+    largest pair meets the real axis outside the circle (1.2 -> reals 1.3 and 0.9) while
+    the second pair goes 0.45 -> 0.55: no event (the largest complex modulus falls from
+    1.2 to 0.55, but no pair crossed the circle)."""
+    from clearjoint.harmonic.response import curve_events as _events
+
+    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
+    omega = np.array([1.0, 2.0, 3.0, 4.0])
+    d = np.zeros((4, 2))
+    turn = np.exp(1j * np.array([1.0, -1.0]))
+    other = np.exp(1j * np.array([2.0, -2.0]))
+    mu = np.array(
+        [
+            np.concatenate((r * turn, s * other, [0.0, 0.0]))
+            for r, s in ((0.8, 0.4), (0.9, 0.45), (1.1, 0.55), (1.2, 0.6))
+        ],
+        dtype=np.complex128,
+    )
+
+    def kinds(m: np.ndarray) -> list[str]:
+        return [e.kind for e in _events(model, omega, m, d, d, omega, np.ones(4), np.full(4, 1e-6))]
+
+    found = _events(model, omega, mu, d, d, omega, np.ones(4), np.full(4, 1e-6))
+    assert [e.kind for e in found] == ["neimark_sacker"]
+    assert found[0].omega == pytest.approx(2.5)
+    collide = mu.copy()
+    collide[:2, :2] = np.array([1.2, 1.1])[:, None] * turn
+    collide[2:, :2] = np.array([[1.3, 0.9], [1.4, 0.8]])
+    assert kinds(collide) == []

@@ -810,19 +810,39 @@ def _turning_points(lam: FloatArray, tolerance: float) -> list[int]:
 #: A multiplier counts as one of a complex pair when abs(Im mu) exceeds this fraction of abs(mu).
 COMPLEX_PAIR = 1e-3
 
-#: Complex multipliers of modulus at most this are not counted when a Neimark-Sacker
-#: crossing is told from a pair meeting the real axis: far inside the unit circle they take
-#: no part in a crossing, and a route that returns only the leading multipliers (the
-#: monodromy's leading block: 0 outside a block whose size changes from point to point;
-#: it never leaves out one above 0.5, ``monodromy._DROPPED``) returns them at some points
-#: and not at others.
-PAIR_COUNTED = 0.5
+
+def _top_complex(multipliers: NDArray[np.complex128]) -> complex | None:
+    """The complex multiplier of largest modulus in the upper half-plane, or None."""
+    mag = np.abs(multipliers)
+    upper = (np.abs(multipliers.imag) > COMPLEX_PAIR * mag) & (multipliers.imag > 0.0)
+    if not np.any(upper):
+        return None
+    found = multipliers[upper]
+    return complex(found[int(np.argmax(np.abs(found)))])
+
+
+def _same_pair(before: NDArray[np.complex128], after: NDArray[np.complex128]) -> bool:
+    """Whether the largest complex pair at ``after`` continues the one at ``before``: each is
+    the other's nearest among its neighbour point's multipliers in the closed upper
+    half-plane (a pair that met the real axis in between has a real multiplier nearer;
+    the largest pair taken over by another has that other nearer). Multipliers returned
+    as 0 (outside a leading block) or far inside the circle take no part, whatever their
+    number at either point."""
+    a, b = _top_complex(before), _top_complex(after)
+    if a is None or b is None:
+        return False
+
+    def nearest(multipliers: NDArray[np.complex128], z: complex) -> complex:
+        upper = multipliers[multipliers.imag >= 0.0]
+        return complex(upper[int(np.argmin(np.abs(upper - z)))])
+
+    return nearest(after, a) == b and nearest(before, b) == a
 
 
 def _complex_pair_test(multipliers: NDArray[np.complex128]) -> FloatArray:
     """Largest abs(mu) - 1 over each point's complex multipliers (NaN where it has none):
-    its sign change between two points with as many complex multipliers is a
-    Neimark-Sacker crossing (a complex pair through the unit circle)."""
+    its sign change between two points whose largest pairs are one pair (:func:`_same_pair`)
+    is a Neimark-Sacker crossing (a complex pair through the unit circle)."""
     mag = np.abs(multipliers)
     pair = np.abs(multipliers.imag) > COMPLEX_PAIR * mag
     top = np.max(np.where(pair, mag, -np.inf), axis=1)
@@ -875,12 +895,10 @@ def curve_events(
         name = "" if model.is_joint else f" of joint {j}"
         tests.append(("grazing", d_max[:, j] - model.g_c[j], f"touches the compression edge{name}"))
         tests.append(("grazing", -model.g_t[j] - d_min[:, j], f"touches the tension edge{name}"))
-    mag = np.abs(multipliers)
-    pairs = np.sum((np.abs(multipliers.imag) > COMPLEX_PAIR * mag) & (mag > PAIR_COUNTED), axis=1)
     for kind, g, note in tests:
         for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
-            if kind == "neimark_sacker" and pairs[i] != pairs[i + 1]:
-                continue  # a pair met the real axis in between: not a crossing of one pair
+            if kind == "neimark_sacker" and not _same_pair(multipliers[i], multipliers[i + 1]):
+                continue  # not one pair through the circle (_same_pair)
             frac = float(g[i] / (g[i] - g[i + 1]))
 
             def lerp(a: FloatArray, i: int = int(i), frac: float = frac) -> float:
