@@ -353,19 +353,11 @@ def _product(
                         taylor[key] = _short_flow(system_key, key, system, inv_m, states[i])
                     return taylor[key]
             if not found:
-                generator = a.copy()  # a copy: leading_block runs passes in threads
-                generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
-                cached = _decompose(generator)
-                if local is None:
-                    _FLOWS.put((system_key, key), cached, 2 * a.nbytes if cached else 0)
-                else:
-                    local[key] = cached
+                cached = _decompose_held(system, system_key, key, states[i], a, inv_m, local)
             if isinstance(cached, _Flow):
                 return cached
         # the plain exponential (the reference and the fallback)
-        generator = a.copy()
-        generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[i])
-        return generator
+        return _generator(system, states[i], a, inv_m)
 
     def apply(start: FloatArray) -> FloatArray:
         return chain(start, widths / omega, keys, flow_of, transition)
@@ -410,23 +402,46 @@ def _decompose_patterns(
         missing = [key for key in wanted if key not in local]
     if len(missing) < 2 or _WORKERS < 2:
         return
-    n = system.n_dof
     inv_m = 1.0 / np.diag(system.mass)
 
     def one(key: bytes) -> None:
-        generator = a.copy()
-        generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, states[first[key]])
-        flow = _decompose(generator)
         # stored at once (the cache evicts as it goes): held until all were done, an
         # orbit's new decompositions would sit beside a full cache, up to twice its 1 GiB
-        if local is None:
-            _FLOWS.put((system_key, key), flow, 2 * a.nbytes if flow else 0)
-        else:
-            local[key] = flow
+        _decompose_held(system, system_key, key, states[first[key]], a, inv_m, local)
 
     with _one_blas_thread(), ThreadPoolExecutor(_WORKERS) as pool:
         for _ in pool.map(one, missing):  # a worker's exception is raised here
             pass
+
+
+def _generator(
+    system: LinearSystem, state: NDArray[np.int64], a: FloatArray, inv_m: FloatArray
+) -> FloatArray:
+    """The pattern's A: a copy of ``a`` (its pattern-free blocks) with -M^-1 K_T below left
+    (a copy: passes and decompositions run in threads)."""
+    n = system.n_dof
+    generator = a.copy()
+    generator[n:, :n] = -inv_m[:, None] * _pattern_stiffness(system, state)
+    return generator
+
+
+def _decompose_held(
+    system: LinearSystem,
+    system_key: bytes,
+    key: bytes,
+    state: NDArray[np.int64],
+    a: FloatArray,
+    inv_m: FloatArray,
+    local: dict[bytes, _Flow | None] | None,
+) -> _Flow | None:
+    """Decompose the pattern's A and hold the result at once: in the cache, or in
+    ``local`` for an orbit too big for it (None: keep ``scipy.linalg.expm``)."""
+    flow = _decompose(_generator(system, state, a, inv_m))
+    if local is None:
+        _FLOWS.put((system_key, key), flow, 2 * a.nbytes if flow else 0)
+    else:
+        local[key] = flow
+    return flow
 
 
 #: Callers inside :func:`_one_blas_thread` now, and the limiter that set BLAS to one thread
