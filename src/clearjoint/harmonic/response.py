@@ -521,12 +521,11 @@ def _start_plain(
             jac = ev.jacobian if sparse is None else sparse(ev, omega, model.damping)
             return ev.residual / k_ref, jac / k_ref, d_lam / k_ref, None
 
-        # the path to START_TOLERANCE, its end polished at the full force; if that path
-        # does not reach the full force or its end does not polish, the path again to the
-        # curve's TOLERANCE (START_TOLERANCE's note): the loose path's larger steps can
-        # lose a path the tight one follows to the end (a 5-mass chain at 42.5 Hz, test)
-        # the loose path first on the sparse route only (START_TOLERANCE's note)
+        # on the sparse route, the path to START_TOLERANCE first, its end polished at the
+        # full force; where it falls short, turns back or does not polish, the path again
+        # to the curve's TOLERANCE, as before (START_TOLERANCE's note)
         paths = (START_TOLERANCE, TOLERANCE) if sparse is not None else (TOLERANCE,)
+        u_scale = np.full(open_guess.size, max(scale, float(np.max(np.abs(open_guess)))))
         for tolerance in dict.fromkeys(paths):
             calls[:] = [0, fraction]  # the error below reports the last path's reach
             try:
@@ -536,9 +535,7 @@ def _start_plain(
                         fraction * open_guess,
                         fraction,
                         1.0,
-                        u_scale=np.full(
-                            open_guess.size, max(scale, float(np.max(np.abs(open_guess))))
-                        ),
+                        u_scale=u_scale,
                         lam_scale=1.0,
                         settings=ContinuationSettings(
                             step=0.01,
