@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -86,6 +88,33 @@ def _residual(
     return float(np.max(np.abs(ev.residual))) / model.reference_stiffness
 
 
+def _paths(
+    monkeypatch: pytest.MonkeyPatch,
+    change: Callable[[float, Any], Any] | None = None,
+) -> list[tuple[float, Any]]:
+    """Record each force path the start follows, as (its tolerance, its branch), in order;
+    ``change(tolerance, branch)``, if given, replaces the branch the start sees."""
+    runs: list[tuple[float, Any]] = []
+    real = response.continue_branch
+
+    def recorded(*args: Any, **kwargs: Any) -> Any:
+        tolerance = kwargs["settings"].tolerance
+        branch = real(*args, **kwargs)
+        if change is not None:
+            branch = change(tolerance, branch)
+        runs.append((tolerance, branch))
+        return branch
+
+    monkeypatch.setattr(response, "continue_branch", recorded)
+    return runs
+
+
+def _examples_chain() -> Structure:
+    """examples/chain.toml's chain: five 0.5 kg masses, rigid links, 0.2 mm joints."""
+    joint = ClearanceJoint(clearance=0.2e-3, compression_stiffness=4e5, gap_stiffness=2e4)
+    return chain([0.5] * 5, [np.inf] * 5, [joint] * 5, dampers=[2.0] * 5)
+
+
 def test_the_loose_force_path_ends_on_the_tight_paths_orbit(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -97,17 +126,10 @@ def test_the_loose_force_path_ends_on_the_tight_paths_orbit(
     force = np.zeros(structure.n_dof)
     force[list(structure.dof_names).index("n41x")] = 0.1
     omega = 0.8 * float(structure.modes("open").omega[0])
-    tolerances: list[float] = []
-    real = response.continue_branch
-
-    def recorded(*args, **kwargs):
-        tolerances.append(kwargs["settings"].tolerance)
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(response, "continue_branch", recorded)
+    runs = _paths(monkeypatch)
     loose, model, basis = _start_of(structure, force, omega)
     # the homotopy ran (Newton from the linear guesses failed), once, on the loose path
-    assert tolerances == [response.START_TOLERANCE]
+    assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE]
     assert response.START_TOLERANCE > response.TOLERANCE
     monkeypatch.setattr(response, "START_TOLERANCE", response.TOLERANCE)
     tight, *_ = _start_of(structure, force, omega)
@@ -119,19 +141,12 @@ def test_the_loose_force_path_ends_on_the_tight_paths_orbit(
 def test_an_end_that_does_not_polish_is_followed_again_at_the_tolerance(
     three_links: Structure, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
-    tolerances: list[float] = []
-    real = response.continue_branch
-
-    def recorded(*args, **kwargs):
-        tolerances.append(kwargs["settings"].tolerance)
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(response, "continue_branch", recorded)
+    runs = _paths(monkeypatch)
     monkeypatch.setattr(response, "_newton_at", lambda *args, **kwargs: None)
     monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
     with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
         q, model, basis = _start_of(three_links, FORCE, OMEGA)
-    assert tolerances == [response.START_TOLERANCE, response.TOLERANCE]
+    assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE, response.TOLERANCE]
     assert any("following it again" in r.getMessage() for r in caplog.records)
     assert _residual(model, basis, q, OMEGA, FORCE) <= 1e-9 * float(np.max(np.abs(q)))
 
@@ -143,26 +158,17 @@ def test_a_loose_path_that_does_not_reach_the_force_is_followed_again_at_the_tol
     # START_TOLERANCE runs out of points (its larger steps lose the path near a grazing),
     # the path followed to TOLERANCE (the start before issue 25's fifth round) reaches the
     # full force in about 400 points: the start must still find that orbit
-    joint = ClearanceJoint(clearance=0.2e-3, compression_stiffness=4e5, gap_stiffness=2e4)
-    structure = chain([0.5] * 5, [np.inf] * 5, [joint] * 5, dampers=[2.0] * 5)
+    structure = _examples_chain()
     force = np.array([0.0, 0.0, 0.0, 0.0, 5.0])
     omega = 2.0 * np.pi * 42.5
-    runs: list[tuple[float, str]] = []
-    real = response.continue_branch
-
-    def recorded(*args, **kwargs):
-        branch = real(*args, **kwargs)
-        runs.append((kwargs["settings"].tolerance, branch.reason))
-        return branch
-
-    monkeypatch.setattr(response, "continue_branch", recorded)
+    runs = _paths(monkeypatch)
     monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
     monkeypatch.setattr(response, "START_POINTS", (600, 600))  # the tight path: ~400
     with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
         q, model, basis = _start_of(structure, force, omega)
     assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE, response.TOLERANCE]
-    assert runs[0][1] != "reached", runs
-    assert runs[1][1] == "reached", runs
+    assert runs[0][1].reason != "reached", runs
+    assert runs[1][1].reason == "reached", runs
     assert any("did not reach the full force" in r.getMessage() for r in caplog.records)
     # an HB orbit at the full force by a residual evaluated here
     assert _residual(model, basis, q, omega, force) <= 1e-9 * float(np.max(np.abs(q)))
@@ -173,16 +179,9 @@ def test_a_small_structure_follows_the_tight_path_alone(
 ) -> None:
     """Below solve.SPARSE_ABOVE unknowns the start's homotopy is as before issue 25's fifth
     round: one path, to the curve's tolerance (small paths are cheap and fold often)."""
-    tolerances: list[float] = []
-    real = response.continue_branch
-
-    def recorded(*args, **kwargs):
-        tolerances.append(kwargs["settings"].tolerance)
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(response, "continue_branch", recorded)
+    runs = _paths(monkeypatch)
     _start_of(three_links, FORCE, OMEGA)
-    assert tolerances == [response.TOLERANCE]
+    assert [tolerance for tolerance, _ in runs] == [response.TOLERANCE]
 
 
 def test_a_loose_path_that_turns_back_is_followed_again_at_the_tolerance(
@@ -192,24 +191,15 @@ def test_a_loose_path_that_turns_back_is_followed_again_at_the_tolerance(
     # in the force several times; followed to START_TOLERANCE it ended, polished, on an HB
     # orbit 32 % from the one the path followed to TOLERANCE ends on (review of issue 25).
     # A path that turns back is followed again at TOLERANCE: the start is that path's end
-    joint = ClearanceJoint(clearance=0.2e-3, compression_stiffness=4e5, gap_stiffness=2e4)
-    structure = chain([0.5] * 5, [np.inf] * 5, [joint] * 5, dampers=[2.0] * 5)
+    structure = _examples_chain()
     force = np.array([0.0, 0.0, 0.0, 0.0, 10.0])
     omega = 2.0 * np.pi * 50.0
     monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
-    runs: list[tuple[float, np.ndarray]] = []
-    real = response.continue_branch
-
-    def recorded(*args, **kwargs):
-        branch = real(*args, **kwargs)
-        runs.append((kwargs["settings"].tolerance, np.asarray(branch.lam)))
-        return branch
-
-    monkeypatch.setattr(response, "continue_branch", recorded)
+    runs = _paths(monkeypatch)
     with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
         q, model, basis = _start_of(structure, force, omega)
     assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE, response.TOLERANCE]
-    assert np.any(np.diff(runs[0][1]) < 0.0)  # the loose path turned back
+    assert np.any(np.diff(runs[0][1].lam) < 0.0)  # the loose path turned back
     assert any("turned back in the force" in r.getMessage() for r in caplog.records)
     monkeypatch.setattr(response, "START_TOLERANCE", response.TOLERANCE)
     tight, *_ = _start_of(structure, force, omega)
@@ -225,22 +215,18 @@ def test_an_end_that_does_not_polish_falls_back_even_where_the_path_does_not_tur
     never reached. Here the loose path's parameter is made monotone (its end unchanged, at
     the full force), so only a failed polish can send the start to the tight path: the
     start must then be the tight path's end, as before issue 25's fifth round."""
-    runs: list[float] = []
-    real = response.continue_branch
 
-    def recorded(*args, **kwargs):
-        branch = real(*args, **kwargs)
-        runs.append(kwargs["settings"].tolerance)
-        if kwargs["settings"].tolerance != response.TOLERANCE:
-            branch = dataclasses.replace(branch, lam=np.maximum.accumulate(branch.lam))
-        return branch
+    def monotone(tolerance: float, branch: Any) -> Any:
+        if tolerance == response.TOLERANCE:
+            return branch
+        return dataclasses.replace(branch, lam=np.maximum.accumulate(branch.lam))
 
     monkeypatch.setattr(solve, "SPARSE_ABOVE", 0)
     monkeypatch.setattr(response, "_newton_at", lambda *args, **kwargs: None)
-    monkeypatch.setattr(response, "continue_branch", recorded)
+    runs = _paths(monkeypatch, monotone)
     with caplog.at_level(logging.INFO, logger="clearjoint.harmonic"):
         q, *_ = _start_of(three_links, FORCE, OMEGA)
-    assert runs == [response.START_TOLERANCE, response.TOLERANCE]
+    assert [tolerance for tolerance, _ in runs] == [response.START_TOLERANCE, response.TOLERANCE]
     messages = [r.getMessage() for r in caplog.records]
     assert any("did not polish" in m for m in messages), messages
     assert not any("turned back" in m for m in messages), messages
