@@ -19,6 +19,7 @@ from clearjoint import ClearanceJoint, Losses, ParameterError
 from clearjoint.harmonic import HarmonicError, aft, frequency_response, hill, monodromy
 from clearjoint.harmonic.system import build
 from clearjoint.periodic import periodic_orbit
+from clearjoint.results import ResponseEvent
 from clearjoint.structure import Structure, chain, mast
 from helpers import with_losses
 from test_harmonic_aft import PYHARM, PYHARM_ZETA
@@ -280,34 +281,40 @@ def test_hill_on_stiff_contact_flags_the_points_the_monodromy_contradicts() -> N
     assert not [e for e in by_mono.events if e.kind == "untrusted"]
 
 
+def _events_on_a_chain(mu: np.ndarray) -> list[ResponseEvent]:
+    """curve_events of multipliers ``mu`` (4 points) at w = 1, 2, 3, 4 on a 2-mass chain,
+    its joints never beyond a gap edge (no grazing)."""
+    from clearjoint.harmonic.response import curve_events
+
+    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
+    omega = np.array([1.0, 2.0, 3.0, 4.0])
+    d = np.zeros((4, 2))
+    return curve_events(model, omega, mu, d, d, omega, np.ones(4), np.full(4, 1e-6))
+
+
+def _kinds(mu: np.ndarray) -> list[str]:
+    return [e.kind for e in _events_on_a_chain(mu)]
+
+
+#: A complex pair at angle +-1 rad.
+_TURN = np.exp(1j * np.array([1.0, -1.0]))
+
+
 def test_neimark_sacker_crossings_are_events_and_collisions_are_not() -> None:
     """A complex pair 0.9 -> 1.1 at angle +-1 rad between w = 2 and 3 (a real pair beside
     it): one "neimark_sacker" event at w = 2.5 by linear interpolation. A real multiplier
     through +1 and a complex pair that meets the real axis outside the circle (the largest
     complex modulus drops from 1.2 to the inside pair's 0.5) give none."""
-    from clearjoint.harmonic.response import curve_events as _events
-
-    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
-    omega = np.array([1.0, 2.0, 3.0, 4.0])
-    force = np.ones(4)
-    amplitude = np.full(4, 1e-6)
-    d = np.zeros((4, 2))  # never beyond a gap edge: no grazing
-
-    def run(mu: np.ndarray) -> list[str]:
-        found = _events(model, omega, mu, d, d, omega, force, amplitude)
-        return [e.kind for e in found]
-
-    turn = np.exp(1j * np.array([1.0, -1.0]))
     mu = np.array(
-        [np.concatenate((r * turn, [0.3, 0.2])) for r in (0.8, 0.9, 1.1, 1.2)],
+        [np.concatenate((r * _TURN, [0.3, 0.2])) for r in (0.8, 0.9, 1.1, 1.2)],
         dtype=np.complex128,
     )
-    found = _events(model, omega, mu, d, d, omega, force, amplitude)
+    found = _events_on_a_chain(mu)
     assert [e.kind for e in found] == ["neimark_sacker"]
     assert found[0].omega == pytest.approx(2.5)
     real = mu.copy()
     real[:, :2] = np.array([[0.8, 0.1], [0.9, 0.1], [1.1, 0.1], [1.2, 0.1]])
-    assert run(real) == []
+    assert _kinds(real) == []
     collide = np.array(
         [
             [1.2 * np.exp(0.2j), 1.2 * np.exp(-0.2j), 0.5j, -0.5j],
@@ -316,7 +323,7 @@ def test_neimark_sacker_crossings_are_events_and_collisions_are_not() -> None:
             [1.5, 0.9, 0.5j, -0.5j],
         ]
     )
-    assert run(collide) == []
+    assert _kinds(collide) == []
 
 
 def test_a_neimark_sacker_crossing_is_found_whatever_the_tiny_multipliers_do() -> None:
@@ -325,18 +332,12 @@ def test_a_neimark_sacker_crossing_is_found_whatever_the_tiny_multipliers_do() -
     block's route returns 0 outside its block, whose size changes from point to point):
     still one "neimark_sacker" event at w = 2.5. Counting every complex multiplier,
     however small, skipped it as a pair meeting the real axis."""
-    from clearjoint.harmonic.response import curve_events as _events
-
-    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
-    omega = np.array([1.0, 2.0, 3.0, 4.0])
-    d = np.zeros((4, 2))
-    turn = np.exp(1j * np.array([1.0, -1.0]))
     mu = np.array(
-        [np.concatenate((r * turn, [0.3, 0.2, 0.0, 0.0])) for r in (0.8, 0.9, 1.1, 1.2)],
+        [np.concatenate((r * _TURN, [0.3, 0.2, 0.0, 0.0])) for r in (0.8, 0.9, 1.1, 1.2)],
         dtype=np.complex128,
     )
     mu[2, 4:] = 1e-7 * np.exp(1j * np.array([2.0, -2.0]))
-    found = _events(model, omega, mu, d, d, omega, np.ones(4), np.full(4, 1e-6))
+    found = _events_on_a_chain(mu)
     assert [e.kind for e in found] == ["neimark_sacker"]
     assert found[0].omega == pytest.approx(2.5)
 
@@ -348,28 +349,18 @@ def test_a_second_pair_moving_beside_the_crossing_one_neither_hides_nor_fakes_it
     largest pair meets the real axis outside the circle (1.2 -> reals 1.3 and 0.9) while
     the second pair goes 0.45 -> 0.55: no event (the largest complex modulus falls from
     1.2 to 0.55, but no pair crossed the circle)."""
-    from clearjoint.harmonic.response import curve_events as _events
-
-    model = build(chain([1.0, 1.0], [1e6, 1e6], [ClearanceJoint(1e-4, 1e7)] * 2), None)
-    omega = np.array([1.0, 2.0, 3.0, 4.0])
-    d = np.zeros((4, 2))
-    turn = np.exp(1j * np.array([1.0, -1.0]))
     other = np.exp(1j * np.array([2.0, -2.0]))
     mu = np.array(
         [
-            np.concatenate((r * turn, s * other, [0.0, 0.0]))
+            np.concatenate((r * _TURN, s * other, [0.0, 0.0]))
             for r, s in ((0.8, 0.4), (0.9, 0.45), (1.1, 0.55), (1.2, 0.6))
         ],
         dtype=np.complex128,
     )
-
-    def kinds(m: np.ndarray) -> list[str]:
-        return [e.kind for e in _events(model, omega, m, d, d, omega, np.ones(4), np.full(4, 1e-6))]
-
-    found = _events(model, omega, mu, d, d, omega, np.ones(4), np.full(4, 1e-6))
+    found = _events_on_a_chain(mu)
     assert [e.kind for e in found] == ["neimark_sacker"]
     assert found[0].omega == pytest.approx(2.5)
     collide = mu.copy()
-    collide[:2, :2] = np.array([1.2, 1.1])[:, None] * turn
+    collide[:2, :2] = np.array([1.2, 1.1])[:, None] * _TURN
     collide[2:, :2] = np.array([[1.3, 0.9], [1.4, 0.8]])
-    assert kinds(collide) == []
+    assert _kinds(collide) == []
