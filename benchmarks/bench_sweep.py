@@ -268,7 +268,6 @@ def store_targets(scale: float = 1.0, rounds: int = 3, parts: tuple[int, ...] = 
     of ``rounds`` runs, the configurations alternating within a round, so that a change
     of the machine's load falls on all of them alike.
     """
-
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (shared)")
     print(f"each figure: the median of {rounds} rounds")
     if 1 in parts:
@@ -513,10 +512,14 @@ if __name__ == "__main__":  # LocalCluster workers are spawned processes: keep t
     )
     options = parser.parse_args()
     if options.store_targets:
-        parts = tuple(int(x) for x in options.parts.split(","))
-        if not parts or not set(parts) <= {1, 2, 3}:
+        parts = tuple(x.strip() for x in options.parts.split(","))
+        if not set(parts) <= {"1", "2", "3"}:
             parser.error(f"--parts takes 1, 2 and 3, comma-separated; got {options.parts!r}")
-        store_targets(0.05 if options.smoke else 1.0, 1 if options.smoke else options.rounds, parts)
+        store_targets(
+            0.05 if options.smoke else 1.0,
+            1 if options.smoke else options.rounds,
+            tuple(int(x) for x in parts),
+        )
         raise SystemExit(0)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     sizes = [(cost, points // 20, chunk // 10) for cost, points, chunk in CASES]
